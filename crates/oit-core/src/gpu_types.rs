@@ -1,0 +1,32 @@
+//! `#[repr(C)]` structs shared with WGSL. Each mirrors a struct in `shaders/`; the
+//! `layout_sizes` test checks the sizes naga computes against these.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Mirrors `FrameUniform` in `shaders/common/scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniform {
+    pub view_proj: [[f32; 4]; 4],
+    pub background: [f32; 4],
+    pub size: [u32; 2],
+    pub triangle_count: u32,
+    pub seed: u32,
+}
+
+/// Mirrors `Node` in `shaders/common/pool.wgsl`: depth, next index, straight RGBA.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PoolNode {
+    pub depth: f32,
+    pub next: u32,
+    pub rgba: [f32; 4],
+}
+
+/// Mirrors `Alloc` in `shaders/common/pool.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct Alloc {
+    pub count: u32,
+    pub capacity: u32,
+}

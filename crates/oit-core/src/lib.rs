@@ -1,0 +1,22 @@
+//! oit-core: order-independent transparency methods on wgpu, with an exact A-buffer and a
+//! CPU float64 reference to measure them against. No Python, no windowing.
+
+pub mod context;
+pub mod error;
+pub mod gpu_types;
+pub mod method;
+mod pipeline;
+pub mod reference;
+pub mod renderer;
+pub mod scene;
+pub mod shader;
+mod targets;
+mod timer;
+mod upload;
+
+pub use context::GpuContext;
+pub use error::{OitError, Result};
+pub use method::{methods, MethodInfo, ParamInfo, ParamKind, ParamValue, Params};
+pub use reference::{reference, ReferenceImage};
+pub use renderer::{shared_context, Frame, Renderer, Stats};
+pub use scene::{Camera, Mesh, Scene};

@@ -1,0 +1,206 @@
+//! The method trait, the registry of names, and parameter validation.
+//! Adding a method: one file here, its WGSL, one line in `REGISTRY`, and its tests.
+
+mod abuffer;
+mod blend;
+
+use std::collections::BTreeMap;
+
+use crate::context::GpuContext;
+use crate::error::{invalid, Result};
+use crate::scene::Camera;
+use crate::targets::Targets;
+use crate::timer::PassTimer;
+use crate::upload::GpuScene;
+
+/// A parameter's type, range and default.
+#[derive(Clone, Copy, Debug)]
+pub enum ParamKind {
+    Int { min: i64, max: i64, default: i64 },
+    Float { min: f64, max: f64, default: f64 },
+    Choice { choices: &'static [&'static str], default: &'static str },
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct ParamInfo {
+    pub name: &'static str,
+    pub kind: ParamKind,
+    pub doc: &'static str,
+}
+
+/// What `oit.methods()` reports about a method.
+#[derive(Clone, Copy, Debug)]
+pub struct MethodInfo {
+    pub name: &'static str,
+    pub summary: &'static str,
+    pub exact: bool,
+    pub bounded_memory: bool,
+    pub passes: &'static [&'static str],
+    pub params: &'static [ParamInfo],
+    create: fn(&GpuContext) -> Box<dyn Method>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamValue {
+    Int(i64),
+    Float(f64),
+    Str(String),
+}
+
+/// Parameters after validation, every declared one present (defaults filled in).
+#[derive(Clone, Debug, Default)]
+pub struct Params(pub BTreeMap<&'static str, ParamValue>);
+
+impl Params {
+    pub fn int(&self, name: &str) -> i64 {
+        match self.0.get(name) {
+            Some(ParamValue::Int(v)) => *v,
+            other => panic!("parameter '{name}' is not an int: {other:?}"),
+        }
+    }
+    pub fn float(&self, name: &str) -> f64 {
+        match self.0.get(name) {
+            Some(ParamValue::Float(v)) => *v,
+            Some(ParamValue::Int(v)) => *v as f64,
+            other => panic!("parameter '{name}' is not a float: {other:?}"),
+        }
+    }
+    pub fn choice(&self, name: &str) -> &str {
+        match self.0.get(name) {
+            Some(ParamValue::Str(v)) => v,
+            other => panic!("parameter '{name}' is not a choice: {other:?}"),
+        }
+    }
+}
+
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED];
+
+pub fn methods() -> &'static [MethodInfo] {
+    REGISTRY
+}
+
+/// Levenshtein distance, for "did you mean" hints.
+fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + (ca != *cb) as usize).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+fn did_you_mean<'a>(name: &str, options: impl Iterator<Item = &'a str>) -> String {
+    options
+        .map(|o| (distance(name, o), o))
+        .filter(|(d, _)| *d <= 2)
+        .min()
+        .map(|(_, o)| format!("; did you mean '{o}'?"))
+        .unwrap_or_default()
+}
+
+pub fn lookup(name: &str) -> Result<&'static MethodInfo> {
+    REGISTRY.iter().find(|m| m.name == name).ok_or_else(|| {
+        let names: Vec<&str> = REGISTRY.iter().map(|m| m.name).collect();
+        invalid!(
+            "unknown method '{name}'{}; valid methods: {}",
+            did_you_mean(name, names.iter().copied()),
+            names.join(", ")
+        )
+    })
+}
+
+impl MethodInfo {
+    /// Checks names, types and ranges of `given` and fills in defaults.
+    pub fn resolve_params(&self, given: &[(String, ParamValue)]) -> Result<Params> {
+        let mut out = BTreeMap::new();
+        for (name, value) in given {
+            let info = self.params.iter().find(|p| p.name == name).ok_or_else(|| {
+                let valid: Vec<&str> = self.params.iter().map(|p| p.name).collect();
+                invalid!(
+                    "method '{}' has no parameter '{name}'{}; its parameters: {}",
+                    self.name,
+                    did_you_mean(name, valid.iter().copied()),
+                    if valid.is_empty() { "none".to_string() } else { valid.join(", ") }
+                )
+            })?;
+            let v = check(self.name, info, value)?;
+            out.insert(info.name, v);
+        }
+        for p in self.params {
+            out.entry(p.name).or_insert_with(|| match p.kind {
+                ParamKind::Int { default, .. } => ParamValue::Int(default),
+                ParamKind::Float { default, .. } => ParamValue::Float(default),
+                ParamKind::Choice { default, .. } => ParamValue::Str(default.to_string()),
+            });
+        }
+        Ok(Params(out))
+    }
+
+    pub(crate) fn instantiate(&self, gpu: &GpuContext) -> Box<dyn Method> {
+        (self.create)(gpu)
+    }
+}
+
+fn check(method: &str, info: &ParamInfo, value: &ParamValue) -> Result<ParamValue> {
+    let name = info.name;
+    match (info.kind, value) {
+        (ParamKind::Int { min, max, .. }, ParamValue::Int(v)) => {
+            if *v < min || *v > max {
+                return Err(invalid!("{method}: {name} = {v} is out of range; use {min} <= {name} <= {max}"));
+            }
+            Ok(ParamValue::Int(*v))
+        }
+        (ParamKind::Float { min, max, .. }, ParamValue::Float(_) | ParamValue::Int(_)) => {
+            let v = match value {
+                ParamValue::Float(f) => *f,
+                ParamValue::Int(i) => *i as f64,
+                ParamValue::Str(_) => unreachable!(),
+            };
+            if !v.is_finite() || v < min || v > max {
+                return Err(invalid!("{method}: {name} = {v} is out of range; use {min} <= {name} <= {max}"));
+            }
+            Ok(ParamValue::Float(v))
+        }
+        (ParamKind::Choice { choices, .. }, ParamValue::Str(s)) => {
+            if !choices.contains(&s.as_str()) {
+                return Err(invalid!("{method}: {name} = '{s}' is not one of: {}", choices.join(", ")));
+            }
+            Ok(ParamValue::Str(s.clone()))
+        }
+        (kind, v) => Err(invalid!("{method}: {name} has the wrong type ({v:?}); expected {kind:?}")),
+    }
+}
+
+/// Everything a method needs to record one frame. The opaque pass and the census have run;
+/// the method writes its final image into `targets.out`.
+pub(crate) struct FrameCtx<'a> {
+    pub gpu: &'a GpuContext,
+    pub scene: &'a GpuScene,
+    pub camera: &'a Camera,
+    pub targets: &'a Targets,
+    pub targets_layout: &'a wgpu::BindGroupLayout,
+    pub scene_layout: &'a wgpu::BindGroupLayout,
+    pub timer: &'a mut PassTimer,
+    pub params: &'a Params,
+}
+
+/// What a method reports about its frame, beyond what the renderer measures.
+#[derive(Debug, Default)]
+pub struct MethodReport {
+    /// GPU memory the method itself allocated (buffers kept for this frame).
+    pub memory_bytes: u64,
+    /// Fragments a bounded structure could not hold.
+    pub overflow_fragments: u64,
+    /// Method-specific numbers (e.g. how often the node pool grew).
+    pub extra: Vec<(&'static str, f64)>,
+}
+
+pub(crate) trait Method: Send {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport>;
+}

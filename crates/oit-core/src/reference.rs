@@ -1,0 +1,231 @@
+//! The CPU float64 reference: a ray through each pixel center between the near and far
+//! planes, every intersection found with a BVH (obvhs), sorted by depth and composited
+//! front to back in f64; the nearest opaque hit ends the ray. The edge and tie rule is in
+//! docs/methods.md ("The reference").
+
+use glam::{DMat4, DVec2, DVec3, DVec4, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::{builder::build_bvh2, Bvh2};
+use obvhs::ray::Ray;
+use obvhs::{Boundable, BvhBuildParams};
+
+use crate::error::{invalid, Result};
+use crate::scene::{Camera, Scene};
+
+/// A pixel center closer than this to a triangle edge (in pixels) is ambiguous: the
+/// rasterizer snaps vertices to 1/256 pixel, so its coverage there can differ.
+pub const EDGE_PIXELS: f64 = 0.01;
+/// Hits whose NDC depths differ by less than this may sort differently in float32.
+pub const DEPTH_TIE: f64 = 4e-6;
+
+pub struct ReferenceImage {
+    pub width: u32,
+    pub height: u32,
+    /// Row-major (height, width, 4): final RGB and background coverage, in f64.
+    pub image: Vec<f64>,
+    /// Pixels where a GPU may legitimately differ (edge or depth tie), row-major.
+    pub ambiguous: Vec<bool>,
+    pub depth_complexity: Vec<u32>,
+}
+
+struct Tri {
+    v: [DVec3; 3],
+    c: [DVec4; 3],
+    opaque: bool,
+    /// Vertex positions in pixels when all three are in front of the eye (w > 0).
+    screen: Option<[DVec2; 3]>,
+}
+
+struct Bounds(Aabb);
+
+impl Boundable for Bounds {
+    fn aabb(&self) -> Aabb {
+        self.0
+    }
+}
+
+struct Hit {
+    z: f64,
+    color: DVec4,
+    opaque: bool,
+}
+
+fn to_pixels(vp: &DMat4, p: DVec3, w: f64, h: f64) -> Option<DVec2> {
+    let c = *vp * p.extend(1.0);
+    (c.w > 0.0).then(|| DVec2::new((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h))
+}
+
+/// Signed distances (pixels) from `p` to the three edges of the screen triangle, positive inside.
+fn edge_distances(s: &[DVec2; 3], p: DVec2) -> [f64; 3] {
+    let area = (s[1] - s[0]).perp_dot(s[2] - s[0]);
+    let sign = if area >= 0.0 { 1.0 } else { -1.0 };
+    let mut d = [0.0; 3];
+    for i in 0..3 {
+        let a = s[i];
+        let b = s[(i + 1) % 3];
+        let len = (b - a).length().max(1e-300);
+        d[i] = sign * (b - a).perp_dot(p - a) / len;
+    }
+    d
+}
+
+/// Möller-Trumbore in f64 on the line o + t * d: returns (t, u, v) without range checks.
+fn intersect(t: &Tri, o: DVec3, d: DVec3) -> Option<(f64, f64, f64)> {
+    let e1 = t.v[1] - t.v[0];
+    let e2 = t.v[2] - t.v[0];
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = o - t.v[0];
+    let q = s.cross(e1);
+    Some((e2.dot(q) * inv, s.dot(p) * inv, d.dot(q) * inv))
+}
+
+/// Whether the pixel center is covered, with the rasterizer's top-left rule for centers
+/// exactly on an edge (so that a shared edge is drawn once); `dist` from `edge_distances`.
+fn covered(s: &[DVec2; 3], dist: &[f64; 3]) -> bool {
+    let area = (s[1] - s[0]).perp_dot(s[2] - s[0]);
+    (0..3).all(|i| {
+        if dist[i] != 0.0 {
+            return dist[i] > 0.0;
+        }
+        // Edge direction with the interior on its positive side (y grows downwards).
+        let d = if area >= 0.0 { s[(i + 1) % 3] - s[i] } else { s[i] - s[(i + 1) % 3] };
+        (d.y == 0.0 && d.x > 0.0) || d.y < 0.0
+    })
+}
+
+fn key_less(a: &Hit, b: &Hit) -> std::cmp::Ordering {
+    a.z.total_cmp(&b.z)
+        .then(a.color.x.total_cmp(&b.color.x))
+        .then(a.color.y.total_cmp(&b.color.y))
+        .then(a.color.z.total_cmp(&b.color.z))
+        .then(a.color.w.total_cmp(&b.color.w))
+}
+
+pub fn reference(scene: &Scene, camera: &Camera, width: u32, height: u32, background: [f64; 3]) -> Result<ReferenceImage> {
+    if width == 0 || height == 0 {
+        return Err(invalid!("width and height must be positive, got {width} x {height}"));
+    }
+    let vp = camera.view_proj;
+    let inv = vp.inverse();
+    let (wf, hf) = (width as f64, height as f64);
+    let mut tris = Vec::new();
+    for m in scene.meshes() {
+        for ix in &m.indices {
+            let v = ix.map(|i| DVec3::from(m.positions[i as usize].map(|x| x as f64)));
+            let c = ix.map(|i| DVec4::from(m.colors[i as usize].map(|x| x as f64)));
+            let screen = match (to_pixels(&vp, v[0], wf, hf), to_pixels(&vp, v[1], wf, hf), to_pixels(&vp, v[2], wf, hf)) {
+                (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+                _ => None,
+            };
+            tris.push(Tri { v, c, opaque: m.opaque, screen });
+        }
+    }
+    // The BVH is f32: pad each box so that rounding cannot drop a triangle the f64 test hits.
+    let bounds: Vec<Bounds> = tris
+        .iter()
+        .map(|t| {
+            let lo = t.v[0].min(t.v[1]).min(t.v[2]);
+            let hi = t.v[0].max(t.v[1]).max(t.v[2]);
+            let pad = (hi - lo).max_element().max(lo.abs().max_element()).max(hi.abs().max_element()) * 1e-5 + 1e-30;
+            Bounds(Aabb::new((lo - pad).as_vec3().into(), (hi + pad).as_vec3().into()))
+        })
+        .collect();
+    let bvh = if tris.is_empty() { None } else { Some(build_bvh2(&bounds, BvhBuildParams::fast_build(), &mut Default::default())) };
+
+    let pixels = (width * height) as usize;
+    let mut image = vec![0.0f64; pixels * 4];
+    let mut ambiguous = vec![false; pixels];
+    let mut complexity = vec![0u32; pixels];
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(height as usize);
+    let rows_per = (height as usize).div_ceil(threads);
+    std::thread::scope(|s| {
+        let chunks = image
+            .chunks_mut(rows_per * width as usize * 4)
+            .zip(ambiguous.chunks_mut(rows_per * width as usize))
+            .zip(complexity.chunks_mut(rows_per * width as usize));
+        for (i, ((img, amb), cx)) in chunks.enumerate() {
+            let (tris, bvh, inv) = (&tris, bvh.as_ref(), &inv);
+            s.spawn(move || {
+                let row0 = i * rows_per;
+                for (k, px) in amb.iter_mut().enumerate() {
+                    let (row, col) = (row0 + k / width as usize, k % width as usize);
+                    let (x, y) = ((col as f64 + 0.5) * 2.0 / wf - 1.0, 1.0 - (row as f64 + 0.5) * 2.0 / hf);
+                    let center = DVec2::new(col as f64 + 0.5, row as f64 + 0.5);
+                    let (o, end) = camera.unproject_segment(inv, x, y);
+                    let d = end - o;
+                    let mut hits: Vec<Hit> = Vec::new();
+                    let mut edge = false;
+                    if let Some(bvh) = bvh {
+                        trace(bvh, tris, o, d, center, &vp, &mut hits, &mut edge);
+                    }
+                    let (rgba, n, tie) = composite(&mut hits, background);
+                    img[4 * k..4 * k + 4].copy_from_slice(&rgba);
+                    *px = edge || tie;
+                    cx[k] = n;
+                }
+            });
+        }
+    });
+    Ok(ReferenceImage { width, height, image, ambiguous, depth_complexity: complexity })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn trace(bvh: &Bvh2, tris: &[Tri], o: DVec3, d: DVec3, center: DVec2, vp: &DMat4, hits: &mut Vec<Hit>, edge: &mut bool) {
+    let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()), -1e-3, 1.0 + 1e-3);
+    bvh.ray_traverse_anyhit(ray, |_, id| {
+        let t = &tris[bvh.primitive_indices[id] as usize];
+        let Some((tt, u, v)) = intersect(t, o, d) else { return };
+        let inside = match &t.screen {
+            Some(s) => {
+                let dist = edge_distances(s, center);
+                if dist.iter().all(|&e| e > -EDGE_PIXELS) && dist.iter().any(|&e| e.abs() < EDGE_PIXELS) {
+                    *edge = true;
+                }
+                covered(s, &dist)
+            }
+            None => {
+                if u.min(v).min(1.0 - u - v).abs() < 1e-9 {
+                    *edge = true;
+                }
+                u >= 0.0 && v >= 0.0 && u + v <= 1.0
+            }
+        };
+        if inside && (0.0..=1.0).contains(&tt) {
+            let p = o + d * tt;
+            let c = *vp * p.extend(1.0);
+            let color = t.c[0] * (1.0 - u - v) + t.c[1] * u + t.c[2] * v;
+            hits.push(Hit { z: c.z / c.w, color, opaque: t.opaque });
+        }
+    });
+}
+
+/// Front-to-back composite of the hits before the nearest opaque one. Returns the pixel,
+/// the transparent depth complexity and whether two relevant depths nearly tie.
+fn composite(hits: &mut [Hit], background: [f64; 3]) -> ([f64; 4], u32, bool) {
+    hits.sort_by(key_less);
+    let mut tie = hits.iter().any(|h| h.z.abs() < DEPTH_TIE || (1.0 - h.z).abs() < DEPTH_TIE);
+    let opaque = hits.iter().position(|h| h.opaque);
+    let end = opaque.unwrap_or(hits.len());
+    for w in hits[..(end + 1).min(hits.len())].windows(2) {
+        if (w[1].z - w[0].z).abs() < DEPTH_TIE && (w[0].color != w[1].color || w[0].opaque != w[1].opaque) {
+            tie = true;
+        }
+    }
+    let mut accum = DVec3::ZERO;
+    let mut trans = 1.0f64;
+    for h in &hits[..end] {
+        accum += trans * h.color.w * h.color.truncate();
+        trans *= 1.0 - h.color.w;
+    }
+    let (behind, cover) = match opaque {
+        Some(i) => (hits[i].color.truncate(), 1.0),
+        None => (DVec3::from(background), 0.0),
+    };
+    let rgb = accum + trans * behind;
+    ([rgb.x, rgb.y, rgb.z, 1.0 - trans * (1.0 - cover)], end as u32, tie)
+}

@@ -1,0 +1,285 @@
+//! The renderer: frame targets, the scene upload cache, the opaque pass, the census of
+//! transparent fragments, and dispatch to the method by name.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
+
+use crate::context::GpuContext;
+use crate::error::{invalid, OitError, Result};
+use crate::gpu_types::FrameUniform;
+use crate::method::{self, FrameCtx, Method, ParamValue, Params};
+use crate::pipeline;
+use crate::scene::{Camera, Scene};
+use crate::shader;
+use crate::targets::{padded_row, read_buffer, targets_layout, Targets, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::timer::PassTimer;
+use crate::upload::{scene_layout, GpuScene};
+
+/// Numbers about one frame (see the contract in README and docs/methods.md).
+#[derive(Clone, Debug, Default)]
+pub struct Stats {
+    pub method: String,
+    pub params: Params,
+    /// Transparent fragments that passed the opaque depth test.
+    pub fragments: u64,
+    pub max_depth_complexity: u32,
+    /// GPU memory the method allocated for this frame (excludes the shared targets).
+    pub memory_bytes: u64,
+    /// Shared frame targets: base color, depth, output, census counts.
+    pub target_bytes: u64,
+    pub scene_bytes: u64,
+    pub gpu_time_ms: Option<f64>,
+    pub pass_times_ms: Vec<(&'static str, f64)>,
+    pub overflow_fragments: u64,
+    pub wall_time_ms: f64,
+    pub extra: Vec<(&'static str, f64)>,
+}
+
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    /// Row-major (height, width, 4) linear RGBA; row 0 is the top of the picture.
+    pub image: Vec<f32>,
+    /// Transparent fragments per pixel (same layout, one value a pixel).
+    pub depth_complexity: Vec<u32>,
+    pub stats: Stats,
+}
+
+/// Pipelines and layouts every frame uses, whatever the method.
+struct Shared {
+    scene_layout: wgpu::BindGroupLayout,
+    targets_layout: wgpu::BindGroupLayout,
+    counts_layout: wgpu::BindGroupLayout,
+    opaque: wgpu::RenderPipeline,
+    census: wgpu::RenderPipeline,
+    uniform: wgpu::Buffer,
+}
+
+impl Shared {
+    fn new(gpu: &GpuContext) -> Self {
+        let d = &gpu.device;
+        let scene_layout = scene_layout(d);
+        let targets_layout = targets_layout(d);
+        let counts_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("census"),
+            entries: &[pipeline::storage_entry(0)],
+        });
+        let opaque_module = shader::module(d, "opaque.wgsl", &[]);
+        let opaque = pipeline::geometry(
+            d,
+            "opaque",
+            &opaque_module,
+            &pipeline::layout(d, &[&scene_layout]),
+            "fs_opaque",
+            &[Some(COLOR_FORMAT.into())],
+            Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+        );
+        let census_module = shader::module(d, "census.wgsl", &[]);
+        let census = pipeline::geometry(
+            d,
+            "census",
+            &census_module,
+            &pipeline::layout(d, &[&scene_layout, &targets_layout, &counts_layout]),
+            "fs_census",
+            &[],
+            pipeline::depth_test_only(),
+        );
+        let uniform = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame uniform"),
+            size: std::mem::size_of::<FrameUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self { scene_layout, targets_layout, counts_layout, opaque, census, uniform }
+    }
+}
+
+/// Renders scenes at one size with any registered method.
+pub struct Renderer {
+    gpu: Arc<GpuContext>,
+    width: u32,
+    height: u32,
+    shared: Shared,
+    targets: Targets,
+    scene: Option<((u64, u64), GpuScene)>,
+    methods: HashMap<&'static str, Box<dyn Method>>,
+    timer: PassTimer,
+}
+
+/// One device per adapter choice, shared by every renderer in the process.
+pub fn shared_context(adapter: Option<&str>) -> Result<Arc<GpuContext>> {
+    static CONTEXTS: OnceLock<Mutex<HashMap<String, Arc<GpuContext>>>> = OnceLock::new();
+    let key = adapter.map(str::to_string).or_else(|| std::env::var("OIT_ADAPTER").ok()).unwrap_or_default();
+    let mut map = CONTEXTS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(c) = map.get(&key) {
+        return Ok(c.clone());
+    }
+    let ctx = Arc::new(GpuContext::new(adapter)?);
+    map.insert(key, ctx.clone());
+    Ok(ctx)
+}
+
+impl Renderer {
+    pub fn new(gpu: Arc<GpuContext>, width: u32, height: u32) -> Result<Self> {
+        let max = gpu.limits.max_texture_dimension_2d;
+        if width == 0 || height == 0 {
+            return Err(invalid!("width and height must be positive, got {width} x {height}"));
+        }
+        if width > max || height > max {
+            return Err(OitError::OutOfMemory(format!(
+                "{width} x {height} passes the adapter's largest texture ({max} x {max}): render at most {max} pixels a side"
+            )));
+        }
+        let shared = Shared::new(&gpu);
+        let targets = Targets::new(&gpu, width, height, &shared.targets_layout, &shared.counts_layout);
+        let timer = PassTimer::new(&gpu);
+        Ok(Self { gpu, width, height, shared, targets, scene: None, methods: HashMap::new(), timer })
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    pub fn context(&self) -> &Arc<GpuContext> {
+        &self.gpu
+    }
+
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        camera: &Camera,
+        method_name: &str,
+        params: &[(String, ParamValue)],
+        background: [f32; 3],
+    ) -> Result<Frame> {
+        let start = Instant::now();
+        let info = method::lookup(method_name)?;
+        let params = info.resolve_params(params)?;
+        if background.iter().any(|c| !c.is_finite() || !(0.0..=1.0).contains(c)) {
+            return Err(invalid!("background {background:?} must be three linear RGB values in [0, 1]"));
+        }
+        self.upload(scene)?;
+        let gpu = self.gpu.clone();
+        let (_, gpu_scene) = self.scene.as_ref().expect("uploaded above");
+        let uniform = FrameUniform {
+            view_proj: camera.matrix_f32().to_cols_array_2d(),
+            background: [background[0], background[1], background[2], 0.0],
+            size: [self.width, self.height],
+            triangle_count: gpu_scene.transparent.triangles,
+            seed: 0,
+        };
+        gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
+        self.opaque_and_census(gpu_scene, background);
+
+        let method = self.methods.entry(info.name).or_insert_with(|| info.instantiate(&gpu));
+        self.timer.reset();
+        let mut cx = FrameCtx {
+            gpu: &gpu,
+            scene: gpu_scene,
+            camera,
+            targets: &self.targets,
+            targets_layout: &self.shared.targets_layout,
+            scene_layout: &self.shared.scene_layout,
+            timer: &mut self.timer,
+            params: &params,
+        };
+        let report = method.render(&mut cx)?;
+        let pass_times = self.timer.read(&gpu)?;
+        let (image, depth_complexity) = self.read_frame()?;
+        let stats = Stats {
+            method: info.name.to_string(),
+            params,
+            fragments: depth_complexity.iter().map(|&c| c as u64).sum(),
+            max_depth_complexity: depth_complexity.iter().copied().max().unwrap_or(0),
+            memory_bytes: report.memory_bytes,
+            target_bytes: self.targets.bytes(),
+            scene_bytes: gpu_scene.transparent.bytes + gpu_scene.opaque.bytes,
+            gpu_time_ms: pass_times.as_ref().map(|p| p.iter().map(|(_, t)| t).sum()),
+            pass_times_ms: pass_times.unwrap_or_default(),
+            overflow_fragments: report.overflow_fragments,
+            wall_time_ms: start.elapsed().as_secs_f64() * 1e3,
+            extra: report.extra,
+        };
+        Ok(Frame { width: self.width, height: self.height, image, depth_complexity, stats })
+    }
+
+    fn upload(&mut self, scene: &Scene) -> Result<()> {
+        if self.scene.as_ref().map(|(k, _)| *k) != Some(scene.key()) {
+            self.scene = None; // free the old buffers first
+            let s = GpuScene::new(&self.gpu, scene, &self.shared.scene_layout, &self.shared.uniform)?;
+            self.scene = Some((scene.key(), s));
+        }
+        Ok(())
+    }
+
+    /// Opaque geometry into base color and depth, then the untimed fragment census.
+    fn opaque_and_census(&self, scene: &GpuScene, bg: [f32; 3]) {
+        let t = &self.targets;
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("opaque"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &t.base,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 0.0 }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &t.depth,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.shared.opaque);
+            scene.opaque.draw_all(&mut pass);
+        }
+        enc.clear_buffer(&t.counts, 0, None);
+        {
+            let mut pass = pipeline::capture_pass(&mut enc, "census", &t.depth, None);
+            pass.set_pipeline(&self.shared.census);
+            pass.set_bind_group(1, &t.group, &[]);
+            pass.set_bind_group(2, &t.counts_group, &[]);
+            scene.transparent.draw_all(&mut pass);
+        }
+        enc.copy_buffer_to_buffer(&t.counts, 0, &t.counts_readback, 0, t.counts.size().min(t.counts_readback.size()));
+        self.gpu.queue.submit([enc.finish()]);
+    }
+
+    fn read_frame(&self) -> Result<(Vec<f32>, Vec<u32>)> {
+        let t = &self.targets;
+        let row = padded_row(t.width, 16);
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            t.out_texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &t.image_readback,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+            },
+            t.out_texture.size(),
+        );
+        self.gpu.queue.submit([enc.finish()]);
+        let raw = read_buffer(&self.gpu, &t.image_readback, row as u64 * t.height as u64)?;
+        let mut image = Vec::with_capacity((t.width * t.height * 4) as usize);
+        for r in 0..t.height as usize {
+            let line = &raw[r * row as usize..r * row as usize + t.width as usize * 16];
+            image.extend(bytemuck::pod_collect_to_vec::<u8, f32>(line));
+        }
+        let pixels = t.width as u64 * t.height as u64;
+        let counts_raw = read_buffer(&self.gpu, &t.counts_readback, pixels * 4)?;
+        Ok((image, bytemuck::pod_collect_to_vec(&counts_raw)))
+    }
+}

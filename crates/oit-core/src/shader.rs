@@ -1,0 +1,73 @@
+//! WGSL sources: `//!include path` directives resolved from the embedded `shaders/` tree,
+//! and compile-time constants prepended from Rust so that each number lives in one place.
+
+/// Every WGSL file, embedded at build time, by path relative to `shaders/`.
+pub const SOURCES: &[(&str, &str)] = &[
+    ("common/scene.wgsl", include_str!("../../../shaders/common/scene.wgsl")),
+    ("common/targets.wgsl", include_str!("../../../shaders/common/targets.wgsl")),
+    ("common/fullscreen.wgsl", include_str!("../../../shaders/common/fullscreen.wgsl")),
+    ("common/pool.wgsl", include_str!("../../../shaders/common/pool.wgsl")),
+    ("opaque.wgsl", include_str!("../../../shaders/opaque.wgsl")),
+    ("census.wgsl", include_str!("../../../shaders/census.wgsl")),
+    ("blend.wgsl", include_str!("../../../shaders/blend.wgsl")),
+    ("abuffer.wgsl", include_str!("../../../shaders/abuffer.wgsl")),
+];
+
+/// A compile-time constant injected in front of a shader.
+#[derive(Clone, Copy, Debug)]
+pub enum Const {
+    U32(&'static str, u32),
+    F32(&'static str, f32),
+}
+
+/// Constants a shader needs when it is validated without a pipeline (tests, tools).
+pub const DEFAULT_CONSTS: &[Const] = &[Const::U32("NODES_PER_BINDING", 1 << 20), Const::U32("BATCH", 32)];
+
+fn source(path: &str) -> &'static str {
+    SOURCES
+        .iter()
+        .find(|(p, _)| *p == path)
+        .map(|(_, s)| *s)
+        .unwrap_or_else(|| panic!("shader '{path}' is not in shader::SOURCES"))
+}
+
+fn expand(path: &str, out: &mut String, seen: &mut Vec<String>) {
+    if seen.iter().any(|s| s == path) {
+        return;
+    }
+    seen.push(path.to_string());
+    for line in source(path).lines() {
+        match line.trim().strip_prefix("//!include ") {
+            Some(inc) => expand(inc.trim(), out, seen),
+            None => {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+}
+
+/// The full WGSL text of `path` with its includes and the given constants.
+pub fn compose(path: &str, consts: &[Const]) -> String {
+    let mut out = String::new();
+    for c in consts {
+        match c {
+            Const::U32(name, v) => out.push_str(&format!("const {name}: u32 = {v}u;\n")),
+            Const::F32(name, v) => out.push_str(&format!("const {name}: f32 = {v:?};\n")),
+        }
+    }
+    expand(path, &mut out, &mut Vec::new());
+    out
+}
+
+/// Top-level shader files (not the `common/` helpers).
+pub fn entry_files() -> impl Iterator<Item = &'static str> {
+    SOURCES.iter().map(|(p, _)| *p).filter(|p| !p.starts_with("common/"))
+}
+
+pub(crate) fn module(device: &wgpu::Device, path: &str, consts: &[Const]) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(path),
+        source: wgpu::ShaderSource::Wgsl(compose(path, consts).into()),
+    })
+}

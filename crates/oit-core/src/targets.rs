@@ -1,0 +1,142 @@
+//! Per-size frame resources shared by every method: the opaque color with coverage
+//! (`base`), the opaque depth, the output image, census counts, and their readbacks.
+
+use crate::context::GpuContext;
+
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Bytes per row of a texture readback, padded to wgpu's 256-byte copy alignment.
+pub fn padded_row(width: u32, bytes_per_pixel: u32) -> u32 {
+    let a = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    (width * bytes_per_pixel).div_ceil(a) * a
+}
+
+pub struct Targets {
+    pub width: u32,
+    pub height: u32,
+    pub base: wgpu::TextureView,
+    pub depth: wgpu::TextureView,
+    pub out_texture: wgpu::Texture,
+    pub out: wgpu::TextureView,
+    pub base_texture: wgpu::Texture,
+    /// Group 1 of storage-writing and resolve passes: opaque depth and base color.
+    pub group: wgpu::BindGroup,
+    pub counts: wgpu::Buffer,
+    pub counts_group: wgpu::BindGroup,
+    pub image_readback: wgpu::Buffer,
+    pub counts_readback: wgpu::Buffer,
+}
+
+fn texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+pub fn targets_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("targets"),
+        entries: &[
+            tex(0, wgpu::TextureSampleType::Depth),
+            tex(1, wgpu::TextureSampleType::Float { filterable: false }),
+        ],
+    })
+}
+
+impl Targets {
+    pub fn new(gpu: &GpuContext, width: u32, height: u32, layout: &wgpu::BindGroupLayout, counts_layout: &wgpu::BindGroupLayout) -> Self {
+        let d = &gpu.device;
+        use wgpu::TextureUsages as U;
+        let base_texture = texture(d, "base", width, height, COLOR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
+        let depth_texture = texture(d, "depth", width, height, DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING);
+        let out_texture = texture(
+            d,
+            "out",
+            width,
+            height,
+            COLOR_FORMAT,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST,
+        );
+        let base = base_texture.create_view(&Default::default());
+        let depth = depth_texture.create_view(&Default::default());
+        let out = out_texture.create_view(&Default::default());
+        let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("targets"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&base) },
+            ],
+        });
+        let pixels = width as u64 * height as u64;
+        let counts = storage_buffer(d, "census counts", pixels * 4, wgpu::BufferUsages::COPY_SRC);
+        let counts_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("census"),
+            layout: counts_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: counts.as_entire_binding() }],
+        });
+        let readback = |label, size| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let image_readback = readback("image readback", padded_row(width, 16) as u64 * height as u64);
+        let counts_readback = readback("counts readback", pixels * 4);
+        Self { width, height, base, depth, out_texture, out, base_texture, group, counts, counts_group, image_readback, counts_readback }
+    }
+
+    /// Bytes of the shared targets (base, depth, out, census counts), not counted per method.
+    pub fn bytes(&self) -> u64 {
+        self.width as u64 * self.height as u64 * (16 + 4 + 16 + 4)
+    }
+}
+
+/// A zero-initialised storage buffer (never smaller than 16 bytes).
+pub fn storage_buffer(device: &wgpu::Device, label: &str, size: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16).next_multiple_of(4),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+        mapped_at_creation: false,
+    })
+}
+
+/// Maps `buffer` (MAP_READ), waits, and returns a copy of its first `size` bytes.
+pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> crate::error::Result<Vec<u8>> {
+    let slice = buffer.slice(..size);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    gpu.wait()?;
+    rx.recv()
+        .map_err(|_| crate::error::OitError::Device("buffer map callback was dropped".into()))?
+        .map_err(|e| crate::error::OitError::Device(format!("mapping a readback buffer failed: {e}")))?;
+    let data = slice
+        .get_mapped_range()
+        .map_err(|e| crate::error::OitError::Device(format!("reading a mapped buffer failed: {e:?}")))?
+        .to_vec();
+    buffer.unmap();
+    Ok(data)
+}

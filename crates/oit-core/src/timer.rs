@@ -1,0 +1,98 @@
+//! GPU time per pass from timestamp queries (when the adapter offers them).
+
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::targets::read_buffer;
+
+const MAX_PASSES: u32 = 32;
+
+pub struct PassTimer {
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,
+    labels: Vec<&'static str>,
+    period_ns: f64,
+}
+
+impl PassTimer {
+    pub fn new(gpu: &GpuContext) -> Self {
+        let queries = gpu.has(wgpu::Features::TIMESTAMP_QUERY).then(|| {
+            let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2 * MAX_PASSES,
+            });
+            let size = 16 * MAX_PASSES as u64;
+            let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp resolve"),
+                size,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp readback"),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            (set, resolve, readback)
+        });
+        Self { queries, labels: Vec::new(), period_ns: gpu.queue.get_timestamp_period() as f64 }
+    }
+
+    /// Forgets the passes recorded so far (a method that renders again starts over).
+    pub fn reset(&mut self) {
+        self.labels.clear();
+    }
+
+    pub fn available(&self) -> bool {
+        self.queries.is_some()
+    }
+
+    /// Timestamp writes for the next pass, named `label`.
+    pub fn render_pass(&mut self, label: &'static str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        let i = self.slot(label)?;
+        self.queries.as_ref().map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: Some(2 * i),
+            end_of_pass_write_index: Some(2 * i + 1),
+        })
+    }
+
+    pub fn compute_pass(&mut self, label: &'static str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        let i = self.slot(label)?;
+        self.queries.as_ref().map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: Some(2 * i),
+            end_of_pass_write_index: Some(2 * i + 1),
+        })
+    }
+
+    fn slot(&mut self, label: &'static str) -> Option<u32> {
+        self.queries.as_ref()?;
+        let i = self.labels.len() as u32;
+        assert!(i < MAX_PASSES, "more than {MAX_PASSES} timed passes in one frame");
+        self.labels.push(label);
+        Some(i)
+    }
+
+    /// Reads every recorded pass's duration in milliseconds, in recording order.
+    pub fn read(&mut self, gpu: &GpuContext) -> Result<Option<Vec<(&'static str, f64)>>> {
+        let Some((set, resolve, readback)) = &self.queries else { return Ok(None) };
+        let n = self.labels.len() as u32;
+        if n == 0 {
+            return Ok(Some(Vec::new()));
+        }
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.resolve_query_set(set, 0..2 * n, resolve, 0);
+        enc.copy_buffer_to_buffer(resolve, 0, readback, 0, 16 * n as u64);
+        gpu.queue.submit([enc.finish()]);
+        let raw = read_buffer(gpu, readback, 16 * n as u64)?;
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&raw);
+        let out = self
+            .labels
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (*l, ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * self.period_ns * 1e-6))
+            .collect();
+        Ok(Some(out))
+    }
+}

@@ -1,0 +1,37 @@
+// Per-frame uniform and scene buffers (group 0), shared by every geometry pass.
+// Mirrors oit_core::gpu_types::FrameUniform; a Rust test checks the size.
+struct FrameUniform {
+    view_proj: mat4x4<f32>,
+    background: vec4<f32>,
+    size: vec2<u32>,
+    triangle_count: u32,
+    seed: u32,
+}
+
+@group(0) @binding(0) var<uniform> frame: FrameUniform;
+// Vertex pulling: positions as packed xyz floats, straight RGBA per vertex, three indices a triangle.
+@group(0) @binding(1) var<storage, read> positions: array<f32>;
+@group(0) @binding(2) var<storage, read> colors: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> indices: array<u32>;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) color: vec4<f32>,
+    // Global triangle index in submission order (non-indexed draw: vertex_index / 3).
+    @location(1) @interpolate(flat) prim: u32,
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+    let v = indices[vi];
+    let p = vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
+    var out: VsOut;
+    out.clip = frame.view_proj * vec4<f32>(p, 1.0);
+    out.color = colors[v];
+    out.prim = vi / 3u;
+    return out;
+}
+
+fn pixel_index(pos: vec4<f32>) -> u32 {
+    return u32(pos.y) * frame.size.x + u32(pos.x);
+}

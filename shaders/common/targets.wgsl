@@ -1,0 +1,14 @@
+// Frame targets (group 1): the opaque depth and the opaque color with coverage.
+// base.rgb is the opaque surface or the background, base.a is 1 where an opaque surface was hit.
+@group(1) @binding(0) var opaque_depth: texture_depth_2d;
+@group(1) @binding(1) var base_color: texture_2d<f32>;
+
+// Storage-writing passes test the opaque depth themselves: a fragment shader with side
+// effects may run its depth test late, after its atomics already happened.
+fn behind_opaque(pos: vec4<f32>) -> bool {
+    return pos.z >= textureLoad(opaque_depth, vec2<i32>(pos.xy), 0);
+}
+
+fn base_at(pos: vec4<f32>) -> vec4<f32> {
+    return textureLoad(base_color, vec2<i32>(pos.xy), 0);
+}

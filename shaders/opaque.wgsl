@@ -1,0 +1,7 @@
+// Opaque geometry: straight color, coverage 1, writes depth.
+//!include common/scene.wgsl
+
+@fragment
+fn fs_opaque(in: VsOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(in.color.rgb, 1.0);
+}
