@@ -8,7 +8,7 @@ use std::time::Instant;
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
 use crate::gpu_types::FrameUniform;
-use crate::method::{self, FrameCtx, Method, ParamValue, Params};
+use crate::method::{self, FrameCtx, Limits, Method, ParamValue, Params};
 use crate::pipeline;
 use crate::scene::{Camera, Scene};
 use crate::shader;
@@ -111,6 +111,7 @@ pub struct Renderer {
     scene: Option<((u64, u64), GpuScene)>,
     methods: HashMap<&'static str, Box<dyn Method>>,
     timer: PassTimer,
+    limits: Limits,
 }
 
 /// One device per adapter choice, shared by every renderer in the process.
@@ -140,7 +141,19 @@ impl Renderer {
         let shared = Shared::new(&gpu);
         let targets = Targets::new(&gpu, width, height, &shared.targets_layout, &shared.counts_layout);
         let timer = PassTimer::new(&gpu);
-        Ok(Self { gpu, width, height, shared, targets, scene: None, methods: HashMap::new(), timer })
+        let limits = Limits { max_binding_bytes: gpu.max_binding_bytes() };
+        Ok(Self { gpu, width, height, shared, targets, scene: None, methods: HashMap::new(), timer, limits })
+    }
+
+    /// Sizes method buffers as if the adapter bound at most `bytes` per storage binding
+    /// (never more than it really does). Methods are rebuilt.
+    pub fn set_max_binding_bytes(&mut self, bytes: u64) -> Result<()> {
+        if bytes < 256 {
+            return Err(invalid!("max_binding_bytes must be at least 256, got {bytes}"));
+        }
+        self.limits.max_binding_bytes = bytes.min(self.gpu.max_binding_bytes());
+        self.methods.clear();
+        Ok(())
     }
 
     pub fn size(&self) -> (u32, u32) {
@@ -178,7 +191,8 @@ impl Renderer {
         gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
         self.opaque_and_census(gpu_scene, background);
 
-        let method = self.methods.entry(info.name).or_insert_with(|| info.instantiate(&gpu));
+        let limits = self.limits;
+        let method = self.methods.entry(info.name).or_insert_with(|| info.instantiate(&gpu, &limits));
         self.timer.reset();
         let mut cx = FrameCtx {
             gpu: &gpu,

@@ -1,1 +1,304 @@
-use pyo3::prelude::*; #[pymodule] fn _oit(_m: &Bound<PyModule>) -> PyResult<()> { Ok(()) }
+//! Thin PyO3 layer over oit-core: array conversion, GIL release during GPU and reference
+//! work, and one mapping from `OitError` to Python exceptions. The public API is
+//! `python/oit`; this module (`oit._oit`) is private.
+
+use std::sync::{Arc, Mutex};
+
+use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray2};
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use oit_core::{OitError, ParamKind, ParamValue};
+
+struct Error(OitError);
+
+impl From<OitError> for Error {
+    fn from(e: OitError) -> Self {
+        Self(e)
+    }
+}
+
+impl From<Error> for PyErr {
+    fn from(Error(e): Error) -> PyErr {
+        let msg = e.to_string();
+        match e {
+            OitError::InvalidInput(_) => PyValueError::new_err(msg),
+            OitError::OutOfMemory(_) => PyMemoryError::new_err(msg),
+            OitError::NoAdapter(_) | OitError::Unsupported(_) | OitError::Device(_) => PyRuntimeError::new_err(msg),
+        }
+    }
+}
+
+type Res<T> = Result<T, Error>;
+
+fn rows<T: Copy + numpy::Element, const N: usize>(a: &PyReadonlyArray2<'_, T>, name: &str) -> PyResult<Vec<[T; N]>> {
+    let shape = a.as_array().shape().to_vec();
+    if shape[1] != N {
+        return Err(PyValueError::new_err(format!("{name} must have shape (n, {N}), got {shape:?}")));
+    }
+    let flat: Vec<T> = a.as_array().iter().copied().collect();
+    Ok(flat.chunks_exact(N).map(|c| c.try_into().expect("chunk of N")).collect())
+}
+
+fn matrix(m: &PyReadonlyArray2<'_, f64>) -> PyResult<[[f64; 4]; 4]> {
+    let a = m.as_array();
+    if a.shape() != [4, 4] {
+        return Err(PyValueError::new_err(format!("camera matrix must be 4 x 4, got {:?}", a.shape())));
+    }
+    let mut out = [[0.0; 4]; 4];
+    for r in 0..4 {
+        for c in 0..4 {
+            out[r][c] = a[[r, c]];
+        }
+    }
+    Ok(out)
+}
+
+/// Meshes in submission order (validated on the way in).
+#[pyclass(module = "oit._oit")]
+struct Scene {
+    inner: oit_core::Scene,
+}
+
+#[pymethods]
+impl Scene {
+    #[new]
+    fn new() -> Self {
+        Self { inner: oit_core::Scene::new() }
+    }
+
+    /// positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32.
+    fn add_mesh(
+        &mut self,
+        positions: PyReadonlyArray2<'_, f32>,
+        indices: PyReadonlyArray2<'_, u32>,
+        colors: PyReadonlyArray2<'_, f32>,
+        opaque: bool,
+    ) -> PyResult<usize> {
+        let mesh = oit_core::Mesh::new(rows(&positions, "positions")?, rows(&indices, "indices")?, rows(&colors, "colors")?, opaque)
+            .map_err(Error::from)?;
+        Ok(self.inner.add_mesh(mesh))
+    }
+
+    fn set_mesh_alpha(&mut self, mesh: usize, alpha: f32) -> Res<()> {
+        Ok(self.inner.set_mesh_alpha(mesh, alpha)?)
+    }
+
+    #[getter]
+    fn mesh_count(&self) -> usize {
+        self.inner.meshes().len()
+    }
+
+    #[getter]
+    fn triangle_count(&self) -> usize {
+        self.inner.meshes().iter().map(|m| m.triangle_count()).sum()
+    }
+
+    /// (triangles, vertices, opaque) per mesh.
+    fn mesh_summary(&self) -> Vec<(usize, usize, bool)> {
+        self.inner.meshes().iter().map(|m| (m.indices.len(), m.positions.len(), m.opaque)).collect()
+    }
+}
+
+#[pyclass(module = "oit._oit")]
+struct Renderer {
+    inner: Mutex<oit_core::Renderer>,
+    context: Arc<oit_core::GpuContext>,
+}
+
+fn param_value(v: &Bound<'_, PyAny>, name: &str) -> PyResult<ParamValue> {
+    if v.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(PyValueError::new_err(format!("parameter '{name}' must be a number or a string, not a bool")));
+    }
+    if let Ok(i) = v.extract::<i64>() {
+        return Ok(ParamValue::Int(i));
+    }
+    if let Ok(f) = v.extract::<f64>() {
+        return Ok(ParamValue::Float(f));
+    }
+    if let Ok(s) = v.extract::<String>() {
+        return Ok(ParamValue::Str(s));
+    }
+    Err(PyValueError::new_err(format!("parameter '{name}' must be a number or a string, got {}", v.get_type().name()?)))
+}
+
+fn value_to_py<'py>(py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        ParamValue::Int(i) => i.into_pyobject(py)?.into_any(),
+        ParamValue::Float(f) => f.into_pyobject(py)?.into_any(),
+        ParamValue::Str(s) => s.into_pyobject(py)?.into_any(),
+    })
+}
+
+fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("method", &s.method)?;
+    let params = PyDict::new(py);
+    for (k, v) in &s.params.0 {
+        params.set_item(*k, value_to_py(py, v)?)?;
+    }
+    d.set_item("params", params)?;
+    d.set_item("fragments", s.fragments)?;
+    d.set_item("max_depth_complexity", s.max_depth_complexity)?;
+    d.set_item("memory_bytes", s.memory_bytes)?;
+    d.set_item("target_bytes", s.target_bytes)?;
+    d.set_item("scene_bytes", s.scene_bytes)?;
+    d.set_item("gpu_time_ms", s.gpu_time_ms)?;
+    let passes = PyDict::new(py);
+    for (k, v) in &s.pass_times_ms {
+        passes.set_item(*k, v)?;
+    }
+    d.set_item("pass_times_ms", passes)?;
+    d.set_item("overflow_fragments", s.overflow_fragments)?;
+    d.set_item("wall_time_ms", s.wall_time_ms)?;
+    for (k, v) in &s.extra {
+        d.set_item(*k, v)?;
+    }
+    Ok(d)
+}
+
+#[pymethods]
+impl Renderer {
+    #[new]
+    #[pyo3(signature = (width, height, adapter=None, max_binding_bytes=None))]
+    fn new(py: Python<'_>, width: i64, height: i64, adapter: Option<String>, max_binding_bytes: Option<u64>) -> Res<Self> {
+        if width <= 0 || height <= 0 || width > u32::MAX as i64 || height > u32::MAX as i64 {
+            return Err(OitError::InvalidInput(format!("width and height must be positive integers, got {width} x {height}")).into());
+        }
+        let (w, h) = (width as u32, height as u32);
+        py.detach(|| {
+            let context = oit_core::shared_context(adapter.as_deref())?;
+            let mut inner = oit_core::Renderer::new(context.clone(), w, h)?;
+            if let Some(b) = max_binding_bytes {
+                inner.set_max_binding_bytes(b)?;
+            }
+            Ok(Self { inner: Mutex::new(inner), context })
+        })
+    }
+
+    #[getter]
+    fn adapter_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let i = &self.context.info;
+        let d = PyDict::new(py);
+        d.set_item("name", &i.name)?;
+        d.set_item("backend", format!("{:?}", i.backend))?;
+        d.set_item("device_type", format!("{:?}", i.device_type))?;
+        d.set_item("driver", &i.driver)?;
+        d.set_item("driver_info", &i.driver_info)?;
+        d.set_item("timestamps", self.context.has(wgpu::Features::TIMESTAMP_QUERY))?;
+        d.set_item("float32_blendable", self.context.has(wgpu::Features::FLOAT32_BLENDABLE))?;
+        d.set_item("int64_atomic_min_max", self.context.has(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX))?;
+        d.set_item("max_storage_binding_bytes", self.context.max_binding_bytes())?;
+        Ok(d)
+    }
+
+    /// Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict).
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        scene: PyRef<'py, Scene>,
+        view_proj: PyReadonlyArray2<'py, f64>,
+        method: &str,
+        background: (f32, f32, f32),
+        params: Bound<'py, PyDict>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let camera = oit_core::Camera::from_rows(matrix(&view_proj)?).map_err(Error::from)?;
+        let mut plist = Vec::new();
+        for (k, v) in params.iter() {
+            let name: String = k.extract()?;
+            plist.push((name.clone(), param_value(&v, &name)?));
+        }
+        let inner_scene = &scene.inner;
+        let bg = [background.0, background.1, background.2];
+        let frame = py
+            .detach(|| {
+                let mut r = self.inner.lock().unwrap_or_else(|p| p.into_inner());
+                r.render(inner_scene, &camera, method, &plist, bg)
+            })
+            .map_err(Error::from)?;
+        let (h, w) = (frame.height as usize, frame.width as usize);
+        let image = frame.image.into_pyarray(py).reshape([h, w, 4])?;
+        let dc = frame.depth_complexity.into_pyarray(py).reshape([h, w])?;
+        let stats = stats_dict(py, &frame.stats)?;
+        Ok((image, dc, stats).into_pyobject(py)?.into_any())
+    }
+}
+
+/// Every method: name, summary, exact, bounded memory, passes, parameters.
+#[pyfunction]
+fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+    let out = PyList::empty(py);
+    for m in oit_core::methods() {
+        let d = PyDict::new(py);
+        d.set_item("name", m.name)?;
+        d.set_item("summary", m.summary)?;
+        d.set_item("exact", m.exact)?;
+        d.set_item("bounded_memory", m.bounded_memory)?;
+        d.set_item("passes", m.passes.to_vec())?;
+        let params = PyList::empty(py);
+        for p in m.params {
+            let pd = PyDict::new(py);
+            pd.set_item("name", p.name)?;
+            pd.set_item("doc", p.doc)?;
+            match p.kind {
+                ParamKind::Int { min, max, default } => {
+                    pd.set_item("type", "int")?;
+                    pd.set_item("min", min)?;
+                    pd.set_item("max", max)?;
+                    pd.set_item("default", default)?;
+                }
+                ParamKind::Float { min, max, default } => {
+                    pd.set_item("type", "float")?;
+                    pd.set_item("min", min)?;
+                    pd.set_item("max", max)?;
+                    pd.set_item("default", default)?;
+                }
+                ParamKind::Choice { choices, default } => {
+                    pd.set_item("type", "choice")?;
+                    pd.set_item("choices", choices.to_vec())?;
+                    pd.set_item("default", default)?;
+                }
+            }
+            params.append(pd)?;
+        }
+        d.set_item("params", params)?;
+        out.append(d)?;
+    }
+    Ok(out)
+}
+
+/// CPU float64 reference: (image (h, w, 4) float64, ambiguous (h, w) bool, depth complexity).
+#[pyfunction]
+fn reference<'py>(
+    py: Python<'py>,
+    scene: PyRef<'py, Scene>,
+    view_proj: PyReadonlyArray2<'py, f64>,
+    width: i64,
+    height: i64,
+    background: (f64, f64, f64),
+) -> PyResult<Bound<'py, PyAny>> {
+    if width <= 0 || height <= 0 || width > 1 << 16 || height > 1 << 16 {
+        return Err(PyValueError::new_err(format!("width and height must be in [1, 65536], got {width} x {height}")));
+    }
+    let camera = oit_core::Camera::from_rows(matrix(&view_proj)?).map_err(Error::from)?;
+    let inner_scene = &scene.inner;
+    let bg = [background.0, background.1, background.2];
+    let r = py
+        .detach(|| oit_core::reference(inner_scene, &camera, width as u32, height as u32, bg))
+        .map_err(Error::from)?;
+    let (h, w) = (height as usize, width as usize);
+    let image = r.image.into_pyarray(py).reshape([h, w, 4])?;
+    let amb = r.ambiguous.into_pyarray(py).reshape([h, w])?;
+    let dc = r.depth_complexity.into_pyarray(py).reshape([h, w])?;
+    Ok((image, amb, dc).into_pyobject(py)?.into_any())
+}
+
+#[pymodule]
+fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Scene>()?;
+    m.add_class::<Renderer>()?;
+    m.add_function(wrap_pyfunction!(methods, m)?)?;
+    m.add_function(wrap_pyfunction!(reference, m)?)?;
+    Ok(())
+}

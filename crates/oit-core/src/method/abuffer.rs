@@ -2,7 +2,7 @@
 //! The node pool follows the scene: it grows to the counted fragments and the frame is
 //! rendered again when the atomic counter says the pool overflowed (docs/methods.md).
 
-use super::{FrameCtx, Method, MethodInfo, MethodReport};
+use super::{FrameCtx, Limits, Method, MethodInfo, MethodReport};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::{Alloc, PoolNode};
@@ -17,7 +17,7 @@ pub const INFO: MethodInfo = MethodInfo {
     bounded_memory: false,
     passes: &["capture (geometry)", "resolve (full screen)"],
     params: &[],
-    create: |gpu| Box::new(ABuffer::new(gpu)),
+    create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 
 /// Storage bindings the pool is split across (shaders/common/pool.wgsl).
@@ -40,7 +40,7 @@ pub(crate) struct NodePool {
 }
 
 impl NodePool {
-    pub fn new(gpu: &GpuContext) -> Self {
+    pub fn new(gpu: &GpuContext, limits: &Limits) -> Self {
         let d = &gpu.device;
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("node pool"),
@@ -54,7 +54,7 @@ impl NodePool {
             mapped_at_creation: false,
         });
         Self {
-            nodes_per_binding: (gpu.max_binding_bytes() / NODE_BYTES).min(u32::MAX as u64 / POOL_BINDINGS),
+            nodes_per_binding: (limits.max_binding_bytes / NODE_BYTES).max(1).min(u32::MAX as u64 / POOL_BINDINGS),
             capacity: 0,
             pixels: 0,
             heads: storage_buffer(d, "heads", 4, wgpu::BufferUsages::empty()),
@@ -144,8 +144,8 @@ struct ABuffer {
 }
 
 impl ABuffer {
-    fn new(gpu: &GpuContext) -> Self {
-        Self { pool: NodePool::new(gpu), pipelines: None }
+    fn new(gpu: &GpuContext, limits: &Limits) -> Self {
+        Self { pool: NodePool::new(gpu, limits), pipelines: None }
     }
 
     fn build(&mut self, cx: &FrameCtx<'_>) {

@@ -2,7 +2,6 @@
 //! submission order or per mesh back to front by centroid (docs/methods.md).
 
 use super::{FrameCtx, Method, MethodInfo, MethodReport};
-use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::pipeline;
 use crate::shader;
@@ -15,7 +14,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["blend"],
     params: &[],
-    create: |gpu| Box::new(Blend::new(gpu, false)),
+    create: |_, _| Box::new(Blend::new(false)),
 };
 
 pub const SORTED: MethodInfo = MethodInfo {
@@ -25,7 +24,7 @@ pub const SORTED: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["sort meshes (CPU)", "blend"],
     params: &[],
-    create: |gpu| Box::new(Blend::new(gpu, true)),
+    create: |_, _| Box::new(Blend::new(true)),
 };
 
 /// Over operator with straight alpha; alpha accumulates coverage a + (1 - a) * A.
@@ -48,7 +47,7 @@ struct Blend {
 }
 
 impl Blend {
-    fn new(_gpu: &GpuContext, sort: bool) -> Self {
+    fn new(sort: bool) -> Self {
         Self { sort, pipeline: None }
     }
 }

@@ -37,7 +37,7 @@ pub struct MethodInfo {
     pub bounded_memory: bool,
     pub passes: &'static [&'static str],
     pub params: &'static [ParamInfo],
-    create: fn(&GpuContext) -> Box<dyn Method>,
+    create: fn(&GpuContext, &Limits) -> Box<dyn Method>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -142,8 +142,8 @@ impl MethodInfo {
         Ok(Params(out))
     }
 
-    pub(crate) fn instantiate(&self, gpu: &GpuContext) -> Box<dyn Method> {
-        (self.create)(gpu)
+    pub(crate) fn instantiate(&self, gpu: &GpuContext, limits: &Limits) -> Box<dyn Method> {
+        (self.create)(gpu, limits)
     }
 }
 
@@ -175,6 +175,13 @@ fn check(method: &str, info: &ParamInfo, value: &ParamValue) -> Result<ParamValu
         }
         (kind, v) => Err(invalid!("{method}: {name} has the wrong type ({v:?}); expected {kind:?}")),
     }
+}
+
+/// Limits a method sizes its buffers by: the adapter's, or lower ones a caller asks for
+/// (tests use a small binding limit to exercise buffer splitting on small scenes).
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    pub max_binding_bytes: u64,
 }
 
 /// Everything a method needs to record one frame. The opaque pass and the census have run;

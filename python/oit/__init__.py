@@ -1,0 +1,15 @@
+"""oit: order-independent transparency methods on one wgpu engine, with the exact
+answer (an A-buffer and a CPU float64 reference) beside them.
+
+    import oit
+    scene = oit.Scene()
+    scene.add_mesh(positions, indices, colors)
+    cam = oit.Camera.look_at(eye=(0, 0, 3), target=(0, 0, 0), fov_y=45.0, near=0.1, far=100.0)
+    frame = oit.Renderer(512, 512).render(scene, cam, method="abuffer")
+    exact = oit.reference(scene, cam, 512, 512)
+"""
+
+from ._api import Camera, Frame, Renderer, Scene, methods, reference
+
+__all__ = ["Camera", "Frame", "Renderer", "Scene", "methods", "reference"]
+__version__ = "0.1.0"

@@ -1,0 +1,287 @@
+"""The public API: validation of every input happens here (or in the core), with
+messages that name the argument and say what to do."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from . import _oit
+
+
+def _float_array(value: Any, name: str) -> np.ndarray:
+    a = np.asarray(value)
+    if a.dtype == object or not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)) or a.dtype == bool:
+        raise TypeError(f"{name} must be a float array (float32 preferred), got dtype {a.dtype}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = np.ascontiguousarray(a, dtype=np.float32)
+    if not np.isfinite(out).all():
+        bad = np.argwhere(~np.isfinite(out))[0]
+        raise ValueError(f"{name} has a NaN or Inf (or a value too large for float32) at index {tuple(int(i) for i in bad)}")
+    return out
+
+
+def _rows(a: np.ndarray, cols: int, name: str) -> np.ndarray:
+    if a.ndim != 2 or a.shape[1] != cols:
+        raise ValueError(f"{name} must have shape (n, {cols}), got {a.shape}")
+    return a
+
+
+class Scene:
+    """Meshes in submission order. Transparent meshes are composited by the chosen method;
+    opaque meshes render first and occlude what lies behind them."""
+
+    def __init__(self) -> None:
+        self._native = _oit.Scene()
+
+    def add_mesh(self, positions: Any, indices: Any, colors: Any, opaque: bool = False) -> int:
+        """Adds a triangle mesh and returns its index.
+
+        positions: (n, 3) float; indices: (m, 3) non-negative integers below n (converted to
+        uint32 after range checks); colors: (n, 4) per vertex or (4,) for the whole mesh,
+        straight (not premultiplied) linear RGBA in [0, 1].
+        """
+        pos = _rows(_float_array(positions, "positions"), 3, "positions")
+        idx = np.asarray(indices)
+        if idx.size == 0:
+            idx = idx.reshape(0, 3).astype(np.int64) if idx.ndim <= 2 else idx
+        if idx.dtype == bool or not np.issubdtype(idx.dtype, np.integer):
+            raise TypeError(f"indices must be an integer array (uint32 preferred), got dtype {idx.dtype}")
+        idx = _rows(idx, 3, "indices")
+        if idx.size:
+            lo, hi = int(idx.min()), int(idx.max())
+            if lo < 0:
+                raise ValueError(f"indices has a negative entry ({lo}); indices must be in [0, {len(pos)})")
+            if hi >= len(pos):
+                raise ValueError(f"indices refers to vertex {hi} but positions has {len(pos)} rows; indices must be in [0, {len(pos)})")
+        idx = np.ascontiguousarray(idx, dtype=np.uint32)
+        col = _float_array(colors, "colors")
+        if col.shape == (4,):
+            col = col.reshape(1, 4)
+        elif col.ndim != 2 or col.shape != (len(pos), 4):
+            raise ValueError(f"colors must have shape ({len(pos)}, 4) (one RGBA per vertex) or (4,), got {col.shape}")
+        if col.size and (col.min() < 0.0 or col.max() > 1.0):
+            raise ValueError(
+                "colors must be straight linear RGBA in [0, 1] (alpha included); "
+                f"got values in [{col.min():g}, {col.max():g}]: clip or rescale them"
+            )
+        if not isinstance(opaque, (bool, np.bool_)):
+            raise TypeError(f"opaque must be a bool, got {type(opaque).__name__}")
+        return self._native.add_mesh(pos, idx, col, bool(opaque))
+
+    def set_mesh_alpha(self, mesh: int, alpha: float) -> None:
+        """Sets every vertex alpha of one mesh."""
+        self._native.set_mesh_alpha(int(mesh), float(alpha))
+
+    @property
+    def mesh_count(self) -> int:
+        return self._native.mesh_count
+
+    @property
+    def triangle_count(self) -> int:
+        return self._native.triangle_count
+
+    @classmethod
+    def from_trimesh(cls, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False) -> "Scene":
+        """A scene from a trimesh Trimesh or Scene. Colors come from vertex colors, face
+        colors or material alpha when present (sRGB 8-bit colors are linearized); `color`
+        (RGB or RGBA) and `alpha` override them."""
+        scene = cls()
+        scene.add_trimesh(obj, alpha=alpha, color=color, opaque=opaque)
+        return scene
+
+    def add_trimesh(self, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False) -> None:
+        import trimesh
+
+        meshes = obj.dump() if isinstance(obj, trimesh.Scene) else [obj]
+        for m in meshes:
+            if not isinstance(m, trimesh.Trimesh):
+                continue
+            positions, faces, colors = _trimesh_arrays(m)
+            if color is not None:
+                c = np.asarray(color, dtype=np.float64)
+                if c.shape not in ((3,), (4,)):
+                    raise ValueError(f"color must be RGB or RGBA, got shape {c.shape}")
+                colors = np.tile(np.append(c, colors[:, 3:4].mean() if c.shape == (3,) else c[3])[:4], (len(positions), 1))
+            if alpha is not None:
+                if not 0.0 <= float(alpha) <= 1.0:
+                    raise ValueError(f"alpha must be in [0, 1], got {alpha}")
+                colors[:, 3] = float(alpha)
+            self.add_mesh(positions, faces, colors, opaque=opaque)
+
+
+def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def _trimesh_arrays(m: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    positions = np.asarray(m.vertices, dtype=np.float32)
+    faces = np.asarray(m.faces, dtype=np.int64)
+    rgba = np.tile([0.8, 0.8, 0.8, 1.0], (len(positions), 1))
+    visual = getattr(m, "visual", None)
+    kind = getattr(visual, "kind", None)
+    if kind == "vertex":
+        rgba = np.asarray(visual.vertex_colors, dtype=np.float64) / 255.0
+    elif kind == "face":
+        # One color per face: split vertices so that each face keeps its own color.
+        fc = np.asarray(visual.face_colors, dtype=np.float64) / 255.0
+        positions = positions[faces.reshape(-1)]
+        faces = np.arange(len(positions)).reshape(-1, 3)
+        rgba = np.repeat(fc, 3, axis=0)
+    elif kind == "texture" and hasattr(visual, "material"):
+        mat = visual.material
+        base = getattr(mat, "baseColorFactor", None)
+        if base is None:
+            base = getattr(mat, "main_color", None)
+        if base is not None:
+            rgba = np.tile(np.asarray(base, dtype=np.float64) / (255.0 if np.max(base) > 1 else 1.0), (len(positions), 1))
+    rgba = rgba.copy()
+    rgba[:, :3] = _srgb_to_linear(rgba[:, :3])
+    return positions, faces, rgba
+
+
+class Camera:
+    """A 4x4 view-projection matrix, column-vector convention (clip = M @ [x, y, z, 1]),
+    wgpu clip space: x, y in [-1, 1] with y up, z in [0, 1] (smaller is nearer)."""
+
+    def __init__(self, view_proj: Any) -> None:
+        m = np.asarray(view_proj, dtype=np.float64)
+        if m.shape != (4, 4):
+            raise ValueError(f"view_proj must be a 4 x 4 matrix, got shape {m.shape}")
+        if not np.isfinite(m).all():
+            raise ValueError("view_proj has NaN or Inf entries")
+        if abs(np.linalg.det(m)) < 1e-300:
+            raise ValueError("view_proj is singular: build it with Camera.look_at or Camera.orthographic")
+        self.view_proj = np.ascontiguousarray(m)
+
+    def __repr__(self) -> str:
+        return f"Camera(view_proj={self.view_proj.tolist()})"
+
+    @staticmethod
+    def _view(eye: Sequence[float], target: Sequence[float], up: Sequence[float]) -> np.ndarray:
+        eye, target, up = (np.asarray(v, dtype=np.float64) for v in (eye, target, up))
+        f = target - eye
+        if np.linalg.norm(f) == 0:
+            raise ValueError("eye and target must differ")
+        f /= np.linalg.norm(f)
+        s = np.cross(f, up)
+        if np.linalg.norm(s) < 1e-12:
+            raise ValueError("up must not be parallel to the viewing direction")
+        s /= np.linalg.norm(s)
+        u = np.cross(s, f)
+        view = np.eye(4)
+        view[0, :3], view[1, :3], view[2, :3] = s, u, -f
+        view[:3, 3] = -view[:3, :3] @ eye
+        return view
+
+    @classmethod
+    def look_at(cls, eye: Sequence[float], target: Sequence[float], fov_y: float = 45.0, near: float = 0.1,
+                far: float = 100.0, up: Sequence[float] = (0.0, 1.0, 0.0), aspect: float = 1.0) -> "Camera":
+        """Right-handed perspective camera; fov_y in degrees; depth 0 at `near`, 1 at `far`."""
+        if not (0.0 < fov_y < 180.0):
+            raise ValueError(f"fov_y must be in (0, 180) degrees, got {fov_y}")
+        if not (0.0 < near < far) or not np.isfinite(far):
+            raise ValueError(f"need 0 < near < far (finite), got near={near}, far={far}")
+        if not aspect > 0:
+            raise ValueError(f"aspect must be positive, got {aspect}")
+        f = 1.0 / np.tan(np.radians(fov_y) / 2.0)
+        proj = np.zeros((4, 4))
+        proj[0, 0], proj[1, 1] = f / aspect, f
+        proj[2, 2], proj[2, 3] = far / (near - far), near * far / (near - far)
+        proj[3, 2] = -1.0
+        return cls(proj @ cls._view(eye, target, up))
+
+    @classmethod
+    def orthographic(cls, left: float, right: float, bottom: float, top: float, near: float, far: float,
+                     eye: Sequence[float] | None = None, target: Sequence[float] | None = None,
+                     up: Sequence[float] = (0.0, 1.0, 0.0)) -> "Camera":
+        """Orthographic projection of the view volume (right-handed: looking down -z),
+        optionally placed with eye/target."""
+        if right == left or top == bottom or far == near:
+            raise ValueError("orthographic volume must have non-zero extent on every axis")
+        proj = np.eye(4)
+        proj[0, 0], proj[0, 3] = 2.0 / (right - left), -(right + left) / (right - left)
+        proj[1, 1], proj[1, 3] = 2.0 / (top - bottom), -(top + bottom) / (top - bottom)
+        proj[2, 2], proj[2, 3] = 1.0 / (near - far), near / (near - far)
+        view = cls._view(eye, target, up) if eye is not None and target is not None else np.eye(4)
+        return cls(proj @ view)
+
+    @classmethod
+    def fit(cls, positions: np.ndarray, direction: Sequence[float] = (0.3, 0.35, 1.0), fov_y: float = 40.0,
+            aspect: float = 1.0) -> "Camera":
+        """A perspective camera that frames the given points' bounding sphere."""
+        p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+        center = (p.min(0) + p.max(0)) / 2 if len(p) else np.zeros(3)
+        radius = max(float(np.linalg.norm(p - center, axis=1).max()) if len(p) else 1.0, 1e-6)
+        d = np.asarray(direction, dtype=np.float64)
+        d /= np.linalg.norm(d)
+        dist = radius / np.sin(np.radians(fov_y) / 2) * 1.05
+        return cls.look_at(center + d * dist, center, fov_y, near=max(dist - radius * 1.5, dist * 1e-3), far=dist + radius * 1.5, aspect=aspect)
+
+
+@dataclass
+class Frame:
+    """One rendered frame. `image`: (h, w, 4) float32, linear; RGB is the final color and A
+    the coverage of the background. `depth_complexity`: transparent fragments per pixel."""
+
+    image: np.ndarray
+    stats: dict
+    depth_complexity: np.ndarray = field(repr=False)
+
+
+class Renderer:
+    """Renders scenes at one size. `adapter` (or the OIT_ADAPTER variable) picks an adapter by
+    a substring of its name; otherwise a hardware adapter is preferred over a software one."""
+
+    def __init__(self, width: int, height: int, adapter: str | None = None, max_binding_bytes: int | None = None) -> None:
+        for name, v in (("width", width), ("height", height)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+                raise TypeError(f"{name} must be an int, got {type(v).__name__}")
+            if v <= 0:
+                raise ValueError(f"{name} must be positive, got {v}")
+        self.width, self.height = int(width), int(height)
+        self._native = _oit.Renderer(self.width, self.height, adapter, max_binding_bytes)
+
+    @property
+    def adapter_info(self) -> dict:
+        return self._native.adapter_info
+
+    def render(self, scene: Scene, camera: Camera, method: str = "abuffer",
+               background: Sequence[float] = (1.0, 1.0, 1.0), **params: Any) -> Frame:
+        """Renders `scene` with `method` (see `oit.methods()`); parameters go as keywords."""
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be an oit.Scene, got {type(scene).__name__}")
+        if not isinstance(camera, Camera):
+            raise TypeError(f"camera must be an oit.Camera, got {type(camera).__name__}")
+        if not isinstance(method, str):
+            raise TypeError(f"method must be a string, got {type(method).__name__}")
+        bg = _background(background)
+        image, dc, stats = self._native.render(scene._native, camera.view_proj, method, bg, params)
+        stats["adapter"] = self.adapter_info["name"]
+        return Frame(image=image, stats=stats, depth_complexity=dc)
+
+
+def _background(background: Sequence[float]) -> tuple[float, float, float]:
+    bg = np.asarray(background, dtype=np.float64)
+    if bg.shape != (3,) or not np.isfinite(bg).all() or bg.min() < 0 or bg.max() > 1:
+        raise ValueError(f"background must be three linear RGB values in [0, 1], got {background!r}")
+    return (float(bg[0]), float(bg[1]), float(bg[2]))
+
+
+def methods() -> list[dict]:
+    """Every method: name, summary, whether it is exact, whether its memory is bounded,
+    the passes it runs, and its parameters with defaults and ranges."""
+    return _oit.methods()
+
+
+def reference(scene: Scene, camera: Camera, width: int, height: int, background: Sequence[float] = (1.0, 1.0, 1.0),
+              return_mask: bool = False):
+    """The CPU float64 reference image (h, w, 4). With return_mask=True, also a boolean
+    (h, w) mask of ambiguous pixels: a pixel center on a triangle edge or on two nearly
+    equal depths, where a rasterizer may legitimately differ (docs/methods.md)."""
+    if not isinstance(scene, Scene) or not isinstance(camera, Camera):
+        raise TypeError("reference(scene, camera, width, height): scene must be an oit.Scene and camera an oit.Camera")
+    image, ambiguous, _ = _oit.reference(scene._native, camera.view_proj, int(width), int(height), _background(background))
+    return (image, ambiguous) if return_mask else image
