@@ -9,6 +9,16 @@ answer (an A-buffer and a CPU float64 reference) beside them.
     exact = oit.reference(scene, cam, 512, 512)
 """
 
+import os as _os
+import tempfile as _tempfile
+
+# The Vulkan loader's window-system code complains on stderr when XDG_RUNTIME_DIR is unset
+# (headless machines, CI); a private directory keeps it quiet. Nothing is written there.
+if not _os.environ.get("XDG_RUNTIME_DIR"):
+    _runtime = _os.path.join(_tempfile.gettempdir(), f"oit-runtime-{_os.getuid()}")
+    _os.makedirs(_runtime, mode=0o700, exist_ok=True)
+    _os.environ["XDG_RUNTIME_DIR"] = _runtime
+
 from ._api import Camera, Frame, Renderer, Scene, methods, reference
 
 __all__ = ["Camera", "Frame", "Renderer", "Scene", "methods", "reference"]

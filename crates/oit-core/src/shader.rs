@@ -10,7 +10,9 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("opaque.wgsl", include_str!("../../../shaders/opaque.wgsl")),
     ("census.wgsl", include_str!("../../../shaders/census.wgsl")),
     ("blend.wgsl", include_str!("../../../shaders/blend.wgsl")),
+    ("common/fixed.wgsl", include_str!("../../../shaders/common/fixed.wgsl")),
     ("abuffer.wgsl", include_str!("../../../shaders/abuffer.wgsl")),
+    ("hybrid.wgsl", include_str!("../../../shaders/hybrid.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.
@@ -21,7 +23,14 @@ pub enum Const {
 }
 
 /// Constants a shader needs when it is validated without a pipeline (tests, tools).
-pub const DEFAULT_CONSTS: &[Const] = &[Const::U32("NODES_PER_BINDING", 1 << 20), Const::U32("BATCH", 32)];
+pub const DEFAULT_CONSTS: &[Const] = &[
+    Const::U32("NODES_PER_BINDING", 1 << 20),
+    Const::U32("BATCH", 32),
+    Const::U32("K", 8),
+    Const::U32("TAIL", 1),
+    Const::F32("CORE_SCALE", 2147483648.0),
+    Const::F32("TAIL_SCALE", 16777216.0),
+];
 
 fn source(path: &str) -> &'static str {
     SOURCES

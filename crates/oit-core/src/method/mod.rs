@@ -3,6 +3,7 @@
 
 mod abuffer;
 mod blend;
+pub mod hybrid;
 
 use std::collections::BTreeMap;
 
@@ -73,7 +74,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY

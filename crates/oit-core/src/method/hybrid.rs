@@ -1,0 +1,224 @@
+//! `hybrid` (Maule et al. 2013, Algorithm 1) and `ktab`, its core alone with the tail
+//! discarded. Two geometry passes, a visibility pass and a final composite; accumulation in
+//! fixed point so that frames do not depend on fragment order (docs/methods.md).
+
+use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
+use crate::error::{OitError, Result};
+use crate::pipeline;
+use crate::shader::{self, Const};
+use crate::targets::{read_buffer, storage_buffer};
+
+const K_PARAM: ParamInfo = ParamInfo {
+    name: "k",
+    kind: ParamKind::Int { min: 1, max: 32, default: 8 },
+    doc: "core size: fragments per pixel kept exactly, sorted (k-TAB slots)",
+};
+
+pub const HYBRID: MethodInfo = MethodInfo {
+    name: "hybrid",
+    summary: "hybrid transparency: the k nearest fragments exactly (k-TAB), the rest by weighted average",
+    exact: false,
+    bounded_memory: true,
+    passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core and tail (geometry)", "final composite (full screen)"],
+    params: &[K_PARAM],
+    create: |_, _| Box::new(Hybrid::new(true)),
+};
+
+pub const KTAB: MethodInfo = MethodInfo {
+    name: "ktab",
+    summary: "k-TAB: the k nearest fragments composited exactly, the others discarded (hybrid's core alone)",
+    exact: false,
+    bounded_memory: true,
+    passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core (geometry)", "final composite (full screen)"],
+    params: &[K_PARAM],
+    create: |_, _| Box::new(Hybrid::new(false)),
+};
+
+/// Words per pixel of the accumulators (mirrors ACCUM_WORDS in shaders/hybrid.wgsl).
+pub const ACCUM_WORDS: u64 = 14;
+/// Fixed-point scales of core sums (values in [0, 1], total <= 1) and tail sums.
+pub const CORE_SCALE: f32 = 2147483648.0; // 2^31
+pub const TAIL_SCALE: f32 = 16777216.0; // 2^24
+
+/// Bytes hybrid allocates at W x H pixels with core size k: k-TAB and visibility (k words
+/// each), the accumulators, and the overflow counter.
+pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
+    pixels * (2 * k + ACCUM_WORDS) * 4 + 4
+}
+
+struct Pipelines {
+    k: u32,
+    store: wgpu::RenderPipeline,
+    visibility: wgpu::ComputePipeline,
+    shade: wgpu::RenderPipeline,
+    finish: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+struct Buffers {
+    key: (u64, u32),
+    ktab: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    overflow: wgpu::Buffer,
+    overflow_readback: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
+struct Hybrid {
+    tail: bool,
+    pipelines: Option<Pipelines>,
+    buffers: Option<Buffers>,
+}
+
+impl Hybrid {
+    fn new(tail: bool) -> Self {
+        Self { tail, pipelines: None, buffers: None }
+    }
+
+    fn build(&self, cx: &FrameCtx<'_>, k: u32) -> Pipelines {
+        let d = &cx.gpu.device;
+        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("hybrid"),
+            entries: &(0..4).map(pipeline::storage_entry).collect::<Vec<_>>(),
+        });
+        let consts = [
+            Const::U32("K", k),
+            Const::U32("TAIL", self.tail as u32),
+            Const::F32("CORE_SCALE", CORE_SCALE),
+            Const::F32("TAIL_SCALE", TAIL_SCALE),
+        ];
+        let module = shader::module(d, "hybrid.wgsl", &consts);
+        let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &layout]);
+        let store = pipeline::geometry(d, "hybrid store", &module, &pl, "fs_store", &[], pipeline::depth_test_only());
+        let shade = pipeline::geometry(d, "hybrid shade", &module, &pl, "fs_shade", &[], pipeline::depth_test_only());
+        let finish = pipeline::fullscreen(d, "hybrid final", &module, &pl, "fs_final");
+        let visibility = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("hybrid visibility"),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("cs_visibility"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Pipelines { k, store, visibility, shade, finish, layout }
+    }
+
+    fn reserve(&mut self, cx: &FrameCtx<'_>, pixels: u64, k: u32) -> Result<()> {
+        if self.buffers.as_ref().is_some_and(|b| b.key == (pixels, k)) {
+            return Ok(());
+        }
+        self.buffers = None;
+        let d = &cx.gpu.device;
+        let max = cx.gpu.max_binding_bytes();
+        let ktab_bytes = pixels * k as u64 * 4;
+        let accum_bytes = pixels * ACCUM_WORDS * 4;
+        if ktab_bytes.max(accum_bytes) > max {
+            let per_pixel = (k as u64 * 4).max(ACCUM_WORDS * 4);
+            return Err(OitError::OutOfMemory(format!(
+                "hybrid with k = {k} needs {ktab_bytes}-byte buffers at this size, past the adapter's {max}-byte \
+                 storage binding limit: use at most {} pixels (e.g. {} x {}) or a smaller k",
+                max / per_pixel,
+                ((max / per_pixel) as f64).sqrt() as u64,
+                ((max / per_pixel) as f64).sqrt() as u64
+            )));
+        }
+        let ktab = storage_buffer(d, "k-TAB and visibility", 2 * ktab_bytes, wgpu::BufferUsages::empty());
+        let accum = storage_buffer(d, "hybrid accumulators", accum_bytes, wgpu::BufferUsages::empty());
+        let overflow = storage_buffer(d, "hybrid overflow", 4, wgpu::BufferUsages::COPY_SRC);
+        let overflow_readback = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("overflow readback"),
+            size: 4,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let p = self.pipelines.as_ref().expect("built before reserve");
+        let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("hybrid"),
+            layout: &p.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &ktab,
+                        offset: 0,
+                        size: Some(ktab_bytes.try_into().expect("non-zero")),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &ktab,
+                        offset: ktab_bytes,
+                        size: Some(ktab_bytes.try_into().expect("non-zero")),
+                    }),
+                },
+                wgpu::BindGroupEntry { binding: 2, resource: accum.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: overflow.as_entire_binding() },
+            ],
+        });
+        self.buffers = Some(Buffers { key: (pixels, k), ktab, accum, overflow, overflow_readback, group });
+        Ok(())
+    }
+}
+
+impl Method for Hybrid {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+        let k = cx.params.int("k") as u32;
+        if self.pipelines.as_ref().is_none_or(|p| p.k != k) {
+            self.pipelines = Some(self.build(cx, k));
+            self.buffers = None;
+        }
+        let t = cx.targets;
+        let pixels = t.width as u64 * t.height as u64;
+        self.reserve(cx, pixels, k)?;
+        let p = self.pipelines.as_ref().expect("built above");
+        let b = self.buffers.as_ref().expect("reserved above");
+        let geo = &cx.scene.transparent;
+        let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&b.ktab, 0, Some(pixels * k as u64 * 4));
+        enc.clear_buffer(&b.accum, 0, None);
+        enc.clear_buffer(&b.overflow, 0, None);
+        {
+            let mut pass = pipeline::capture_pass(&mut enc, "hybrid store", &t.depth, cx.timer.render_pass("store"));
+            pass.set_pipeline(&p.store);
+            pass.set_bind_group(1, &t.group, &[]);
+            pass.set_bind_group(2, &b.group, &[]);
+            geo.draw_all(&mut pass);
+        }
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("hybrid visibility"),
+                timestamp_writes: cx.timer.compute_pass("visibility"),
+            });
+            pass.set_pipeline(&p.visibility);
+            pass.set_bind_group(0, &geo.group, &[]);
+            pass.set_bind_group(1, &t.group, &[]);
+            pass.set_bind_group(2, &b.group, &[]);
+            pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+        }
+        {
+            let mut pass = pipeline::capture_pass(&mut enc, "hybrid shade", &t.depth, cx.timer.render_pass("shade"));
+            pass.set_pipeline(&p.shade);
+            pass.set_bind_group(1, &t.group, &[]);
+            pass.set_bind_group(2, &b.group, &[]);
+            geo.draw_all(&mut pass);
+        }
+        {
+            let mut pass = pipeline::resolve_pass(&mut enc, "hybrid final", &t.out, cx.timer.render_pass("final"));
+            pass.set_pipeline(&p.finish);
+            pass.set_bind_group(0, &geo.group, &[]);
+            pass.set_bind_group(1, &t.group, &[]);
+            pass.set_bind_group(2, &b.group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        enc.copy_buffer_to_buffer(&b.overflow, 0, &b.overflow_readback, 0, 4);
+        cx.gpu.queue.submit([enc.finish()]);
+        let raw = read_buffer(cx.gpu, &b.overflow_readback, 4)?;
+        let overflow = u32::from_le_bytes(raw[..4].try_into().expect("4 bytes")) as u64;
+        Ok(MethodReport {
+            memory_bytes: memory_bytes(pixels, k as u64),
+            overflow_fragments: overflow,
+            extra: vec![("tail_fragments", overflow as f64)],
+        })
+    }
+}

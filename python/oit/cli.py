@@ -1,0 +1,187 @@
+"""`python -m oit`: the command line. One function pair per subcommand (`_add_<name>` for
+its arguments, `_<name>` to run it) and one line in `SUBCOMMANDS`. Errors end with a
+one-line message: exit status 2 for bad input (as argparse does), 1 for device or memory
+failures."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+
+EXIT_USAGE = 2
+
+
+def _ensure_parent(path: str) -> None:
+    parent = os.path.dirname(os.path.abspath(path))
+    os.makedirs(parent, exist_ok=True)
+
+
+def _positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if v <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {v}")
+    return v
+
+
+def _unit_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}") from None
+    if not 0.0 <= v <= 1.0:
+        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {v}")
+    return v
+
+
+def parse_param(text: str) -> Tuple[str, Any]:
+    """'k=v' to (k, v) with v an int, else a float, else the string."""
+    key, sep, value = text.partition("=")
+    if not sep or not key:
+        raise argparse.ArgumentTypeError(f"parameters are written name=value, got {text!r}")
+    for convert in (int, float):
+        try:
+            return key, convert(value)
+        except ValueError:
+            pass
+    return key, value
+
+
+# ---- demo
+
+
+def _add_demo(p: argparse.ArgumentParser) -> None:
+    p.add_argument("-o", "--output", default="out/demo.png", help="PNG to write (default: %(default)s)")
+    p.add_argument("--size", type=_positive_int, default=384, help="width and height of each tile (default: %(default)s)")
+    p.add_argument("--adapter", default=None, help="substring of the adapter name (default: OIT_ADAPTER or the best one)")
+
+
+def _demo(args: argparse.Namespace) -> int:
+    from . import demo
+    from .imageio import write_png
+
+    result = demo.run(args.size, adapter=args.adapter)
+    _ensure_parent(args.output)
+    write_png(args.output, result.mosaic)
+    print(f"adapter: {result.frames['abuffer'].stats['adapter']}")
+    print(demo.legend(result))
+    print(f"wrote {args.output} ({result.mosaic.shape[1]} x {result.mosaic.shape[0]})")
+    return 0
+
+
+# ---- render
+
+
+def _add_render(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="any mesh file trimesh can load (OBJ, PLY, STL, GLB, ...)")
+    p.add_argument("-m", "--method", default="abuffer", help="see `python -m oit methods` (default: %(default)s)")
+    p.add_argument("--alpha", type=_unit_float, default=0.4, help="alpha of every vertex (default: %(default)s)")
+    p.add_argument("-o", "--output", default=None, help="PNG to write (default: out/<file stem>-<method>.png)")
+    p.add_argument("--size", type=_positive_int, nargs=2, metavar=("W", "H"), default=(512, 512))
+    p.add_argument("--background", type=_unit_float, nargs=3, metavar=("R", "G", "B"), default=(1.0, 1.0, 1.0),
+                   help="linear RGB in [0, 1] (default: white)")
+    p.add_argument("--param", type=parse_param, action="append", default=[], metavar="NAME=VALUE",
+                   help="a method parameter; repeat for several")
+    p.add_argument("--adapter", default=None, help="substring of the adapter name (default: OIT_ADAPTER or the best one)")
+
+
+def _render(args: argparse.Namespace) -> int:
+    import trimesh
+
+    from ._api import Camera, Renderer, Scene
+    from .imageio import write_png
+
+    if not os.path.isfile(args.file):
+        raise ValueError(f"no such file: {args.file}")
+    mesh = trimesh.load(args.file, force="mesh")
+    if len(mesh.faces) == 0:
+        raise ValueError(f"{args.file} has no triangles")
+    scene = Scene.from_trimesh(mesh, alpha=args.alpha)
+    width, height = args.size
+    camera = Camera.fit(mesh.vertices, aspect=width / height)
+    params: Dict[str, Any] = dict(args.param)
+    frame = Renderer(width, height, adapter=args.adapter).render(
+        scene, camera, method=args.method, background=tuple(args.background), **params
+    )
+    stem = os.path.splitext(os.path.basename(args.file))[0]
+    output = args.output or os.path.join("out", f"{stem}-{args.method}.png")
+    _ensure_parent(output)
+    write_png(output, frame.image[..., :3])
+    s = frame.stats
+    gpu = f"{s['gpu_time_ms']:.2f} ms" if s.get("gpu_time_ms") is not None else "n/a (no timestamp queries)"
+    print(f"{args.file}: {scene.triangle_count} triangles, alpha {args.alpha}, {width} x {height}, method {s['method']}")
+    print(f"  params: {s['params'] or '{}'}")
+    print(f"  fragments {s['fragments']}, max depth complexity {s['max_depth_complexity']}, "
+          f"overflow {s['overflow_fragments']}")
+    print(f"  memory {s['memory_bytes'] / 2**20:.2f} MiB, gpu {gpu}, wall {s['wall_time_ms']:.1f} ms")
+    print(f"  adapter: {s['adapter']}")
+    print(f"wrote {output}")
+    return 0
+
+
+# ---- methods
+
+
+def _add_methods(p: argparse.ArgumentParser) -> None:
+    pass
+
+
+def format_methods(methods: List[dict]) -> str:
+    """The method table: name, exact, bounded memory, passes, parameters, summary."""
+
+    def param(p: dict) -> str:
+        if p["type"] == "choice":
+            return f"{p['name']}={p['default']} {{{','.join(p['choices'])}}}"
+        return f"{p['name']}={p['default']} [{p['min']}, {p['max']}]"
+
+    rows = [("method", "exact", "bounded", "passes", "params")]
+    for m in methods:
+        rows.append((m["name"], "yes" if m["exact"] else "no", "yes" if m["bounded_memory"] else "no",
+                     " + ".join(m["passes"]), "; ".join(param(p) for p in m["params"]) or "-"))
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    lines.append("")
+    lines.extend(f"{m['name']}: {m['summary']}" for m in methods)
+    return "\n".join(lines)
+
+
+def _methods(args: argparse.Namespace) -> int:
+    from ._api import methods
+
+    print(format_methods(methods()))
+    return 0
+
+
+Subcommand = Tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]
+
+SUBCOMMANDS: Sequence[Subcommand] = (
+    ("demo", "render the built-in scene with every blending method and their errors into one PNG", _add_demo, _demo),
+    ("render", "render a mesh file with one method into a PNG", _add_render, _render),
+    ("methods", "list the methods with their properties and parameters", _add_methods, _methods),
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m oit", description="Order-independent transparency on wgpu.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name, help_text, add, run in SUBCOMMANDS:
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        add(p)
+        p.set_defaults(run=run)
+    return parser
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.run(args)
+    except (ValueError, MemoryError, RuntimeError, OSError) as e:
+        # Engine and input errors carry messages that say what to do; no traceback.
+        print(f"{parser.prog} {args.command}: error: {e}", file=sys.stderr)
+        return EXIT_USAGE if isinstance(e, ValueError) else 1

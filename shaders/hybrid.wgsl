@@ -1,0 +1,169 @@
+// Hybrid transparency (Maule et al. 2013, Algorithm 1) and its k-TAB baseline.
+//   fs_store      geometry pass 1: keep the K nearest <depth, alpha> words per pixel,
+//                 sorted, by the single-pass atomic bubble (one atomicMax per slot).
+//   cs_visibility full screen: transmittance in front of each core slot (eq. 2).
+//   fs_shade      geometry pass 2: core fragments add C * v (eq. 3), the others the tail
+//                 sums C * alpha, alpha and their count (eqs. 5-6).
+//   fs_final      full screen: eqs. 7-11 over the opaque scene or background.
+// Keys, ties and error bounds: docs/methods.md ("hybrid").
+//!include common/scene.wgsl
+//!include common/targets.wgsl
+//!include common/fullscreen.wgsl
+
+// Per-pixel accumulator words (mirrors oit_core::method::hybrid::ACCUM_WORDS).
+const CORE_R: u32 = 0u;      // 3 words: core color, fixed point
+const TAIL_R: u32 = 3u;      // 8 words: tail C * alpha (rgb) and alpha, (lo, hi) pairs
+const TAIL_COUNT: u32 = 11u; // tail fragment count
+const T_CORE: u32 = 12u;     // transmittance behind the core (f32 bits)
+const EVICTED: u32 = 13u;    // nearest key pushed out of the full k-TAB (0: none)
+const ACCUM_WORDS: u32 = 14u;
+
+@group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
+@group(2) @binding(1) var<storage, read_write> vis: array<f32>;
+@group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
+@group(2) @binding(3) var<storage, read_write> overflow: atomic<u32>;
+//!include common/fixed.wgsl
+
+// 24-bit depth over 8-bit alpha, inverted so that a cleared (zero) slot is empty and
+// atomicMax keeps the nearest: a larger key is a nearer fragment (lower alpha first on ties).
+fn pack_key(z: f32, alpha: f32) -> u32 {
+    let d = min(u32(z * 16777215.0), 0xfffffeu);
+    let a = u32(round(clamp(alpha, 0.0, 1.0) * 255.0));
+    return ~((d << 8u) | a);
+}
+
+fn key_alpha(key: u32) -> f32 {
+    return f32((~key) & 0xffu) / 255.0;
+}
+
+@fragment
+fn fs_store(in: VsOut) {
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
+        return;
+    }
+    let px = pixel_index(in.clip);
+    let base = px * K;
+    var v = pack_key(in.clip.z, in.color.a);
+    for (var i = 0u; i < K; i++) {
+        let old = atomicMax(&ktab[base + i], v);
+        if old == 0u {
+            return; // took an empty slot
+        }
+        v = min(old, v); // the farther of the two moves on
+    }
+    atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
+}
+
+// The smallest key that counts as core. Every stored key does, except when a fragment with
+// the same key as the last slot was pushed out: that tied group is split across the table's
+// end, so all of it goes to the tail (no fragment counted twice or dropped).
+fn core_bound(px: u32) -> u32 {
+    let last = atomicLoad(&ktab[px * K + K - 1u]);
+    let evicted = atomicLoad(&accum[px * ACCUM_WORDS + EVICTED]);
+    return select(last, last + 1u, evicted != 0u && evicted == last);
+}
+
+fn core_slots(px: u32) -> u32 {
+    let bound = core_bound(px);
+    var n = 0u;
+    while n < K {
+        let key = atomicLoad(&ktab[px * K + n]);
+        if key == 0u || key < bound {
+            break;
+        }
+        n++;
+    }
+    return n;
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= frame.size.x || id.y >= frame.size.y {
+        return;
+    }
+    let px = id.y * frame.size.x + id.x;
+    let base = px * K;
+    let n = core_slots(px);
+    var t = 1.0;
+    for (var i = 0u; i < n; i++) {
+        vis[base + i] = t; // transmittance in front of slot i: v_i = alpha_i * t (eq. 2)
+        t *= 1.0 - key_alpha(atomicLoad(&ktab[base + i]));
+    }
+    atomicStore(&accum[px * ACCUM_WORDS + T_CORE], bitcast<u32>(t));
+}
+
+@fragment
+fn fs_shade(in: VsOut) {
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
+        return;
+    }
+    let px = pixel_index(in.clip);
+    let base = px * K;
+    let acc = px * ACCUM_WORDS;
+    let key = pack_key(in.clip.z, in.color.a);
+    if key >= core_bound(px) {
+        // Core: the first slot holding this key (the table is sorted by descending key).
+        var lo = 0u;
+        var hi = K;
+        while lo < hi {
+            let mid = (lo + hi) / 2u;
+            if atomicLoad(&ktab[base + mid]) > key { lo = mid + 1u; } else { hi = mid; }
+        }
+        var m = 0u;
+        while lo + m < K && atomicLoad(&ktab[base + lo + m]) == key {
+            m++;
+        }
+        if m > 0u {
+            // m fragments share one quantized key: they share the visibility of their slots.
+            let a = in.color.a;
+            let share = select((1.0 - pow(1.0 - a, f32(m))) / f32(m), a, m == 1u);
+            let w = vis[base + lo] * share;
+            add_fixed32(acc + CORE_R, in.color.r * w);
+            add_fixed32(acc + CORE_R + 1u, in.color.g * w);
+            add_fixed32(acc + CORE_R + 2u, in.color.b * w);
+            return;
+        }
+    }
+    atomicAdd(&accum[acc + TAIL_COUNT], 1u);
+    if TAIL != 0u {
+        let a = in.color.a;
+        add_fixed64(acc + TAIL_R, in.color.r * a);
+        add_fixed64(acc + TAIL_R + 2u, in.color.g * a);
+        add_fixed64(acc + TAIL_R + 4u, in.color.b * a);
+        add_fixed64(acc + TAIL_R + 6u, a);
+    }
+}
+
+fn word(i: u32) -> u32 {
+    return atomicLoad(&accum[i]);
+}
+
+@fragment
+fn fs_final(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let base = base_at(pos);
+    let acc = pixel_index(pos) * ACCUM_WORDS;
+    let core = vec3<f32>(read_fixed32(word(acc + CORE_R)), read_fixed32(word(acc + CORE_R + 1u)), read_fixed32(word(acc + CORE_R + 2u)));
+    let t_core = bitcast<f32>(word(acc + T_CORE));
+    let count = word(acc + TAIL_COUNT);
+    if count > 0u {
+        atomicAdd(&overflow, count);
+    }
+    var tail = vec3<f32>(0.0);
+    var t_tail = 1.0;
+    if TAIL != 0u && count > 0u {
+        let sum_a = read_fixed64(word(acc + TAIL_R + 6u), word(acc + TAIL_R + 7u));
+        if sum_a > 0.0 {
+            let sum_c = vec3<f32>(
+                read_fixed64(word(acc + TAIL_R), word(acc + TAIL_R + 1u)),
+                read_fixed64(word(acc + TAIL_R + 2u), word(acc + TAIL_R + 3u)),
+                read_fixed64(word(acc + TAIL_R + 4u), word(acc + TAIL_R + 5u)),
+            );
+            let n = f32(count);
+            let a_avg = min(sum_a / n, 1.0);                  // eq. 8
+            t_tail = select(pow(1.0 - a_avg, n), 0.0, a_avg >= 1.0); // eq. 9
+            tail = (sum_c / sum_a) * (1.0 - t_tail);          // eqs. 7 and 10: C_tail * alpha_tail
+        }
+    }
+    let rgb = core + t_core * (tail + t_tail * base.rgb);    // eq. 11
+    return vec4<f32>(rgb, 1.0 - t_core * t_tail * (1.0 - base.a));
+}
