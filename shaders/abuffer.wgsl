@@ -3,21 +3,23 @@
 // Resolve: sort each list front to back in batches of BATCH and composite (docs/methods.md).
 //!include common/scene.wgsl
 //!include common/targets.wgsl
-//!include common/pool.wgsl
 //!include common/fullscreen.wgsl
+
+// Mirrors oit_core::gpu_types::PoolNode.
+struct Node {
+    depth: f32,
+    next: u32,
+    rg: vec2<f32>,
+    ba: vec2<f32>,
+}
+//!include common/pool.wgsl
 
 @fragment
 fn fs_capture(in: VsOut) {
     if behind_opaque(in.clip) {
         return;
     }
-    let i = atomicAdd(&alloc.count, 1u);
-    if i >= alloc.capacity {
-        return; // counted; the host grows the pool and renders again
-    }
-    let px = pixel_index(in.clip);
-    let prev = atomicExchange(&heads[px], i + 1u);
-    store_node(i, Node(in.clip.z, prev, in.color.rg, in.color.ba));
+    push_node(pixel_index(in.clip), Node(in.clip.z, 0u, in.color.rg, in.color.ba));
 }
 
 struct Frag {

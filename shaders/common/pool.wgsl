@@ -1,13 +1,8 @@
 // A node pool split across up to four storage bindings, so that it can pass the adapter's
 // per-binding limit. NODES_PER_BINDING is injected by the pipeline (oit_core::shader).
 // Unused bindings hold a one-node placeholder buffer. Links (heads, next) store a node's
-// index + 1, so that a zero-cleared head buffer means empty lists.
-struct Node {
-    depth: f32,
-    next: u32,
-    rg: vec2<f32>,
-    ba: vec2<f32>,
-}
+// index + 1, so that a zero-cleared head buffer means empty lists. The including shader
+// defines `struct Node` with a `next: u32` field (abuffer.wgsl, adaptive.wgsl).
 
 struct Alloc {
     count: atomic<u32>,
@@ -41,4 +36,16 @@ fn load_node(i: u32) -> Node {
         case 2u: { return pool2[o]; }
         default: { return pool3[o]; }
     }
+}
+
+// Appends `n` to pixel `px`'s list; past the capacity it is only counted (the host grows
+// the pool and renders again).
+fn push_node(px: u32, n: Node) {
+    let i = atomicAdd(&alloc.count, 1u);
+    if i >= alloc.capacity {
+        return;
+    }
+    var node = n;
+    node.next = atomicExchange(&heads[px], i + 1u);
+    store_node(i, node);
 }

@@ -15,10 +15,12 @@ struct FrameUniform {
 @group(0) @binding(3) var<storage, read> indices: array<u32>;
 
 struct VsOut {
-    @builtin(position) clip: vec4<f32>,
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) color: vec4<f32>,
     // Global triangle index in submission order (non-indexed draw: vertex_index / 3).
     @location(1) @interpolate(flat) prim: u32,
+    // Clip w, interpolated: the view distance under a perspective camera (1 for orthographic).
+    @location(2) view_w: f32,
 }
 
 @vertex
@@ -29,6 +31,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     out.clip = frame.view_proj * vec4<f32>(p, 1.0);
     out.color = colors[v];
     out.prim = vi / 3u;
+    out.view_w = out.clip.w;
     return out;
 }
 

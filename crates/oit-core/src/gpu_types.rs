@@ -14,13 +14,24 @@ pub struct FrameUniform {
     pub seed: u32,
 }
 
-/// Mirrors `Node` in `shaders/common/pool.wgsl`: depth, next index, straight RGBA.
+/// Mirrors `Node` in `shaders/abuffer.wgsl`: depth, next index, straight RGBA.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct PoolNode {
     pub depth: f32,
     pub next: u32,
     pub rgba: [f32; 4],
+}
+
+/// Mirrors `Node` in `shaders/adaptive.wgsl`: a pool node with its primitive index.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PrimNode {
+    pub depth: f32,
+    pub next: u32,
+    pub rgba: [f32; 4],
+    pub prim: u32,
+    pub pad: u32,
 }
 
 /// Mirrors `Alloc` in `shaders/common/pool.wgsl`.

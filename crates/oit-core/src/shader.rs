@@ -13,6 +13,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/fixed.wgsl", include_str!("../../../shaders/common/fixed.wgsl")),
     ("abuffer.wgsl", include_str!("../../../shaders/abuffer.wgsl")),
     ("hybrid.wgsl", include_str!("../../../shaders/hybrid.wgsl")),
+    ("weighted.wgsl", include_str!("../../../shaders/weighted.wgsl")),
+    ("adaptive.wgsl", include_str!("../../../shaders/adaptive.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.
@@ -28,6 +30,9 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("BATCH", 32),
     Const::U32("K", 8),
     Const::U32("TAIL", 1),
+    Const::U32("WEIGHT", 10),
+    Const::U32("NODES", 8),
+    Const::U32("NODES_PLUS_ONE", 9),
     Const::F32("CORE_SCALE", 2147483648.0),
     Const::F32("TAIL_SCALE", 16777216.0),
 ];

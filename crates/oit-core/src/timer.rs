@@ -43,10 +43,6 @@ impl PassTimer {
         self.labels.clear();
     }
 
-    pub fn available(&self) -> bool {
-        self.queries.is_some()
-    }
-
     /// Timestamp writes for the next pass, named `label`.
     pub fn render_pass(&mut self, label: &'static str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
         let i = self.slot(label)?;

@@ -1,7 +1,7 @@
 //! Every WGSL file parses and validates with naga (no GPU needed), and the structs shared
 //! with Rust have the sizes naga computes.
 
-use oit_core::gpu_types::{Alloc, FrameUniform, PoolNode};
+use oit_core::gpu_types::{Alloc, FrameUniform, PoolNode, PrimNode};
 use oit_core::shader::{compose, entry_files, DEFAULT_CONSTS};
 
 fn validate(path: &str) -> naga::Module {
@@ -39,4 +39,6 @@ fn layout_sizes() {
     assert_eq!(struct_size(&m, "FrameUniform") as usize, std::mem::size_of::<FrameUniform>());
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<PoolNode>());
     assert_eq!(struct_size(&m, "Alloc") as usize, std::mem::size_of::<Alloc>());
+    let m = validate("adaptive.wgsl");
+    assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<PrimNode>());
 }

@@ -1,14 +1,11 @@
-//! `abuffer`: the exact A-buffer as per-pixel linked lists (Yang et al. 2010).
-//! The node pool follows the scene: it grows to the counted fragments and the frame is
-//! rendered again when the atomic counter says the pool overflowed (docs/methods.md).
+//! `abuffer`: the exact A-buffer as per-pixel linked lists (Yang et al. 2010), resolved by
+//! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
+use super::lists::ListMethod;
 use super::{FrameCtx, Limits, Method, MethodInfo, MethodReport};
 use crate::context::GpuContext;
-use crate::error::{OitError, Result};
-use crate::gpu_types::{Alloc, PoolNode};
-use crate::pipeline;
-use crate::shader::{self, Const};
-use crate::targets::{read_buffer, storage_buffer};
+use crate::error::Result;
+use crate::gpu_types::PoolNode;
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "abuffer",
@@ -20,195 +17,16 @@ pub const INFO: MethodInfo = MethodInfo {
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 
-/// Storage bindings the pool is split across (shaders/common/pool.wgsl).
-pub const POOL_BINDINGS: u64 = 4;
-/// Fragments sorted per sweep of the resolve (shaders/abuffer.wgsl).
-pub const BATCH: u32 = 32;
-const NODE_BYTES: u64 = std::mem::size_of::<PoolNode>() as u64;
-
-/// A linked-list node pool with its heads and allocator, shared by list-based methods.
-pub(crate) struct NodePool {
-    pub nodes_per_binding: u64,
-    pub capacity: u64,
-    pixels: u64,
-    pub heads: wgpu::Buffer,
-    pub alloc: wgpu::Buffer,
-    alloc_readback: wgpu::Buffer,
-    pub pools: Vec<wgpu::Buffer>,
-    pub layout: wgpu::BindGroupLayout,
-    pub group: Option<wgpu::BindGroup>,
-}
-
-impl NodePool {
-    pub fn new(gpu: &GpuContext, limits: &Limits) -> Self {
-        let d = &gpu.device;
-        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("node pool"),
-            entries: &(0..2 + POOL_BINDINGS as u32).map(pipeline::storage_entry).collect::<Vec<_>>(),
-        });
-        let alloc = storage_buffer(d, "alloc", 8, wgpu::BufferUsages::COPY_SRC);
-        let alloc_readback = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("alloc readback"),
-            size: 8,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        Self {
-            nodes_per_binding: (limits.max_binding_bytes / NODE_BYTES).max(1).min(u32::MAX as u64 / POOL_BINDINGS),
-            capacity: 0,
-            pixels: 0,
-            heads: storage_buffer(d, "heads", 4, wgpu::BufferUsages::empty()),
-            alloc,
-            alloc_readback,
-            pools: Vec::new(),
-            layout,
-            group: None,
-        }
-    }
-
-    pub fn consts(&self) -> [Const; 1] {
-        [Const::U32("NODES_PER_BINDING", self.nodes_per_binding as u32)]
-    }
-
-    pub fn max_nodes(&self) -> u64 {
-        self.nodes_per_binding * POOL_BINDINGS
-    }
-
-    pub fn bytes(&self) -> u64 {
-        self.capacity * NODE_BYTES + self.pixels * 4 + 8
-    }
-
-    /// Makes room for `nodes` nodes and `pixels` heads, reallocating only when needed.
-    pub fn reserve(&mut self, gpu: &GpuContext, nodes: u64, pixels: u64) -> Result<()> {
-        if nodes > self.max_nodes() {
-            return Err(OitError::OutOfMemory(format!(
-                "the frame has {nodes} transparent fragments but the node pool holds at most {} on this adapter \
-                 ({POOL_BINDINGS} bindings of {} bytes): render at a smaller size or with a bounded method (e.g. hybrid)",
-                self.max_nodes(),
-                self.nodes_per_binding * NODE_BYTES
-            )));
-        }
-        let d = &gpu.device;
-        let mut changed = self.group.is_none();
-        if pixels != self.pixels {
-            self.heads = storage_buffer(d, "heads", pixels * 4, wgpu::BufferUsages::empty());
-            self.pixels = pixels;
-            changed = true;
-        }
-        // Grow to what was counted; shrink when less than a quarter is used.
-        if nodes > self.capacity || nodes < self.capacity / 4 {
-            self.capacity = nodes.max(1);
-            self.pools = (0..POOL_BINDINGS)
-                .map(|b| {
-                    let n = self.capacity.saturating_sub(b * self.nodes_per_binding).min(self.nodes_per_binding).max(1);
-                    storage_buffer(d, "node pool", n * NODE_BYTES, wgpu::BufferUsages::empty())
-                })
-                .collect();
-            changed = true;
-        }
-        if changed {
-            let mut entries = vec![
-                wgpu::BindGroupEntry { binding: 0, resource: self.heads.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: self.alloc.as_entire_binding() },
-            ];
-            entries.extend(self.pools.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry {
-                binding: 2 + i as u32,
-                resource: b.as_entire_binding(),
-            }));
-            self.group = Some(d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("node pool"), layout: &self.layout, entries: &entries }));
-        }
-        Ok(())
-    }
-
-    /// Records the per-frame reset: empty lists and a zero counter with the capacity.
-    pub fn clear(&self, gpu: &GpuContext, enc: &mut wgpu::CommandEncoder) {
-        enc.clear_buffer(&self.heads, 0, None);
-        let alloc = Alloc { count: 0, capacity: self.capacity.min(u32::MAX as u64) as u32 };
-        gpu.queue.write_buffer(&self.alloc, 0, bytemuck::bytes_of(&alloc));
-    }
-
-    pub fn copy_count(&self, enc: &mut wgpu::CommandEncoder) {
-        enc.copy_buffer_to_buffer(&self.alloc, 0, &self.alloc_readback, 0, 8);
-    }
-
-    /// Fragments the last capture tried to store (may exceed the capacity).
-    pub fn read_count(&self, gpu: &GpuContext) -> Result<u64> {
-        let raw = read_buffer(gpu, &self.alloc_readback, 8)?;
-        Ok(bytemuck::pod_read_unaligned::<Alloc>(&raw).count as u64)
-    }
-}
-
-struct ABuffer {
-    pool: NodePool,
-    pipelines: Option<(wgpu::RenderPipeline, wgpu::RenderPipeline)>,
-}
+struct ABuffer(ListMethod);
 
 impl ABuffer {
     fn new(gpu: &GpuContext, limits: &Limits) -> Self {
-        Self { pool: NodePool::new(gpu, limits), pipelines: None }
-    }
-
-    fn build(&mut self, cx: &FrameCtx<'_>) {
-        let d = &cx.gpu.device;
-        let mut consts = self.pool.consts().to_vec();
-        consts.push(Const::U32("BATCH", BATCH));
-        let module = shader::module(d, "abuffer.wgsl", &consts);
-        let layout = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &self.pool.layout]);
-        let capture = pipeline::geometry(d, "abuffer capture", &module, &layout, "fs_capture", &[], pipeline::depth_test_only());
-        let resolve = pipeline::fullscreen(d, "abuffer resolve", &module, &layout, "fs_resolve");
-        self.pipelines = Some((capture, resolve));
+        Self(ListMethod::new(gpu, limits, "abuffer.wgsl", std::mem::size_of::<PoolNode>() as u64))
     }
 }
 
 impl Method for ABuffer {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        if self.pipelines.is_none() {
-            self.build(cx);
-        }
-        let t = cx.targets;
-        let pixels = t.width as u64 * t.height as u64;
-        let initial = if self.pool.capacity == 0 { pixels } else { self.pool.capacity };
-        self.pool.reserve(cx.gpu, initial, pixels)?;
-        let mut regrown = 0.0;
-        loop {
-            cx.timer.reset();
-            let (capture, resolve) = self.pipelines.as_ref().expect("built above");
-            let group = self.pool.group.as_ref().expect("reserved above");
-            let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-            self.pool.clear(cx.gpu, &mut enc);
-            {
-                let mut pass = pipeline::capture_pass(&mut enc, "abuffer capture", &t.depth, cx.timer.render_pass("capture"));
-                pass.set_pipeline(capture);
-                pass.set_bind_group(1, &t.group, &[]);
-                pass.set_bind_group(2, group, &[]);
-                cx.scene.transparent.draw_all(&mut pass);
-            }
-            self.pool.copy_count(&mut enc);
-            {
-                let mut pass = pipeline::resolve_pass(&mut enc, "abuffer resolve", &t.out, cx.timer.render_pass("resolve"));
-                pass.set_pipeline(resolve);
-                pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
-                pass.set_bind_group(1, &t.group, &[]);
-                pass.set_bind_group(2, group, &[]);
-                pass.draw(0..3, 0..1);
-            }
-            cx.gpu.queue.submit([enc.finish()]);
-            let count = self.pool.read_count(cx.gpu)?;
-            if count <= self.pool.capacity {
-                // Shrink for the next frame when this one used little of the pool.
-                if count < self.pool.capacity / 4 {
-                    let memory = self.pool.bytes();
-                    self.pool.reserve(cx.gpu, count, pixels)?;
-                    return Ok(report(memory, regrown));
-                }
-                return Ok(report(self.pool.bytes(), regrown));
-            }
-            self.pool.reserve(cx.gpu, count, pixels)?;
-            regrown += 1.0;
-        }
+        self.0.render(cx)
     }
-}
-
-fn report(memory_bytes: u64, regrown: f64) -> MethodReport {
-    MethodReport { memory_bytes, overflow_fragments: 0, extra: vec![("pool_regrown", regrown)] }
 }

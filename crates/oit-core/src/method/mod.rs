@@ -2,8 +2,11 @@
 //! Adding a method: one file here, its WGSL, one line in `REGISTRY`, and its tests.
 
 mod abuffer;
+mod adaptive;
 mod blend;
+mod lists;
 pub mod hybrid;
+pub mod weighted;
 
 use std::collections::BTreeMap;
 
@@ -74,7 +77,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY

@@ -1,0 +1,34 @@
+//! `adaptive`: adaptive transparency (Salvi et al. 2011) as the paper's proof of concept:
+//! every fragment captured in per-pixel lists (unbounded memory, as theirs), then a
+//! full-screen pass that builds a visibility function of at most `nodes` steps in submission
+//! order and composites every fragment by it (shaders/adaptive.wgsl).
+
+use super::lists::ListMethod;
+use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
+use crate::error::Result;
+use crate::gpu_types::PrimNode;
+use crate::shader::Const;
+
+pub const INFO: MethodInfo = MethodInfo {
+    name: "adaptive",
+    summary: "adaptive transparency: a visibility function of at most `nodes` steps per pixel, built from captured lists",
+    exact: false,
+    bounded_memory: false,
+    passes: &["capture (geometry)", "build visibility and composite (full screen)"],
+    params: &[ParamInfo {
+        name: "nodes",
+        kind: ParamKind::Int { min: 1, max: 32, default: 8 },
+        doc: "steps of the per-pixel visibility function",
+    }],
+    create: |gpu, limits| Box::new(Adaptive(ListMethod::new(gpu, limits, "adaptive.wgsl", std::mem::size_of::<PrimNode>() as u64))),
+};
+
+struct Adaptive(ListMethod);
+
+impl Method for Adaptive {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+        let nodes = cx.params.int("nodes") as u32;
+        self.0.set_consts(vec![Const::U32("NODES", nodes), Const::U32("NODES_PLUS_ONE", nodes + 1)]);
+        self.0.render(cx)
+    }
+}
