@@ -58,6 +58,7 @@ struct Pipelines {
 struct Buffers {
     key: (u64, u32),
     ktab: wgpu::Buffer,
+    _vis: wgpu::Buffer,
     accum: wgpu::Buffer,
     overflow: wgpu::Buffer,
     overflow_readback: wgpu::Buffer,
@@ -122,7 +123,8 @@ impl Hybrid {
                 ((max / per_pixel) as f64).sqrt() as u64
             )));
         }
-        let ktab = storage_buffer(d, "k-TAB and visibility", 2 * ktab_bytes, wgpu::BufferUsages::empty());
+        let ktab = storage_buffer(d, "k-TAB", ktab_bytes, wgpu::BufferUsages::empty());
+        let vis = storage_buffer(d, "core visibility", ktab_bytes, wgpu::BufferUsages::empty());
         let accum = storage_buffer(d, "hybrid accumulators", accum_bytes, wgpu::BufferUsages::empty());
         let overflow = storage_buffer(d, "hybrid overflow", 4, wgpu::BufferUsages::COPY_SRC);
         let overflow_readback = d.create_buffer(&wgpu::BufferDescriptor {
@@ -136,27 +138,13 @@ impl Hybrid {
             label: Some("hybrid"),
             layout: &p.layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &ktab,
-                        offset: 0,
-                        size: Some(ktab_bytes.try_into().expect("non-zero")),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &ktab,
-                        offset: ktab_bytes,
-                        size: Some(ktab_bytes.try_into().expect("non-zero")),
-                    }),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: ktab.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: vis.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: accum.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: overflow.as_entire_binding() },
             ],
         });
-        self.buffers = Some(Buffers { key: (pixels, k), ktab, accum, overflow, overflow_readback, group });
+        self.buffers = Some(Buffers { key: (pixels, k), ktab, _vis: vis, accum, overflow, overflow_readback, group });
         Ok(())
     }
 }
@@ -175,7 +163,7 @@ impl Method for Hybrid {
         let b = self.buffers.as_ref().expect("reserved above");
         let geo = &cx.scene.transparent;
         let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&b.ktab, 0, Some(pixels * k as u64 * 4));
+        enc.clear_buffer(&b.ktab, 0, None);
         enc.clear_buffer(&b.accum, 0, None);
         enc.clear_buffer(&b.overflow, 0, None);
         {

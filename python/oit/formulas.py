@@ -1,0 +1,22 @@
+"""Memory formulas of the bounded methods, as docs/methods.md states them; the tests check
+`frame.stats["memory_bytes"]` against these. Unbounded methods (abuffer, adaptive) size
+their node pool to the frame's fragments and have no formula in W and H alone."""
+
+from __future__ import annotations
+
+# Words per pixel of hybrid's accumulators: core RGB (3), tail sums as 64-bit pairs (8),
+# tail count, transmittance behind the core, nearest evicted key.
+HYBRID_ACCUM_WORDS = 14
+
+
+def memory_bytes(method: str, width: int, height: int, **params) -> int | None:
+    """GPU bytes `method` allocates for a width x height frame, or None when unbounded."""
+    pixels = width * height
+    if method in ("hybrid", "ktab"):
+        k = int(params.get("k", 8))
+        return pixels * (2 * k + HYBRID_ACCUM_WORDS) * 4 + 4  # k-TAB, visibility, accumulators, counter
+    if method in ("wavg", "wsum", "wboit"):
+        return pixels * (16 + 4)  # RGBA32F accumulation and an R32F count or revealage
+    if method in ("unsorted", "sorted"):
+        return 0  # blends into the shared output target
+    return None

@@ -1,0 +1,166 @@
+"""CPU models (numpy, float64) of the methods, on one pixel's fragment stack.
+
+Each model takes the fragments of a pixel in submission order, `z` (n,) depths in [0, 1),
+`rgb` (n, 3) straight colors, `alpha` (n,), and the color behind them `bg` (3,) with its
+coverage `bg_a` (1 for an opaque surface, 0 for the background), and returns RGBA as the
+renderer does. They mirror the shaders' equations, keys and tie rules (docs/methods.md), so
+a GPU image can be checked against them to within float32 and fixed-point rounding.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+DEPTH_MAX = 0xFFFFFE
+
+
+def _visible(z, rgb, alpha):
+    z, rgb, alpha = np.asarray(z, np.float64), np.asarray(rgb, np.float64).reshape(-1, 3), np.asarray(alpha, np.float64)
+    keep = alpha > 0.0  # alpha-0 fragments are invisible and skipped by every method
+    return z[keep], rgb[keep], alpha[keep]
+
+
+def _out(rgb, t, bg, bg_a):
+    return np.append(rgb + t * np.asarray(bg, np.float64), 1.0 - t * (1.0 - bg_a))
+
+
+def exact(z, rgb, alpha, bg, bg_a=0.0):
+    """Sorted front-to-back compositing (ties by color, as the A-buffer)."""
+    z, rgb, alpha = np.asarray(z, np.float64), np.asarray(rgb, np.float64).reshape(-1, 3), np.asarray(alpha, np.float64)
+    order = np.lexsort((alpha, rgb[:, 2], rgb[:, 1], rgb[:, 0], z))
+    c, t = np.zeros(3), 1.0
+    for i in order:
+        c += t * alpha[i] * rgb[i]
+        t *= 1.0 - alpha[i]
+    return _out(c, t, bg, bg_a)
+
+
+def hybrid_keys(z, alpha):
+    """The k-TAB key: 24-bit depth over 8-bit alpha, inverted (larger = nearer)."""
+    d = np.minimum((np.asarray(z, np.float32) * np.float32(16777215.0)).astype(np.uint64), DEPTH_MAX)
+    a = np.round(np.clip(np.asarray(alpha, np.float32), 0, 1) * np.float32(255.0)).astype(np.uint64)
+    return (~((d << np.uint64(8)) | a)) & np.uint64(0xFFFFFFFF)
+
+
+def hybrid(z, rgb, alpha, bg, bg_a=0.0, k=8, tail=True):
+    """Hybrid transparency (Maule et al. 2013, eqs. 2-11) with the renderer's packing and tie
+    rule; `tail=False` is the k-TAB baseline."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    keys = hybrid_keys(z, alpha)
+    ranked = np.sort(keys)[::-1]
+    table = ranked[:k]
+    if len(table) < k:
+        bound = 0
+    else:
+        last = int(table[-1])
+        evicted = int(ranked[k]) if len(ranked) > k else 0
+        bound = last + 1 if evicted != 0 and evicted == last else last
+    slots = [int(x) for x in table if int(x) >= bound]
+    t_before, t = [], 1.0
+    for key in slots:
+        t_before.append(t)
+        t *= 1.0 - ((~key) & 0xFF) / 255.0
+    core, t_core = np.zeros(3), t
+    sum_c, sum_a, count = np.zeros(3), 0.0, 0
+    for key, c, a in zip(keys, rgb, alpha):
+        if bound <= key and int(key) in slots:
+            j = slots.index(int(key))
+            m = slots.count(int(key))
+            share = a if m == 1 else (1.0 - (1.0 - a) ** m) / m
+            core += c * t_before[j] * share
+        else:
+            count += 1
+            sum_c += c * a
+            sum_a += a
+    tail_c, t_tail = np.zeros(3), 1.0
+    if tail and count and sum_a > 0:
+        a_avg = min(sum_a / count, 1.0)
+        t_tail = 0.0 if a_avg >= 1.0 else (1.0 - a_avg) ** count
+        tail_c = sum_c / sum_a * (1.0 - t_tail)
+    return _out(core + t_core * tail_c, t_core * t_tail, bg, bg_a)
+
+
+def ktab(z, rgb, alpha, bg, bg_a=0.0, k=8):
+    return hybrid(z, rgb, alpha, bg, bg_a, k=k, tail=False)
+
+
+def wavg(z, rgb, alpha, bg, bg_a=0.0):
+    """Weighted average (Bavoil & Myers 2008; RTR 5.5)."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    n, sa = len(alpha), alpha.sum()
+    if n == 0 or sa <= 0:
+        return _out(np.zeros(3), 1.0, bg, bg_a)
+    c = (rgb * alpha[:, None]).sum(0) / sa
+    a_avg = min(sa / n, 1.0)
+    u = 0.0 if a_avg >= 1 else (1 - a_avg) ** n
+    return _out(c * (1 - u), u, bg, bg_a)
+
+
+def wsum(z, rgb, alpha, bg, bg_a=0.0):
+    """Weighted sum (Meshkin 2007; RTR 5.5), unclamped."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    return _out((rgb * alpha[:, None]).sum(0), 1.0 - alpha.sum(), bg, bg_a)
+
+
+def wboit_weight(z, view_w, alpha, eq=10):
+    d = np.abs(view_w)
+    if eq == 7:
+        return alpha * np.clip(10 / (1e-5 + (d / 5) ** 2 + (d / 200) ** 6), 1e-2, 3e3)
+    if eq == 8:
+        return alpha * np.clip(10 / (1e-5 + (d / 10) ** 3 + (d / 200) ** 6), 1e-2, 3e3)
+    if eq == 9:
+        return alpha * np.clip(0.03 / (1e-5 + (d / 200) ** 4), 1e-2, 3e3)
+    return alpha * np.maximum(1e-2, 3e3 * (1 - z) ** 3)
+
+
+def wboit(z, rgb, alpha, bg, bg_a=0.0, eq=10, view_w=None):
+    """Weighted blended OIT (McGuire & Bavoil 2013); view_w defaults to 1 (orthographic)."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    if len(alpha) == 0:
+        return _out(np.zeros(3), 1.0, bg, bg_a)
+    w = wboit_weight(z, np.ones_like(z) if view_w is None else view_w, alpha, eq)
+    acc = (rgb * (alpha * w)[:, None]).sum(0)
+    acc_a = (alpha * w).sum()
+    reveal = np.prod(1 - alpha)
+    c = acc / np.clip(acc_a, 1e-5, 5e4)
+    return _out(c * (1 - reveal), reveal, bg, bg_a)
+
+
+def adaptive_visibility(z, alpha, nodes=8):
+    """Salvi et al. 2011: insert in submission order into at most `nodes` steps, removing the
+    node whose merge into its predecessor changes the area under the curve least."""
+    depth: list[float] = []
+    trans: list[float] = []
+    for zi, ai in zip(z, alpha):
+        p = len(depth)
+        while p > 0 and depth[p - 1] > zi:
+            p -= 1
+        front = trans[p - 1] if p > 0 else 1.0
+        trans[p:] = [t * (1 - ai) for t in trans[p:]]
+        depth.insert(p, float(zi))
+        trans.insert(p, front * (1 - ai))
+        if len(depth) > nodes:
+            areas = [(depth[i] - depth[i - 1]) * (trans[i - 1] - trans[i]) for i in range(1, len(depth))]
+            best = 1 + int(np.argmin(areas))
+            trans[best - 1] = trans[best]
+            del depth[best], trans[best]
+    return depth, trans
+
+
+def adaptive(z, rgb, alpha, bg, bg_a=0.0, nodes=8):
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    depth, trans = adaptive_visibility(z, alpha, nodes)
+
+    def vis(zi):
+        t = 1.0
+        for d, tr in zip(depth, trans):
+            if d >= zi:
+                break
+            t = tr
+        return t
+
+    c = sum((rgb[i] * alpha[i] * vis(z[i]) for i in range(len(z))), np.zeros(3))
+    return _out(c, trans[-1] if trans else 1.0, bg, bg_a)
+
+
+MODELS = {"abuffer": exact, "hybrid": hybrid, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit, "adaptive": adaptive}

@@ -1,0 +1,173 @@
+"""Hybrid transparency and the methods it is judged against (hybrid, ktab, wavg, wsum,
+wboit, adaptive): each GPU image against its CPU model (oit.models, float64) fed the same
+fragment stacks, the models against the exact composite, and hybrid's packing cases (ties,
+tiny alpha, alpha = 1)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import oit
+from oit import models
+from oit.formulas import memory_bytes
+from oit.scenes import stacks
+from scenes import IDENTITY, build_scene, random_meshes
+
+BG = np.array([0.2, 0.4, 0.6])
+
+# (method, params, tolerance against its model). Bounds, from docs/methods.md:
+# - hybrid/ktab: the model mirrors the 24/8-bit keys and the tie rule, so only float32
+#   products (<= n * 2^-24 relative) and fixed-point sums (core 2^-32, tail n * 2^-25 per
+#   add) separate them: 2e-6 covers n = 100.
+# - wavg/wboit/adaptive: float32 sums and products over n <= 100 layers: 2e-6.
+# - wsum is unbounded (sums reach n): float32 relative error 100 * 2^-24 of values up to 50.
+CASES = [
+    ("hybrid", {"k": 1}, 2e-6), ("hybrid", {"k": 4}, 2e-6), ("hybrid", {"k": 16}, 2e-6),
+    ("ktab", {"k": 4}, 2e-6), ("wavg", {}, 2e-6), ("wboit", {}, 2e-6),
+    ("adaptive", {"nodes": 4}, 2e-6), ("adaptive", {"nodes": 8}, 2e-6), ("wsum", {}, 5e-5),
+]
+
+
+def model_image(built, method, params, bg=BG):
+    m = built.meta
+    return np.array([models.MODELS[method](m["z"][p], m["rgb"][p], m["alpha"][p], bg, **params)
+                     for p in range(len(m["z"]))])
+
+
+@pytest.mark.parametrize("alphas", ["random", "worst"])
+@pytest.mark.parametrize("layers", [20, 100])
+@pytest.mark.parametrize("method,params,tol", CASES, ids=[f"{m}-{p}" for m, p, _ in CASES])
+def test_gpu_matches_model(renderer, method, params, tol, layers, alphas):
+    built = stacks(layers=layers, alphas=alphas, size=(6, 6), seed=layers)
+    frame = renderer(6, 6).render(built.scene, built.camera, method, background=tuple(BG), **params)
+    got = frame.image.reshape(-1, 4)
+    want = model_image(built, method, params)
+    assert np.abs(got - want).max() <= tol
+
+
+@pytest.mark.parametrize("alphas", ["random", "increasing", "worst", "constant"])
+def test_models_are_exact_when_capacity_suffices(alphas):
+    """With k (nodes) >= the depth complexity, hybrid and ktab equal the exact composite up
+    to 8-bit alpha quantization, and adaptive equals it exactly."""
+    built = stacks(layers=12, alphas=alphas, size=(4, 4), seed=7)
+    m = built.meta
+    for p in range(16):
+        z, rgb, a = m["z"][p], m["rgb"][p], m["alpha"][p]
+        exact = models.exact(z, rgb, a, BG)
+        # |T' - T| <= sum |q_j - a_j| <= (i - 1) / 510 before fragment i (docs/methods.md).
+        n = len(z)
+        bound = (np.sum(a * np.arange(n)) + n) / 510
+        for method in ("hybrid", "ktab"):
+            assert np.abs(models.MODELS[method](z, rgb, a, BG, k=n) - exact).max() <= bound
+        assert np.abs(models.adaptive(z, rgb, a, BG, nodes=n) - exact).max() <= 1e-12
+
+
+def random_scene(seed):
+    return build_scene(random_meshes(seed)), IDENTITY
+
+
+def test_hybrid_with_k_at_depth_complexity_equals_abuffer(renderer):
+    scene, camera = random_scene(11)
+    r = renderer(32, 32)
+    exact = r.render(scene, camera, "abuffer", background=tuple(BG))
+    k = int(exact.stats["max_depth_complexity"])
+    assert 2 <= k <= 32
+    hyb = r.render(scene, camera, "hybrid", background=tuple(BG), k=k)
+    assert hyb.stats["overflow_fragments"] == 0
+    dc = exact.depth_complexity
+    # Per pixel, 8-bit alpha changes each transmittance by at most (number in front) / 510.
+    bound = (dc * (dc + 1) / 2 + dc) / 510 + 1e-6
+    assert (np.abs(hyb.image - exact.image).max(-1) <= bound).all()
+    assert np.abs(hyb.image - exact.image).mean() < 2e-3
+
+
+def quads(layers, size=4):
+    """A scene of full-screen quads: (z, (r, g, b, a)) in submission order."""
+    s = oit.Scene()
+    for z, rgba in layers:
+        p = np.array([[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]], np.float32)
+        s.add_mesh(p, [[0, 1, 2], [0, 2, 3]], rgba)
+    return s
+
+
+def composite_model(layers, method, **params):
+    z = np.array([l[0] for l in layers])
+    rgba = np.array([l[1] for l in layers], np.float64)
+    return models.MODELS[method](z, rgba[:, :3], rgba[:, 3], BG, **params)
+
+
+def test_quantized_depth_ties_across_the_core_boundary(renderer, identity_camera):
+    """Three fragments share one packed key and only one slot is left for them: none may be
+    counted twice or dropped, and the result must not depend on submission order."""
+    layers = [(0.2, (0.9, 0.1, 0.1, 0.5)), (0.6, (0.1, 0.9, 0.1, 0.3)), (0.6, (0.1, 0.1, 0.9, 0.3)),
+              (0.6 + 1e-9, (0.9, 0.9, 0.1, 0.3)), (0.8, (0.5, 0.5, 0.5, 0.4))]
+    r = renderer(4, 4)
+    images = []
+    for perm in ([0, 1, 2, 3, 4], [4, 3, 2, 1, 0], [2, 0, 4, 1, 3]):
+        f = r.render(quads([layers[i] for i in perm]), identity_camera, "hybrid", background=tuple(BG), k=2)
+        images.append(f.image)
+        # The nearer fragment is core; the three tied ones and the far one go to the tail.
+        assert f.stats["overflow_fragments"] == 4 * 16
+    assert all(np.array_equal(images[0], im) for im in images[1:])
+    want = composite_model(layers, "hybrid", k=2)
+    assert np.abs(images[0][0, 0] - want).max() < 2e-6
+    # With room for all of them the tied group is core: its members share the group's
+    # visibility T (1 - (1 - a)^3) equally (their order is undefined), so coverage is exact up
+    # to 8-bit alpha and the color is the model's.
+    f = r.render(quads(layers), identity_camera, "hybrid", background=tuple(BG), k=8)
+    assert f.stats["overflow_fragments"] == 0
+    assert np.abs(f.image[0, 0] - composite_model(layers, "hybrid", k=8)).max() < 2e-6
+    assert abs(f.image[0, 0, 3] - composite_model(layers, "abuffer")[3]) < 5 / 510
+
+
+def test_alpha_below_8bit_resolution_is_not_dropped(renderer, identity_camera):
+    """alpha = 1e-3 packs to 0 in the key; the fragment still adds C * alpha * T."""
+    layers = [(0.3, (1.0, 1.0, 1.0, 1e-3)), (0.5, (1.0, 0.0, 0.0, 1e-4))]
+    r = renderer(4, 4)
+    for method in ("hybrid", "ktab"):
+        f = r.render(quads(layers), identity_camera, method, background=(0.0, 0.0, 0.0), k=4)
+        exact = r.render(quads(layers), identity_camera, "abuffer", background=(0.0, 0.0, 0.0))
+        # Colors use the exact alpha; only the transmittance in front of the second fragment
+        # loses 1e-3 (its key's alpha is 0), a color error of 1e-3 * 1e-4.
+        assert np.abs(f.image[..., :3] - exact.image[..., :3]).max() <= 1e-3 * 1e-4 + 1e-7
+        assert f.image[0, 0, 0] > 1e-3
+        # Coverage comes from the keys: both alphas pack to 0, an error below their sum.
+        assert np.abs(f.image[..., 3] - exact.image[..., 3]).max() <= 1e-3 + 1e-4
+
+
+def test_alpha_one_hides_everything_behind(renderer, identity_camera):
+    layers = [(0.7, (0.0, 1.0, 0.0, 0.6)), (0.4, (0.3, 0.2, 0.1, 1.0)), (0.1, (0.0, 0.0, 1.0, 0.5))]
+    r = renderer(4, 4)
+    want = np.array([0.5 * 0.3, 0.5 * 0.2, 0.5 + 0.5 * 0.1, 1.0])
+    for method, params in (("abuffer", {}), ("hybrid", {"k": 2}), ("hybrid", {"k": 8}), ("ktab", {"k": 2})):
+        f = r.render(quads(layers), identity_camera, method, background=tuple(BG), **params)
+        # 8-bit alpha: 0.5 packs exactly (128/255 differs by 1/510), so allow that bound.
+        assert np.abs(f.image - want).max() <= 1 / 510 + 1e-6, method
+
+
+def test_weighted_methods_with_all_alpha_zero_give_the_background(renderer, identity_camera):
+    layers = [(0.3, (1.0, 0.0, 0.0, 0.0)), (0.6, (0.0, 1.0, 0.0, 0.0))]
+    r = renderer(4, 4)
+    for method in ("wavg", "wsum", "wboit", "hybrid", "ktab", "adaptive", "abuffer", "unsorted"):
+        f = r.render(quads(layers), identity_camera, method, background=tuple(BG))
+        assert np.array_equal(f.image[..., :3], np.broadcast_to(BG.astype(np.float32), (4, 4, 3))), method
+        assert (f.image[..., 3] == 0).all(), method
+
+
+@pytest.mark.parametrize("method,params", [("hybrid", {"k": 1}), ("hybrid", {"k": 8}), ("ktab", {"k": 32}),
+                                           ("wavg", {}), ("wsum", {}), ("wboit", {}), ("unsorted", {})])
+def test_bounded_memory_follows_the_formula(renderer, method, params):
+    scene, camera = random_scene(2)
+    f = renderer(24, 16).render(scene, camera, method, **params)
+    assert f.stats["memory_bytes"] == memory_bytes(method, 24, 16, **params)
+
+
+def test_wboit_weight_choice(renderer):
+    scene, camera = random_scene(5)
+    r = renderer(16, 16)
+    a = r.render(scene, camera, "wboit", weight="eq10").image
+    b = r.render(scene, camera, "wboit", weight="eq7").image
+    assert not np.array_equal(a, b)
+    with pytest.raises(ValueError, match="eq10"):
+        r.render(scene, camera, "wboit", weight="eq11")
