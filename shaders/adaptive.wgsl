@@ -21,6 +21,19 @@ struct Node {
 }
 //!include common/pool.wgsl
 
+@group(2) @binding(6) var<storage, read_write> state: array<u32>; // unused: one dispatch
+
+struct Frag {
+    prim: u32,
+    depth: f32,
+    alpha: f32,
+}
+
+fn frag_less(a: Frag, b: Frag) -> bool {
+    return a.prim < b.prim; // a triangle covers a pixel center at most once
+}
+//!include common/select.wgsl
+
 @fragment
 fn fs_capture(in: VsOut) {
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
@@ -88,10 +101,8 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let head = atomicLoad(&heads[pixel_index(pos)]);
     count = 0u;
     // 1. Submission order: each sweep takes the BATCH smallest primitive indices above the
-    //    last one taken (a primitive covers a pixel center at most once).
-    var batch_prim: array<u32, BATCH>;
-    var batch_z: array<f32, BATCH>;
-    var batch_a: array<f32, BATCH>;
+    //    last one taken.
+    var heap: array<Frag, BATCH>;
     var last = 0u;
     var have_last = false;
     loop {
@@ -100,28 +111,18 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         while i != NIL {
             let node = load_node(i - 1u);
             i = node.next;
-            if (have_last && node.prim <= last) || (n == BATCH && node.prim >= batch_prim[BATCH - 1u]) {
-                continue;
+            if !have_last || node.prim > last {
+                n = heap_offer(&heap, n, Frag(node.prim, node.depth, node.ba.y));
             }
-            var j = min(n, BATCH - 1u);
-            while j > 0u && node.prim < batch_prim[j - 1u] {
-                batch_prim[j] = batch_prim[j - 1u];
-                batch_z[j] = batch_z[j - 1u];
-                batch_a[j] = batch_a[j - 1u];
-                j -= 1u;
-            }
-            batch_prim[j] = node.prim;
-            batch_z[j] = node.depth;
-            batch_a[j] = node.ba.y;
-            n = min(n + 1u, BATCH);
         }
+        heap_sort(&heap, n);
         for (var b = 0u; b < n; b++) {
-            insert(batch_z[b], batch_a[b]);
+            insert(heap[b].depth, heap[b].alpha);
         }
         if n < BATCH {
             break;
         }
-        last = batch_prim[BATCH - 1u];
+        last = heap[BATCH - 1u].prim;
         have_last = true;
     }
     // 2. Composite every fragment by the approximate visibility.

@@ -131,22 +131,23 @@ def _add_methods(p: argparse.ArgumentParser) -> None:
 
 
 def format_methods(methods: List[dict]) -> str:
-    """The method table: name, exact, bounded memory, passes, parameters, summary."""
+    """The method table (name, exact, bounded memory, parameters), then each method's
+    summary and passes."""
 
     def param(p: dict) -> str:
         if p["type"] == "choice":
             return f"{p['name']}={p['default']} {{{','.join(p['choices'])}}}"
         return f"{p['name']}={p['default']} [{p['min']}, {p['max']}]"
 
-    rows = [("method", "exact", "bounded", "passes", "params")]
+    rows = [("method", "exact", "bounded memory", "parameters (default [range])")]
     for m in methods:
         rows.append((m["name"], "yes" if m["exact"] else "no", "yes" if m["bounded_memory"] else "no",
-                     " + ".join(m["passes"]), "; ".join(param(p) for p in m["params"]) or "-"))
+                     "; ".join(param(p) for p in m["params"]) or "-"))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
     lines.insert(1, "  ".join("-" * w for w in widths))
-    lines.append("")
-    lines.extend(f"{m['name']}: {m['summary']}" for m in methods)
+    for m in methods:
+        lines += ["", f"{m['name']}: {m['summary']}", f"  passes: {' -> '.join(m['passes'])}"]
     return "\n".join(lines)
 
 

@@ -190,6 +190,9 @@ impl Renderer {
         };
         gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
         self.opaque_and_census(gpu_scene, background);
+        let counts_raw = read_buffer(&gpu, &self.targets.counts_readback, self.width as u64 * self.height as u64 * 4)?;
+        let depth_complexity: Vec<u32> = bytemuck::pod_collect_to_vec(&counts_raw);
+        let max_depth_complexity = depth_complexity.iter().copied().max().unwrap_or(0);
 
         let limits = self.limits;
         let method = self.methods.entry(info.name).or_insert_with(|| info.instantiate(&gpu, &limits));
@@ -203,15 +206,16 @@ impl Renderer {
             scene_layout: &self.shared.scene_layout,
             timer: &mut self.timer,
             params: &params,
+            max_depth_complexity,
         };
         let report = method.render(&mut cx)?;
         let pass_times = self.timer.read(&gpu)?;
-        let (image, depth_complexity) = self.read_frame()?;
+        let image = self.read_image()?;
         let stats = Stats {
             method: info.name.to_string(),
             params,
             fragments: depth_complexity.iter().map(|&c| c as u64).sum(),
-            max_depth_complexity: depth_complexity.iter().copied().max().unwrap_or(0),
+            max_depth_complexity,
             memory_bytes: report.memory_bytes,
             target_bytes: self.targets.bytes(),
             scene_bytes: gpu_scene.transparent.bytes + gpu_scene.opaque.bytes,
@@ -273,7 +277,7 @@ impl Renderer {
         self.gpu.queue.submit([enc.finish()]);
     }
 
-    fn read_frame(&self) -> Result<(Vec<f32>, Vec<u32>)> {
+    fn read_image(&self) -> Result<Vec<f32>> {
         let t = &self.targets;
         let row = padded_row(t.width, 16);
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
@@ -292,8 +296,6 @@ impl Renderer {
             let line = &raw[r * row as usize..r * row as usize + t.width as usize * 16];
             image.extend(bytemuck::pod_collect_to_vec::<u8, f32>(line));
         }
-        let pixels = t.width as u64 * t.height as u64;
-        let counts_raw = read_buffer(&self.gpu, &t.counts_readback, pixels * 4)?;
-        Ok((image, bytemuck::pod_collect_to_vec(&counts_raw)))
+        Ok(image)
     }
 }

@@ -7,6 +7,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/targets.wgsl", include_str!("../../../shaders/common/targets.wgsl")),
     ("common/fullscreen.wgsl", include_str!("../../../shaders/common/fullscreen.wgsl")),
     ("common/pool.wgsl", include_str!("../../../shaders/common/pool.wgsl")),
+    ("common/select.wgsl", include_str!("../../../shaders/common/select.wgsl")),
     ("opaque.wgsl", include_str!("../../../shaders/opaque.wgsl")),
     ("census.wgsl", include_str!("../../../shaders/census.wgsl")),
     ("blend.wgsl", include_str!("../../../shaders/blend.wgsl")),

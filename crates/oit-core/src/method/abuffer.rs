@@ -1,10 +1,10 @@
 //! `abuffer`: the exact A-buffer as per-pixel linked lists (Yang et al. 2010), resolved by
 //! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
-use super::lists::ListMethod;
+use super::lists::{loop_limited, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
 use super::{FrameCtx, Limits, Method, MethodInfo, MethodReport};
 use crate::context::GpuContext;
-use crate::error::Result;
+use crate::error::{OitError, Result};
 use crate::gpu_types::PoolNode;
 
 pub const INFO: MethodInfo = MethodInfo {
@@ -21,12 +21,31 @@ struct ABuffer(ListMethod);
 
 impl ABuffer {
     fn new(gpu: &GpuContext, limits: &Limits) -> Self {
-        Self(ListMethod::new(gpu, limits, "abuffer.wgsl", std::mem::size_of::<PoolNode>() as u64))
+        Self(ListMethod::new(gpu, limits, "abuffer.wgsl", std::mem::size_of::<PoolNode>() as u64, STATE_WORDS))
     }
+}
+
+/// Words of per-pixel sweep state (mirrors STATE_WORDS in shaders/abuffer.wgsl).
+const STATE_WORDS: u64 = 12;
+
+/// Loop iterations of one sweep over a list of n fragments, at worst: one per node and
+/// log2(BATCH) heap steps per node kept, then the batch's heap sort.
+pub fn sweep_iterations(n: u64) -> u64 {
+    let log = BATCH.ilog2() as u64;
+    n * (1 + log) + BATCH as u64 * (log + 1)
 }
 
 impl Method for ABuffer {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+        let n = cx.max_depth_complexity as u64;
+        if loop_limited(cx.gpu) && sweep_iterations(n) > LLVMPIPE_LOOP_LIMIT {
+            return Err(OitError::Unsupported(format!(
+                "a pixel has {n} transparent fragments; on llvmpipe one resolve sweep handles at most about {} \
+                 (the driver ends a shader's loops after {LLVMPIPE_LOOP_LIMIT} iterations): use a hardware adapter, \
+                 fewer layers, or a bounded method such as hybrid",
+                (LLVMPIPE_LOOP_LIMIT - BATCH as u64 * 6) / 6
+            )));
+        }
         self.0.render(cx)
     }
 }

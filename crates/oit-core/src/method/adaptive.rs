@@ -3,9 +3,9 @@
 //! full-screen pass that builds a visibility function of at most `nodes` steps in submission
 //! order and composites every fragment by it (shaders/adaptive.wgsl).
 
-use super::lists::ListMethod;
+use super::lists::{loop_limited, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
 use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
-use crate::error::Result;
+use crate::error::{OitError, Result};
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;
 
@@ -20,7 +20,7 @@ pub const INFO: MethodInfo = MethodInfo {
         kind: ParamKind::Int { min: 1, max: 32, default: 8 },
         doc: "steps of the per-pixel visibility function",
     }],
-    create: |gpu, limits| Box::new(Adaptive(ListMethod::new(gpu, limits, "adaptive.wgsl", std::mem::size_of::<PrimNode>() as u64))),
+    create: |gpu, limits| Box::new(Adaptive(ListMethod::new(gpu, limits, "adaptive.wgsl", std::mem::size_of::<PrimNode>() as u64, 0))),
 };
 
 struct Adaptive(ListMethod);
@@ -28,6 +28,17 @@ struct Adaptive(ListMethod);
 impl Method for Adaptive {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let nodes = cx.params.int("nodes") as u32;
+        let n = cx.max_depth_complexity as u64;
+        // One invocation does all of a pixel's work: (n / BATCH + 1) heap sweeps of the list,
+        // then n insertions and n lookups of up to `nodes` steps each.
+        let iterations = (n / BATCH as u64 + 1) * n * 6 + n * 4 * nodes as u64;
+        if loop_limited(cx.gpu) && iterations > LLVMPIPE_LOOP_LIMIT {
+            return Err(OitError::Unsupported(format!(
+                "adaptive with nodes = {nodes} on a pixel with {n} fragments needs about {iterations} loop iterations in one \
+                 shader invocation, and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: use a hardware adapter, \
+                 fewer nodes or layers"
+            )));
+        }
         self.0.set_consts(vec![Const::U32("NODES", nodes), Const::U32("NODES_PLUS_ONE", nodes + 1)]);
         self.0.render(cx)
     }

@@ -26,16 +26,19 @@ pub(crate) struct NodePool {
     pub alloc: wgpu::Buffer,
     alloc_readback: wgpu::Buffer,
     pub pools: Vec<wgpu::Buffer>,
+    /// Per-pixel state carried between resolve sweeps (binding 6).
+    state: wgpu::Buffer,
+    state_words: u64,
     pub layout: wgpu::BindGroupLayout,
     pub group: Option<wgpu::BindGroup>,
 }
 
 impl NodePool {
-    pub fn new(gpu: &GpuContext, limits: &Limits, node_bytes: u64) -> Self {
+    pub fn new(gpu: &GpuContext, limits: &Limits, node_bytes: u64, state_words: u64) -> Self {
         let d = &gpu.device;
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("node pool"),
-            entries: &(0..2 + POOL_BINDINGS as u32).map(pipeline::storage_entry).collect::<Vec<_>>(),
+            entries: &(0..3 + POOL_BINDINGS as u32).map(pipeline::storage_entry).collect::<Vec<_>>(),
         });
         let alloc = storage_buffer(d, "alloc", 8, wgpu::BufferUsages::COPY_SRC);
         let alloc_readback = d.create_buffer(&wgpu::BufferDescriptor {
@@ -53,6 +56,8 @@ impl NodePool {
             alloc,
             alloc_readback,
             pools: Vec::new(),
+            state: storage_buffer(d, "sweep state", 4, wgpu::BufferUsages::empty()),
+            state_words,
             layout,
             group: None,
         }
@@ -67,7 +72,7 @@ impl NodePool {
     }
 
     pub fn bytes(&self) -> u64 {
-        self.capacity * self.node_bytes + self.pixels * 4 + 8
+        self.capacity * self.node_bytes + self.pixels * (4 + 4 * self.state_words) + 8
     }
 
     /// Makes room for `nodes` nodes and `pixels` heads, reallocating only when needed.
@@ -84,6 +89,7 @@ impl NodePool {
         let mut changed = self.group.is_none();
         if pixels != self.pixels {
             self.heads = storage_buffer(d, "heads", pixels * 4, wgpu::BufferUsages::empty());
+            self.state = storage_buffer(d, "sweep state", pixels * 4 * self.state_words, wgpu::BufferUsages::empty());
             self.pixels = pixels;
             changed = true;
         }
@@ -107,6 +113,7 @@ impl NodePool {
                 binding: 2 + i as u32,
                 resource: b.as_entire_binding(),
             }));
+            entries.push(wgpu::BindGroupEntry { binding: 2 + POOL_BINDINGS as u32, resource: self.state.as_entire_binding() });
             self.group = Some(d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("node pool"), layout: &self.layout, entries: &entries }));
         }
         Ok(())
@@ -115,6 +122,7 @@ impl NodePool {
     /// Records the per-frame reset: empty lists and a zero counter with the capacity.
     pub fn clear(&self, gpu: &GpuContext, enc: &mut wgpu::CommandEncoder) {
         enc.clear_buffer(&self.heads, 0, None);
+        enc.clear_buffer(&self.state, 0, None);
         let alloc = Alloc { count: 0, capacity: self.capacity.min(u32::MAX as u64) as u32 };
         gpu.queue.write_buffer(&self.alloc, 0, bytemuck::bytes_of(&alloc));
     }
@@ -135,12 +143,37 @@ pub(crate) struct ListMethod {
     shader: &'static str,
     consts: Vec<Const>,
     pool: NodePool,
-    pipelines: Option<(wgpu::RenderPipeline, wgpu::RenderPipeline)>,
+    /// Whether the resolve runs `cs_sweep` dispatches before the full-screen pass.
+    sweeps: bool,
+    pipelines: Option<Pipelines>,
+}
+
+struct Pipelines {
+    capture: wgpu::RenderPipeline,
+    sweep: Option<wgpu::ComputePipeline>,
+    resolve: wgpu::RenderPipeline,
+}
+
+/// Loop iterations llvmpipe allows one shader invocation (all loops together); past them
+/// it silently ends the loops. Methods whose per-pixel work grows with the depth complexity
+/// check their estimate against it on that adapter.
+pub const LLVMPIPE_LOOP_LIMIT: u64 = 65_535;
+
+/// Whether `gpu` is llvmpipe (lavapipe), which has [`LLVMPIPE_LOOP_LIMIT`].
+pub fn loop_limited(gpu: &GpuContext) -> bool {
+    gpu.info.name.contains("llvmpipe")
 }
 
 impl ListMethod {
-    pub fn new(gpu: &GpuContext, limits: &Limits, shader: &'static str, node_bytes: u64) -> Self {
-        Self { shader, consts: Vec::new(), pool: NodePool::new(gpu, limits, node_bytes), pipelines: None }
+    /// `state_words` per pixel carry a sweep's results to the next one (0 without sweeps).
+    pub fn new(gpu: &GpuContext, limits: &Limits, shader: &'static str, node_bytes: u64, state_words: u64) -> Self {
+        Self {
+            shader,
+            consts: Vec::new(),
+            pool: NodePool::new(gpu, limits, node_bytes, state_words),
+            sweeps: state_words > 0,
+            pipelines: None,
+        }
     }
 
     /// Sets the shader constants (besides the pool's); pipelines are rebuilt when they change.
@@ -160,7 +193,17 @@ impl ListMethod {
         let layout = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &self.pool.layout]);
         let capture = pipeline::geometry(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::depth_test_only());
         let resolve = pipeline::fullscreen(d, "list resolve", &module, &layout, "fs_resolve");
-        self.pipelines = Some((capture, resolve));
+        let sweep = self.sweeps.then(|| {
+            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("list sweep"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("cs_sweep"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        });
+        self.pipelines = Some(Pipelines { capture, sweep, resolve });
     }
 
     pub fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
@@ -169,26 +212,41 @@ impl ListMethod {
         }
         let t = cx.targets;
         let pixels = t.width as u64 * t.height as u64;
-        let initial = if self.pool.capacity == 0 { pixels } else { self.pool.capacity };
+        let initial = if self.pool.capacity == 0 { pixels.min(self.pool.max_nodes()) } else { self.pool.capacity };
+        // A list of n fragments takes floor(n / BATCH) + 1 sweeps (the last one finds it empty).
+        let sweeps = cx.max_depth_complexity / BATCH + 1;
         self.pool.reserve(cx.gpu, initial, pixels)?;
         let mut regrown = 0.0;
         loop {
             cx.timer.reset();
-            let (capture, resolve) = self.pipelines.as_ref().expect("built above");
+            let p = self.pipelines.as_ref().expect("built above");
             let group = self.pool.group.as_ref().expect("reserved above");
             let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
             self.pool.clear(cx.gpu, &mut enc);
             {
                 let mut pass = pipeline::capture_pass(&mut enc, "list capture", &t.depth, cx.timer.render_pass("capture"));
-                pass.set_pipeline(capture);
+                pass.set_pipeline(&p.capture);
                 pass.set_bind_group(1, &t.group, &[]);
                 pass.set_bind_group(2, group, &[]);
                 cx.scene.transparent.draw_all(&mut pass);
             }
             self.pool.copy_count(&mut enc);
+            if let Some(sweep) = &p.sweep {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("list sweeps"),
+                    timestamp_writes: cx.timer.compute_pass("sweeps"),
+                });
+                pass.set_pipeline(sweep);
+                pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
+                pass.set_bind_group(1, &t.group, &[]);
+                pass.set_bind_group(2, group, &[]);
+                for _ in 0..sweeps {
+                    pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+                }
+            }
             {
                 let mut pass = pipeline::resolve_pass(&mut enc, "list resolve", &t.out, cx.timer.render_pass("resolve"));
-                pass.set_pipeline(resolve);
+                pass.set_pipeline(&p.resolve);
                 pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
                 pass.set_bind_group(1, &t.group, &[]);
                 pass.set_bind_group(2, group, &[]);
@@ -198,11 +256,13 @@ impl ListMethod {
             let count = self.pool.read_count(cx.gpu)?;
             if count <= self.pool.capacity {
                 let memory = self.pool.bytes();
+                let p = self.pipelines.as_ref().expect("built above");
                 // Shrink for the next frame when this one used little of the pool.
                 if count < self.pool.capacity / 4 {
                     self.pool.reserve(cx.gpu, count, pixels)?;
                 }
-                return Ok(MethodReport { memory_bytes: memory, overflow_fragments: 0, extra: vec![("pool_regrown", regrown)] });
+                let extra = vec![("pool_regrown", regrown), ("resolve_sweeps", if p.sweep.is_some() { sweeps as f64 } else { 1.0 })];
+                return Ok(MethodReport { memory_bytes: memory, overflow_fragments: 0, extra });
             }
             self.pool.reserve(cx.gpu, count, pixels)?;
             regrown += 1.0;

@@ -4,7 +4,7 @@
 mod abuffer;
 mod adaptive;
 mod blend;
-mod lists;
+pub(crate) mod lists;
 pub mod hybrid;
 pub mod weighted;
 
@@ -199,6 +199,8 @@ pub(crate) struct FrameCtx<'a> {
     pub scene_layout: &'a wgpu::BindGroupLayout,
     pub timer: &'a mut PassTimer,
     pub params: &'a Params,
+    /// Largest transparent fragment count of a pixel, from this frame's census.
+    pub max_depth_complexity: u32,
 }
 
 /// What a method reports about its frame, beyond what the renderer measures.

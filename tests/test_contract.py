@@ -1,0 +1,144 @@
+"""The frame contract: stats, array types and shapes, the pixel-center convention, the
+method table, adapter info, the node pool split across bindings, and empty scenes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import oit
+from oit import geometry
+from scenes import IDENTITY, MeshData, build_scene, layer, random_meshes
+
+METHODS = ["abuffer", "unsorted", "sorted"]
+STAT_KEYS = {"fragments", "max_depth_complexity", "memory_bytes", "gpu_time_ms", "overflow_fragments"}
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_stats_count_known_fragments(renderer, method):
+    w, h = 24, 16
+    r = renderer(w, h)
+    scene = build_scene([layer(z, (0.5, 0.5, 0.5, 0.5)) for z in (0.2, 0.4, 0.6)])
+    frame = r.render(scene, IDENTITY, method=method)
+    s = frame.stats
+    assert STAT_KEYS <= set(s)
+    assert s["method"] == method
+    # Full-screen quads: the shared diagonal of each quad's two triangles passes through
+    # pixel centers, and is drawn once (top-left rule): exactly 3 fragments a pixel.
+    assert s["fragments"] == 3 * w * h
+    assert s["max_depth_complexity"] == 3
+    assert (frame.depth_complexity == 3).all()
+    assert s["overflow_fragments"] == 0
+    if r.adapter_info["timestamps"]:
+        assert isinstance(s["gpu_time_ms"], float) and s["gpu_time_ms"] > 0
+    else:
+        assert s["gpu_time_ms"] is None
+    if method == "abuffer":
+        # At least one 24-byte node (depth, next link, RGBA) a fragment.
+        assert s["memory_bytes"] >= 24 * 3 * w * h
+    else:
+        assert s["memory_bytes"] >= 0
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_image_and_depth_complexity_types(renderer, method):
+    frame = renderer(24, 16).render(build_scene([layer(0.5, (1, 0, 0, 0.5))]), IDENTITY, method=method)
+    assert frame.image.dtype == np.float32 and frame.image.shape == (16, 24, 4)
+    assert frame.depth_complexity.dtype == np.uint32 and frame.depth_complexity.shape == (16, 24)
+    assert frame.image.flags.c_contiguous
+
+
+def test_pixel_centers_and_row_zero_at_the_top(renderer):
+    # 16 x 8 pixels; pixel (row, col) has its center at x = (col + 0.5) / 8 - 1,
+    # y = 1 - (row + 0.5) / 4. A quad over x in [-0.75, -0.25], y in [0.25, 0.75] has its
+    # edges on pixel boundaries and covers exactly columns 2-5 of rows 1-2 (near the top).
+    positions, indices = geometry.quad((-0.5, 0.5, 0.5), (0.5, 0.5))
+    scene = build_scene([MeshData(positions, indices, np.tile(np.float32([1, 0, 0, 0.5]), (4, 1)))])
+    frame = renderer(16, 8).render(scene, IDENTITY, background=(0.0, 0.0, 0.0))
+    expected = np.zeros((8, 16), dtype=np.uint32)
+    expected[1:3, 2:6] = 1
+    assert np.array_equal(frame.depth_complexity, expected)
+    assert np.array_equal(frame.image[..., 3] > 0, expected > 0)
+
+
+def test_small_triangle_lands_on_one_pixel(renderer):
+    # A triangle around the center of pixel (row 0, col 15) of 16 x 8: the top-right corner.
+    cx, cy = (15 + 0.5) / 8 - 1, 1 - (0 + 0.5) / 4
+    d = 0.04
+    positions = np.float32([[cx - d, cy - d, 0.5], [cx + d, cy - d, 0.5], [cx, cy + d, 0.5]])
+    scene = build_scene([MeshData(positions, np.array([[0, 1, 2]]), np.tile(np.float32([0, 1, 0, 1]), (3, 1)))])
+    frame = renderer(16, 8).render(scene, IDENTITY, background=(0.0, 0.0, 0.0))
+    assert np.argwhere(frame.depth_complexity).tolist() == [[0, 15]]
+    assert frame.image[0, 15].tolist() == [0.0, 1.0, 0.0, 1.0]
+
+
+def test_orthographic_camera_in_pixel_units(renderer):
+    # World units = pixels, y up: the frame is x in [0, 16], y in [0, 8]. A quad over
+    # x in [3, 5], y in [6, 8] is the top two rows (0 and 1), columns 3 and 4.
+    camera = oit.Camera.orthographic(0.0, 16.0, 0.0, 8.0, near=0.0, far=2.0)
+    positions, indices = geometry.quad((4.0, 7.0, -1.0), (2.0, 2.0))
+    scene = build_scene([MeshData(positions, indices, np.tile(np.float32([0, 0, 1, 1]), (4, 1)))])
+    frame = renderer(16, 8).render(scene, camera, background=(0.0, 0.0, 0.0))
+    assert sorted(map(tuple, np.argwhere(frame.depth_complexity).tolist())) == [(0, 3), (0, 4), (1, 3), (1, 4)]
+    ref = oit.reference(scene, camera, 16, 8, background=(0.0, 0.0, 0.0))
+    assert np.abs(frame.image - ref).max() <= 1e-7
+
+
+def test_method_table():
+    table = {m["name"]: m for m in oit.methods()}
+    assert set(METHODS) <= set(table)
+    assert table["abuffer"]["exact"] is True and table["abuffer"]["bounded_memory"] is False
+    assert table["unsorted"]["exact"] is False and table["sorted"]["exact"] is False
+    for m in table.values():
+        assert isinstance(m["summary"], str) and m["summary"]
+        assert m["passes"] and all(isinstance(p, str) for p in m["passes"])
+        assert isinstance(m["params"], list)
+        for p in m["params"]:
+            assert {"name", "type", "default", "doc"} <= set(p)
+
+
+def test_adapter_info(renderer):
+    info = renderer(16, 16).adapter_info
+    assert isinstance(info["name"], str) and info["name"]
+    assert info["max_storage_binding_bytes"] > 0
+
+
+def test_node_pool_split_across_bindings_gives_the_same_image(renderer):
+    # 4096-byte bindings hold 170 nodes each, 680 in all; this scene has 511-680 fragments,
+    # so nodes land in all four bindings.
+    meshes = random_meshes(2, transparent=10, opaque=1, triangles=4, space="ndc", spread=0.9)
+    scene = build_scene(meshes)
+    whole = renderer(16, 16).render(scene, IDENTITY, background=(0.2, 0.2, 0.2))
+    split = renderer(16, 16, max_binding_bytes=4096).render(scene, IDENTITY, background=(0.2, 0.2, 0.2))
+    assert 3 * 170 < split.stats["fragments"] <= 4 * 170
+    assert np.array_equal(split.image, whole.image)
+
+
+def test_node_pool_too_small_raises_memory_error(renderer):
+    # 256-byte bindings hold 10 nodes each, 40 in all; 4 x 4 pixels x 4 layers = 64.
+    r = renderer(4, 4, max_binding_bytes=256)
+    scene = build_scene([layer(z, (1, 0, 0, 0.5)) for z in (0.2, 0.4, 0.6, 0.8)])
+    with pytest.raises(MemoryError, match=r"64 transparent fragments.*at most 40.*render at a smaller size"):
+        r.render(scene, IDENTITY)
+    # Within the limit, the same renderer works.
+    ok = r.render(build_scene([layer(0.5, (1, 0, 0, 0.5))]), IDENTITY)
+    assert ok.stats["fragments"] == 16
+
+
+def test_small_node_pool_with_few_fragments_on_a_large_frame(renderer):
+    # 16 x 16 = 256 pixels, but only 16 fragments: well within 40 nodes.
+    positions, indices = geometry.quad((-0.75, 0.75, 0.5), (0.5, 0.5))
+    scene = build_scene([MeshData(positions, indices, np.tile(np.float32([1, 0, 0, 0.5]), (4, 1)))])
+    frame = renderer(16, 16, max_binding_bytes=256).render(scene, IDENTITY)
+    assert frame.stats["fragments"] == 16
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_empty_scene_is_the_background(renderer, method):
+    r = renderer(16, 16)
+    empty_mesh = oit.Scene()
+    empty_mesh.add_mesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.uint32), (1.0, 0.0, 0.0, 1.0))
+    for scene in (oit.Scene(), empty_mesh):
+        frame = r.render(scene, IDENTITY, method=method, background=(0.1, 0.2, 0.3))
+        assert np.array_equal(frame.image, np.broadcast_to(np.float32([0.1, 0.2, 0.3, 0.0]), (16, 16, 4)))
+        assert frame.stats["fragments"] == 0 and frame.stats["max_depth_complexity"] == 0
