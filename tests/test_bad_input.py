@@ -73,7 +73,7 @@ def test_set_mesh_alpha_checks_alpha_and_mesh():
         scene.set_mesh_alpha(0, 1.5)
     with pytest.raises(ValueError, match="alpha NaN is outside"):
         scene.set_mesh_alpha(0, float("nan"))
-    with pytest.raises(ValueError, match="no mesh 3"):
+    with pytest.raises(ValueError, match="mesh index 3 is out of range: the scene has 1 meshes"):
         scene.set_mesh_alpha(3, 0.5)
 
 
@@ -185,12 +185,40 @@ def test_parameters_are_checked_against_their_method(small):
     if not with_params:
         pytest.skip("no method has an integer parameter")
     method, p = with_params[0]
-    with pytest.raises(ValueError, match=f"has no parameter '{p['name']}x'; did you mean '{p['name']}'"):
+    with pytest.raises(ValueError, match=rf"has no parameter '{p['name']}x' \(did you mean '{p['name']}'\?\)"):
         r.render(scene, IDENTITY, method=method, **{p["name"] + "x": p["default"]})
     with pytest.raises(ValueError, match=f"{p['name']} = {p['max'] + 1} is out of range"):
         r.render(scene, IDENTITY, method=method, **{p["name"]: p["max"] + 1})
-    with pytest.raises(ValueError, match=f"{p['name']} has the wrong type"):
+    with pytest.raises(ValueError, match=rf"{p['name']} must be an integer in \[{p['min']}, {p['max']}\], got the string 'four'"):
         r.render(scene, IDENTITY, method=method, **{p["name"]: "four"})
+
+
+def test_method_names_are_suggested_whatever_the_case(small):
+    r, scene = small
+    with pytest.raises(ValueError, match=r"unknown method 'ABUFFER' \(did you mean 'abuffer'\?\)"):
+        r.render(scene, IDENTITY, method="ABUFFER")
+
+
+@pytest.mark.parametrize("call,error,message", [
+    (lambda: oit.Camera("eye"), TypeError, "view_proj must be a 4 x 4 array of numbers"),
+    (lambda: oit.Renderer(4, 4, max_binding_bytes=-5), ValueError, "max_binding_bytes must be positive"),
+])
+def test_arguments_of_the_wrong_kind_are_named(call, error, message):
+    with pytest.raises(error, match=message):
+        call()
+
+
+def test_background_of_the_wrong_kind(small):
+    r, scene = small
+    with pytest.raises(ValueError, match="background must be three linear RGB values"):
+        r.render(scene, IDENTITY, background="white")
+
+
+def test_set_mesh_alpha_rejects_negative_mesh_indices():
+    scene = oit.Scene()
+    scene.add_mesh(P, I, C)
+    with pytest.raises(ValueError, match="mesh index -1 is out of range: the scene has 1 meshes"):
+        scene.set_mesh_alpha(-1, 0.5)
 
 
 @pytest.mark.parametrize("matrix,message", [

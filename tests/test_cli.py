@@ -126,3 +126,14 @@ def test_demo_result():
     for method in ("sorted", "unsorted"):
         assert result.errors[method].max() > 0.1
     assert result.mosaic.shape == (2 * 48 + 2, 3 * 48 + 2 * 2, 3)
+
+
+def test_bench_quick_writes_its_tables(tmp_path):
+    out = tmp_path / "bench"
+    result = run_oit("bench", "--quick", "--out", str(out), cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    table = (out / "results.md").read_text()
+    assert "| hair |" in table and "hybrid" in table and "abuffer" in table
+    rows = (out / "results.csv").read_text().splitlines()
+    assert rows[0].startswith("scene,size,method")
+    assert len(rows) > 5

@@ -147,7 +147,10 @@ class Camera:
     wgpu clip space: x, y in [-1, 1] with y up, z in [0, 1] (smaller is nearer)."""
 
     def __init__(self, view_proj: Any) -> None:
-        m = np.asarray(view_proj, dtype=np.float64)
+        try:
+            m = np.asarray(view_proj, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise TypeError(f"view_proj must be a 4 x 4 array of numbers, got {view_proj!r:.60}") from e
         if m.shape != (4, 4):
             raise ValueError(f"view_proj must be a 4 x 4 matrix, got shape {m.shape}")
         if not np.isfinite(m).all():
@@ -264,7 +267,10 @@ class Renderer:
 
 
 def _background(background: Sequence[float]) -> tuple[float, float, float]:
-    bg = np.asarray(background, dtype=np.float64)
+    try:
+        bg = np.asarray(background, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"background must be three linear RGB values in [0, 1], got {background!r}") from None
     if bg.shape != (3,) or not np.isfinite(bg).all() or bg.min() < 0 or bg.max() > 1:
         raise ValueError(f"background must be three linear RGB values in [0, 1], got {background!r}")
     return (float(bg[0]), float(bg[1]), float(bg[2]))

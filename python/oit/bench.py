@@ -134,16 +134,17 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m oit bench", description=__doc__)
+def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--scenes", nargs="+", default=["hair"], choices=sorted(scene_lib.SCENES))
     ap.add_argument("--methods", nargs="+", default=None, help="methods to run (default: all)")
     ap.add_argument("--sizes", type=int, default=None, help="square frame size (default: the scene's)")
     ap.add_argument("--repeat", type=int, default=5, help="timed renders per row after one warm-up (median)")
     ap.add_argument("--out", default="out/bench", help="directory for results.csv and results.md")
     ap.add_argument("--quick", action="store_true", help="small frames and few rows: a smoke test of the bench")
-    a = ap.parse_args(argv)
-    rows = run(a.scenes, a.methods, a.sizes, max(1, a.repeat if not a.quick else 1), a.quick)
+
+
+def run_cli(a: argparse.Namespace) -> int:
+    rows = run(a.scenes, a.methods, a.sizes, 1 if a.quick else max(1, a.repeat), a.quick)
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "results.csv"), "w", newline="") as f:
         wr = csv.DictWriter(f, fieldnames=list(rows[0]))

@@ -158,12 +158,28 @@ def _methods(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---- bench
+
+
+def _add_bench(p: argparse.ArgumentParser) -> None:
+    from . import bench
+
+    bench.add_arguments(p)
+
+
+def _bench(args: argparse.Namespace) -> int:
+    from . import bench
+
+    return bench.run_cli(args)
+
+
 Subcommand = Tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]
 
 SUBCOMMANDS: Sequence[Subcommand] = (
     ("demo", "render the built-in scene with every blending method and their errors into one PNG", _add_demo, _demo),
     ("render", "render a mesh file with one method into a PNG", _add_render, _render),
     ("methods", "list the methods with their properties and parameters", _add_methods, _methods),
+    ("bench", "time, memory and error of every method against the exact A-buffer", _add_bench, _bench),
 )
 
 

@@ -81,8 +81,13 @@ impl Scene {
         Ok(self.inner.add_mesh(mesh))
     }
 
-    fn set_mesh_alpha(&mut self, mesh: usize, alpha: f32) -> Res<()> {
-        Ok(self.inner.set_mesh_alpha(mesh, alpha)?)
+    fn set_mesh_alpha(&mut self, mesh: i64, alpha: f32) -> Res<()> {
+        let count = self.inner.meshes().len();
+        let index = usize::try_from(mesh)
+            .ok()
+            .filter(|&i| i < count)
+            .ok_or_else(|| OitError::InvalidInput(format!("mesh index {mesh} is out of range: the scene has {count} meshes")))?;
+        Ok(self.inner.set_mesh_alpha(index, alpha)?)
     }
 
     #[getter]
@@ -162,7 +167,7 @@ fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, 
 impl Renderer {
     #[new]
     #[pyo3(signature = (width, height, adapter=None, max_binding_bytes=None))]
-    fn new(py: Python<'_>, width: i64, height: i64, adapter: Option<String>, max_binding_bytes: Option<u64>) -> Res<Self> {
+    fn new(py: Python<'_>, width: i64, height: i64, adapter: Option<String>, max_binding_bytes: Option<i64>) -> Res<Self> {
         if width <= 0 || height <= 0 || width > u32::MAX as i64 || height > u32::MAX as i64 {
             return Err(OitError::InvalidInput(format!("width and height must be positive integers, got {width} x {height}")).into());
         }
@@ -171,6 +176,7 @@ impl Renderer {
             let context = oit_core::shared_context(adapter.as_deref())?;
             let mut inner = oit_core::Renderer::new(context.clone(), w, h)?;
             if let Some(b) = max_binding_bytes {
+                let b = u64::try_from(b).map_err(|_| OitError::InvalidInput(format!("max_binding_bytes must be positive, got {b}")))?;
                 inner.set_max_binding_bytes(b)?;
             }
             Ok(Self { inner: Mutex::new(inner), context })

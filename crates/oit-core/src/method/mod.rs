@@ -100,11 +100,12 @@ fn distance(a: &str, b: &str) -> usize {
 }
 
 fn did_you_mean<'a>(name: &str, options: impl Iterator<Item = &'a str>) -> String {
+    let lower = name.to_lowercase();
     options
-        .map(|o| (distance(name, o), o))
+        .map(|o| (distance(&lower, o), o))
         .filter(|(d, _)| *d <= 2)
         .min()
-        .map(|(_, o)| format!("; did you mean '{o}'?"))
+        .map(|(_, o)| format!(" (did you mean '{o}'?)"))
         .unwrap_or_default()
 }
 
@@ -177,7 +178,19 @@ fn check(method: &str, info: &ParamInfo, value: &ParamValue) -> Result<ParamValu
             }
             Ok(ParamValue::Str(s.clone()))
         }
-        (kind, v) => Err(invalid!("{method}: {name} has the wrong type ({v:?}); expected {kind:?}")),
+        (kind, v) => {
+            let got = match v {
+                ParamValue::Int(i) => format!("the integer {i}"),
+                ParamValue::Float(f) => format!("the number {f}"),
+                ParamValue::Str(s) => format!("the string '{s}'"),
+            };
+            let want = match kind {
+                ParamKind::Int { min, max, .. } => format!("an integer in [{min}, {max}]"),
+                ParamKind::Float { min, max, .. } => format!("a number in [{min}, {max}]"),
+                ParamKind::Choice { choices, .. } => format!("one of {}", choices.join(", ")),
+            };
+            Err(invalid!("{method}: {name} must be {want}, got {got}"))
+        }
     }
 }
 
