@@ -44,6 +44,13 @@ fn fs_store(in: VsOut) {
     let px = pixel_index(in.clip);
     let base = px * K;
     var v = pack_key(in.clip.z, in.color.a);
+    // Slots only ever grow (atomicMax), so a key not above a full table's last one now will
+    // not be in the final table: record it as evicted without walking the table.
+    let last = atomicLoad(&ktab[base + K - 1u]);
+    if last != 0u && v <= last {
+        atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
+        return;
+    }
     for (var i = 0u; i < K; i++) {
         let old = atomicMax(&ktab[base + i], v);
         if old == 0u {
