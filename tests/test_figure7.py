@@ -6,36 +6,19 @@ paper's robust findings are asserted (docs/results.md has the full table)."""
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
-from oit.scenes import stacks
+from oit.bench import FIGURE7_KS as KS, figure7_errors
 
-KS = (1, 2, 4, 8, 16)
 SIZE = (20, 20)  # 400 stacks per configuration
-
-
-def mean_rgb_distance(a: np.ndarray, b: np.ndarray) -> float:
-    return float(np.sqrt(((a[..., :3].astype(np.float64) - b[..., :3]) ** 2).sum(-1)).mean())
 
 
 @pytest.fixture(scope="module")
 def errors(renderer):
     """errors[(layers, alphas)][(method, k)] -> mean RGB distance; k = 0 for wavg."""
     r = renderer(*SIZE)
-    out = {}
-    for layers in (20, 100):
-        for alphas in ("random", "increasing", "worst", "constant"):
-            built = stacks(layers=layers, alphas=alphas, size=SIZE, seed=layers + len(alphas))
-            render = lambda m, **p: r.render(built.scene, built.camera, m, background=(0.0, 0.0, 0.0), **p).image
-            exact = render("abuffer")
-            e = {("wavg", 0): mean_rgb_distance(render("wavg"), exact)}
-            for k in KS:
-                e[("hybrid", k)] = mean_rgb_distance(render("hybrid", k=k), exact)
-                e[("ktab", k)] = mean_rgb_distance(render("ktab", k=k), exact)
-                e[("adaptive", k)] = mean_rgb_distance(render("adaptive", nodes=k), exact)
-            out[(layers, alphas)] = e
-    return out
+    return {(n, a): figure7_errors(r, n, a, seed=n + len(a)) for n in (20, 100)
+            for a in ("random", "increasing", "worst", "constant")}
 
 
 CONFIGS = [(n, a) for n in (20, 100) for a in ("random", "increasing", "worst", "constant")]

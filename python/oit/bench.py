@@ -121,6 +121,42 @@ def run(scenes: list[str], methods: list[str] | None, size: int | None, repeat: 
     return rows
 
 
+FIGURE7_KS = (1, 2, 4, 8, 16)
+
+
+def mean_rgb_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """Mean over pixels of the RGB distance between two images."""
+    return float(np.sqrt(((a[..., :3].astype(np.float64) - b[..., :3]) ** 2).sum(-1)).mean())
+
+
+def figure7_errors(renderer: Renderer, layers: int, alphas: str, seed: int = 0) -> dict[tuple[str, int], float]:
+    """The hybrid paper's Figure 7 on the GPU: one stack per pixel of the renderer's frame
+    (oit.scenes.stacks, black background), mean RGB distance to the exact A-buffer for wavg
+    (k = 0) and for hybrid, ktab and adaptive at each k in FIGURE7_KS."""
+    built = scene_lib.stacks(layers=layers, alphas=alphas, size=(renderer.width, renderer.height), seed=seed)
+    render = lambda m, **p: renderer.render(built.scene, built.camera, m, background=(0.0, 0.0, 0.0), **p).image
+    exact = render("abuffer")
+    errors = {("wavg", 0): mean_rgb_distance(render("wavg"), exact)}
+    for k in FIGURE7_KS:
+        errors[("hybrid", k)] = mean_rgb_distance(render("hybrid", k=k), exact)
+        errors[("ktab", k)] = mean_rgb_distance(render("ktab", k=k), exact)
+        errors[("adaptive", k)] = mean_rgb_distance(render("adaptive", nodes=k), exact)
+    return errors
+
+
+def figure7_table(size: int = 20) -> str:
+    """Markdown table of figure7_errors for 20 and 100 fragments and every distribution."""
+    r = Renderer(size, size)
+    lines = ["| layers | alphas | wavg | " + " | ".join(f"{m} k={k}" for k in FIGURE7_KS for m in ("hybrid", "ktab", "adaptive")) + " |"]
+    lines.append("|" + "---|" * (3 + 3 * len(FIGURE7_KS)))
+    for layers in (20, 100):
+        for alphas in scene_lib.ALPHA_KINDS:
+            e = figure7_errors(r, layers, alphas, seed=layers + len(alphas))
+            cells = [f"{e[(m, k)]:.4f}" for k in FIGURE7_KS for m in ("hybrid", "ktab", "adaptive")]
+            lines.append(f"| {layers} | {alphas} | {e[('wavg', 0)]:.4f} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 COLUMNS = [
     ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("params", "{}"), ("gpu_ms", "{:.2f}"),
     ("x_floor", "{:.2f}"), ("abuffer_speedup", "{:.2f}"), ("wall_ms", "{:.1f}"), ("memory_mib", "{:.2f}"),
@@ -144,6 +180,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--repeat", type=int, default=5, help="timed renders per row after one warm-up (median)")
     ap.add_argument("--out", default="out/bench", help="directory for results.csv and results.md")
     ap.add_argument("--quick", action="store_true", help="small frames and few rows: a smoke test of the bench")
+    ap.add_argument("--figure7", action="store_true", help="also run the hybrid paper's Figure 7 experiment (400 stacks)")
 
 
 def run_cli(a: argparse.Namespace) -> int:
@@ -158,4 +195,10 @@ def run_cli(a: argparse.Namespace) -> int:
         f.write(f"Adapter: {rows[0]['adapter']}\n\n{table}\n")
     print(f"adapter: {rows[0]['adapter']}")
     print(table)
+    if a.figure7:
+        fig7 = figure7_table()
+        with open(os.path.join(a.out, "figure7.md"), "w") as f:
+            f.write(fig7 + "\n")
+        print("\nFigure 7 (mean per-pixel RGB distance to the A-buffer, 400 stacks):")
+        print(fig7)
     return 0
