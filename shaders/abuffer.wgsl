@@ -53,10 +53,10 @@ fn frag_less(a: Frag, b: Frag) -> bool {
 
 @compute @workgroup_size(8, 8)
 fn cs_sweep(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if gid.x >= frame.size.x || gid.y >= frame.size.y {
+    let px = compute_pixel(gid);
+    if px == OUTSIDE {
         return;
     }
-    let px = gid.y * frame.size.x + gid.x;
     let s = px * STATE_WORDS;
     let flags = state[s + 10u];
     if (flags & DONE) != 0u {

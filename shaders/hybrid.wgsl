@@ -85,10 +85,10 @@ fn core_slots(px: u32) -> u32 {
 
 @compute @workgroup_size(8, 8)
 fn cs_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    let px = compute_pixel(id);
+    if px == OUTSIDE {
         return;
     }
-    let px = id.y * frame.size.x + id.x;
     let base = px * K;
     let n = core_slots(px);
     var t = 1.0;

@@ -38,3 +38,13 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
 fn pixel_index(pos: vec4<f32>) -> u32 {
     return u32(pos.y) * frame.size.x + u32(pos.x);
 }
+
+// Pixel index of a compute invocation laid over the frame; `OUTSIDE` past its edges.
+const OUTSIDE: u32 = 0xffffffffu;
+
+fn compute_pixel(gid: vec3<u32>) -> u32 {
+    if gid.x >= frame.size.x || gid.y >= frame.size.y {
+        return OUTSIDE;
+    }
+    return gid.y * frame.size.x + gid.x;
+}
