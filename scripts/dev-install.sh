@@ -1,10 +1,9 @@
 #!/usr/bin/env bash
-# Rebuilds the wheel and reinstalls it into the existing virtual environment (no apt, no pip
-# dependency step): the inner loop while developing. scripts/setup.sh does everything.
+# The inner loop while developing: builds the extension and installs the package into the
+# existing virtual environment in editable mode (python/oit is used in place, so Python edits
+# need no rebuild). scripts/setup.sh does the full set-up and installs the abi3 wheel.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${VENV:-.venv}
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$HOME/.cache/oit/target}
-rm -rf dist
-"$VENV/bin/maturin" build --release --out dist -q 2>&1 | grep -E "^error|^warning: unused" -A5 || true
-"$VENV/bin/python" -m pip install -q --force-reinstall --no-deps dist/oit-*.whl
+VIRTUAL_ENV="$PWD/$VENV" "$VENV/bin/maturin" develop --release -q 2>&1 | grep -E "^error|^warning: unused" -A5 || true
