@@ -7,6 +7,10 @@
 struct Alloc {
     count: atomic<u32>,
     capacity: u32,
+    // Fragments a method could not place where its allocation said (pall: outside the
+    // triangle's bound); any is an error the host reports.
+    escaped: atomic<u32>,
+    pad: u32,
 }
 
 @group(2) @binding(0) var<storage, read_write> heads: array<atomic<u32>>;

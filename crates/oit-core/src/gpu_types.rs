@@ -40,4 +40,33 @@ pub struct PrimNode {
 pub struct Alloc {
     pub count: u32,
     pub capacity: u32,
+    pub escaped: u32,
+    pub pad: u32,
+}
+
+/// Mirrors `Node` in `shaders/compact_abuffer.wgsl`: depth, next link, triangle index.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CompactNode {
+    pub depth: f32,
+    pub next: u32,
+    pub prim: u32,
+}
+
+/// Mirrors `PrimShading` in `shaders/compact_abuffer.wgsl`: clip-space corners and colors.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PrimShading {
+    pub clip: [[f32; 4]; 3],
+    pub color: [[f32; 4]; 3],
+}
+
+/// Mirrors `Block` in `shaders/pall.wgsl`: a triangle's node block and pixel box.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PallBlock {
+    pub start: u32,
+    pub origin: u32,
+    pub extent: u32,
+    pub pad: u32,
 }

@@ -8,6 +8,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/fullscreen.wgsl", include_str!("../../../shaders/common/fullscreen.wgsl")),
     ("common/pool.wgsl", include_str!("../../../shaders/common/pool.wgsl")),
     ("common/select.wgsl", include_str!("../../../shaders/common/select.wgsl")),
+    ("common/sweep.wgsl", include_str!("../../../shaders/common/sweep.wgsl")),
+    ("common/setup.wgsl", include_str!("../../../shaders/common/setup.wgsl")),
     ("opaque.wgsl", include_str!("../../../shaders/opaque.wgsl")),
     ("census.wgsl", include_str!("../../../shaders/census.wgsl")),
     ("blend.wgsl", include_str!("../../../shaders/blend.wgsl")),
@@ -16,6 +18,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("hybrid.wgsl", include_str!("../../../shaders/hybrid.wgsl")),
     ("weighted.wgsl", include_str!("../../../shaders/weighted.wgsl")),
     ("adaptive.wgsl", include_str!("../../../shaders/adaptive.wgsl")),
+    ("pall.wgsl", include_str!("../../../shaders/pall.wgsl")),
+    ("compact_abuffer.wgsl", include_str!("../../../shaders/compact_abuffer.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.

@@ -1,7 +1,7 @@
 //! `abuffer`: the exact A-buffer as per-pixel linked lists (Yang et al. 2010), resolved by
 //! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
-use super::lists::{loop_limited, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
+use super::lists::{loop_limited, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
 use super::{FrameCtx, Limits, Method, MethodInfo, MethodReport};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
@@ -21,12 +21,17 @@ struct ABuffer(ListMethod);
 
 impl ABuffer {
     fn new(gpu: &GpuContext, limits: &Limits) -> Self {
-        Self(ListMethod::new(gpu, limits, "abuffer.wgsl", std::mem::size_of::<PoolNode>() as u64, STATE_WORDS))
+        Self(ListMethod::new(gpu, limits, ListLayout {
+            shader: "abuffer.wgsl",
+            node_bytes: std::mem::size_of::<PoolNode>() as u64,
+            state_words: STATE_WORDS,
+            prim_bytes: 0,
+        }))
     }
 }
 
-/// Words of per-pixel sweep state (mirrors STATE_WORDS in shaders/abuffer.wgsl).
-const STATE_WORDS: u64 = 12;
+/// Words of per-pixel sweep state (mirrors STATE_WORDS in shaders/common/sweep.wgsl).
+pub(crate) const STATE_WORDS: u64 = 12;
 
 /// Loop iterations of one sweep over a list of n fragments, at worst: one per node and
 /// log2(BATCH) heap steps per node kept, then the batch's heap sort.
@@ -35,17 +40,23 @@ pub fn sweep_iterations(n: u64) -> u64 {
     n * (1 + log) + BATCH as u64 * (log + 1)
 }
 
+/// Refuses a frame whose deepest pixel one sweep could not walk on llvmpipe.
+pub(crate) fn check_sweep_budget(cx: &FrameCtx<'_>) -> Result<()> {
+    let n = cx.max_depth_complexity as u64;
+    if loop_limited(cx.gpu) && sweep_iterations(n) > LLVMPIPE_LOOP_LIMIT {
+        return Err(OitError::Unsupported(format!(
+            "a pixel has {n} transparent fragments; on llvmpipe one resolve sweep handles at most about {} \
+             (the driver ends a shader's loops after {LLVMPIPE_LOOP_LIMIT} iterations): use a hardware adapter, \
+             fewer layers, or a bounded method such as hybrid",
+            (LLVMPIPE_LOOP_LIMIT - BATCH as u64 * 6) / 6
+        )));
+    }
+    Ok(())
+}
+
 impl Method for ABuffer {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        let n = cx.max_depth_complexity as u64;
-        if loop_limited(cx.gpu) && sweep_iterations(n) > LLVMPIPE_LOOP_LIMIT {
-            return Err(OitError::Unsupported(format!(
-                "a pixel has {n} transparent fragments; on llvmpipe one resolve sweep handles at most about {} \
-                 (the driver ends a shader's loops after {LLVMPIPE_LOOP_LIMIT} iterations): use a hardware adapter, \
-                 fewer layers, or a bounded method such as hybrid",
-                (LLVMPIPE_LOOP_LIMIT - BATCH as u64 * 6) / 6
-            )));
-        }
+        check_sweep_budget(cx)?;
         self.0.render(cx)
     }
 }

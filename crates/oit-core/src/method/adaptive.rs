@@ -3,7 +3,7 @@
 //! full-screen pass that builds a visibility function of at most `nodes` steps in submission
 //! order and composites every fragment by it (shaders/adaptive.wgsl).
 
-use super::lists::{loop_limited, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
+use super::lists::{loop_limited, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
 use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
 use crate::error::{OitError, Result};
 use crate::gpu_types::PrimNode;
@@ -20,7 +20,14 @@ pub const INFO: MethodInfo = MethodInfo {
         kind: ParamKind::Int { min: 1, max: 32, default: 8 },
         doc: "steps of the per-pixel visibility function",
     }],
-    create: |gpu, limits| Box::new(Adaptive(ListMethod::new(gpu, limits, "adaptive.wgsl", std::mem::size_of::<PrimNode>() as u64, 0))),
+    create: |gpu, limits| {
+        Box::new(Adaptive(ListMethod::new(gpu, limits, ListLayout {
+            shader: "adaptive.wgsl",
+            node_bytes: std::mem::size_of::<PrimNode>() as u64,
+            state_words: 0,
+            prim_bytes: 0,
+        })))
+    },
 };
 
 struct Adaptive(ListMethod);

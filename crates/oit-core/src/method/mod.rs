@@ -4,6 +4,8 @@
 mod abuffer;
 mod adaptive;
 mod blend;
+mod compact_abuffer;
+mod pall;
 pub(crate) mod lists;
 pub mod hybrid;
 pub mod weighted;
@@ -77,7 +79,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY

@@ -1,0 +1,36 @@
+//! `compact_abuffer`: the compact A-buffer (Kerzner et al. 2013). Nodes hold depth and the
+//! triangle index only (12 bytes); each triangle's shading data (clip-space corners and
+//! colors, 96 bytes) is written once by a compute pass and the resolve shades each fragment
+//! from it (shaders/compact_abuffer.wgsl).
+
+use super::abuffer::{check_sweep_budget, STATE_WORDS};
+use super::lists::{ListLayout, ListMethod};
+use super::{FrameCtx, Method, MethodInfo, MethodReport};
+use crate::error::Result;
+use crate::gpu_types::{CompactNode, PrimShading};
+
+pub const INFO: MethodInfo = MethodInfo {
+    name: "compact_abuffer",
+    summary: "compact A-buffer: 12-byte nodes (depth, triangle), shading stored once per triangle, exact",
+    exact: true,
+    bounded_memory: false,
+    passes: &["triangle setup (compute)", "capture (geometry)", "sweeps (compute)", "resolve (full screen)"],
+    params: &[],
+    create: |gpu, limits| {
+        Box::new(Compact(ListMethod::new(gpu, limits, ListLayout {
+            shader: "compact_abuffer.wgsl",
+            node_bytes: std::mem::size_of::<CompactNode>() as u64,
+            state_words: STATE_WORDS,
+            prim_bytes: std::mem::size_of::<PrimShading>() as u64,
+        })))
+    },
+};
+
+struct Compact(ListMethod);
+
+impl Method for Compact {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+        check_sweep_budget(cx)?;
+        self.0.render(cx)
+    }
+}

@@ -1,0 +1,36 @@
+//! `pall`: primitive-allocated linked lists (Kerzner et al. 2013). A compute pass gives each
+//! triangle one block of nodes, sized by the pixel centers of its screen bounding box (a
+//! conservative bound of its fragments); fragments then link nodes of their triangle's
+//! block without a global atomic. Resolved exactly like `abuffer` (shaders/pall.wgsl).
+
+use super::abuffer::{check_sweep_budget, STATE_WORDS};
+use super::lists::{ListLayout, ListMethod};
+use super::{FrameCtx, Method, MethodInfo, MethodReport};
+use crate::error::Result;
+use crate::gpu_types::{PallBlock, PoolNode};
+
+pub const INFO: MethodInfo = MethodInfo {
+    name: "pall",
+    summary: "primitive-allocated linked lists: one allocation per triangle (bounding-box bound), exact",
+    exact: true,
+    bounded_memory: false,
+    passes: &["allocate per triangle (compute)", "capture (geometry)", "sweeps (compute)", "resolve (full screen)"],
+    params: &[],
+    create: |gpu, limits| {
+        Box::new(Pall(ListMethod::new(gpu, limits, ListLayout {
+            shader: "pall.wgsl",
+            node_bytes: std::mem::size_of::<PoolNode>() as u64,
+            state_words: STATE_WORDS,
+            prim_bytes: std::mem::size_of::<PallBlock>() as u64,
+        })))
+    },
+};
+
+struct Pall(ListMethod);
+
+impl Method for Pall {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+        check_sweep_budget(cx)?;
+        self.0.render(cx)
+    }
+}

@@ -1,0 +1,48 @@
+// Triangle setup in compute passes over the transparent triangles (one invocation each):
+// clip-space vertices by vertex pulling, and the pixel-center bounding box.
+
+// Triangle of an invocation: dispatches over more than 65,535 groups of 64 use y as well.
+fn triangle_of(gid: vec3<u32>) -> u32 {
+    return gid.y * (65535u * 64u) + gid.x;
+}
+
+fn clip_vertex(t: u32, corner: u32) -> vec4<f32> {
+    let v = indices[3u * t + corner];
+    let p = vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
+    return frame.view_proj * vec4<f32>(p, 1.0);
+}
+
+// Inclusive pixel range [lo, hi] whose centers a triangle can cover, clamped to the frame;
+// the whole frame when a vertex is behind the eye (w <= 0). Empty when hi < lo.
+struct PixelBox {
+    lo: vec2<i32>,
+    hi: vec2<i32>,
+}
+
+fn pixel_box(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>) -> PixelBox {
+    let size = vec2<f32>(frame.size);
+    let last = vec2<i32>(frame.size) - 1;
+    if c0.w <= 0.0 || c1.w <= 0.0 || c2.w <= 0.0 {
+        return PixelBox(vec2<i32>(0), last);
+    }
+    // NDC to pixels: x right, y down; a center (i + 0.5) is covered only inside the box.
+    let p0 = vec2<f32>(c0.x / c0.w + 1.0, 1.0 - c0.y / c0.w) * 0.5 * size;
+    let p1 = vec2<f32>(c1.x / c1.w + 1.0, 1.0 - c1.y / c1.w) * 0.5 * size;
+    let p2 = vec2<f32>(c2.x / c2.w + 1.0, 1.0 - c2.y / c2.w) * 0.5 * size;
+    // Pixel i's center i + 0.5 lies in [lo, hi]; 1/16 pixel of slack covers the rasterizer's
+    // vertex snapping (1/256 pixel) and float rounding.
+    let lo = min(min(p0, p1), p2) - 0.0625;
+    let hi = max(max(p0, p1), p2) + 0.0625;
+    let a = max(vec2<i32>(ceil(lo - 0.5)), vec2<i32>(0));
+    let b = min(vec2<i32>(floor(hi - 0.5)), last);
+    return PixelBox(a, b);
+}
+
+// Perspective-correct barycentrics of the point of the triangle under NDC (x, y): solves
+// sum(b_i * (c_i.xy - ndc * c_i.w)) = 0 with sum(b_i) = 1, valid whatever the signs of w.
+fn barycentrics(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, ndc: vec2<f32>) -> vec3<f32> {
+    let r1 = vec3<f32>(c0.x - ndc.x * c0.w, c1.x - ndc.x * c1.w, c2.x - ndc.x * c2.w);
+    let r2 = vec3<f32>(c0.y - ndc.y * c0.w, c1.y - ndc.y * c1.w, c2.y - ndc.y * c2.w);
+    let b = cross(r1, r2);
+    return b / (b.x + b.y + b.z);
+}

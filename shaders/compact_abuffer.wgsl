@@ -1,0 +1,75 @@
+// The compact A-buffer (Kerzner et al. 2013): per-pixel linked lists whose nodes hold only
+// depth and the triangle index (12 bytes); each triangle's shading data (clip-space vertices
+// and vertex colors) is stored once, by a compute pass before capture, and the resolve
+// shades every fragment from it (perspective-correct interpolation at the pixel center).
+// Resolve: common/sweep.wgsl. docs/methods.md ("compact_abuffer").
+//!include common/scene.wgsl
+//!include common/targets.wgsl
+//!include common/fullscreen.wgsl
+//!include common/setup.wgsl
+
+// Mirrors oit_core::gpu_types::CompactNode.
+struct Node {
+    depth: f32,
+    next: u32,
+    prim: u32,
+}
+//!include common/pool.wgsl
+
+@group(2) @binding(6) var<storage, read_write> state: array<u32>;
+
+// Mirrors oit_core::gpu_types::PrimShading: clip-space corners and their colors.
+struct PrimShading {
+    clip: array<vec4<f32>, 3>,
+    color: array<vec4<f32>, 3>,
+}
+@group(2) @binding(7) var<storage, read_write> shading: array<PrimShading>;
+
+@compute @workgroup_size(64)
+fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let t = triangle_of(gid);
+    if t >= frame.triangle_count {
+        return;
+    }
+    var s: PrimShading;
+    for (var k = 0u; k < 3u; k++) {
+        s.clip[k] = clip_vertex(t, k);
+        s.color[k] = colors[indices[3u * t + k]];
+    }
+    shading[t] = s;
+}
+
+@fragment
+fn fs_capture(in: VsOut) {
+    if behind_opaque(in.clip) {
+        return;
+    }
+    push_node(pixel_index(in.clip), Node(in.clip.z, 0u, in.prim));
+}
+
+struct Cursor {
+    link: u32,
+    px: u32,
+}
+
+fn cursor_begin(px: u32) -> Cursor {
+    return Cursor(atomicLoad(&heads[px]), px);
+}
+
+fn cursor_more(c: Cursor) -> bool {
+    return c.link != NIL;
+}
+
+fn cursor_step(c: ptr<function, Cursor>) -> Frag {
+    let i = (*c).link;
+    let node = load_node(i - 1u);
+    (*c).link = node.next;
+    let s = shading[node.prim];
+    let px = (*c).px;
+    let ndc = vec2<f32>((f32(px % frame.size.x) + 0.5) * 2.0 / f32(frame.size.x) - 1.0,
+                        1.0 - (f32(px / frame.size.x) + 0.5) * 2.0 / f32(frame.size.y));
+    let b = barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
+    let color = clamp(b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2], vec4<f32>(0.0), vec4<f32>(1.0));
+    return Frag(node.depth, color, i);
+}
+//!include common/sweep.wgsl

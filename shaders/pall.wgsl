@@ -1,0 +1,90 @@
+// Primitive-allocated linked lists (Kerzner et al. 2013): one atomic allocation per
+// triangle, sized by a conservative bound of its fragments (the pixel centers inside its
+// screen bounding box, widened by 1/16 pixel, clamped to the frame), in a compute pass
+// before capture. A
+// fragment's node is the triangle's block start plus its pixel's offset inside the box, so
+// capture needs no global atomic, only the per-pixel head exchange. Resolve:
+// common/sweep.wgsl. docs/methods.md ("pall").
+//!include common/scene.wgsl
+//!include common/targets.wgsl
+//!include common/fullscreen.wgsl
+//!include common/setup.wgsl
+
+// Mirrors oit_core::gpu_types::PoolNode.
+struct Node {
+    depth: f32,
+    next: u32,
+    rg: vec2<f32>,
+    ba: vec2<f32>,
+}
+//!include common/pool.wgsl
+
+@group(2) @binding(6) var<storage, read_write> state: array<u32>;
+// Per triangle: its block's first node and its box (origin and extent, 16 bits each).
+// Mirrors oit_core::gpu_types::PallBlock.
+struct Block {
+    start: u32,
+    origin: u32,
+    extent: u32,
+    pad: u32,
+}
+@group(2) @binding(7) var<storage, read_write> blocks: array<Block>;
+
+@compute @workgroup_size(64)
+fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let t = triangle_of(gid);
+    if t >= frame.triangle_count {
+        return;
+    }
+    let b = pixel_box(clip_vertex(t, 0u), clip_vertex(t, 1u), clip_vertex(t, 2u));
+    var extent = vec2<u32>(0u);
+    if all(b.hi >= b.lo) {
+        extent = vec2<u32>(b.hi - b.lo + 1);
+    }
+    let start = atomicAdd(&alloc.count, extent.x * extent.y);
+    let lo = vec2<u32>(max(b.lo, vec2<i32>(0)));
+    blocks[t] = Block(start, lo.x | (lo.y << 16u), extent.x | (extent.y << 16u), 0u);
+}
+
+@fragment
+fn fs_capture(in: VsOut) {
+    if behind_opaque(in.clip) {
+        return;
+    }
+    let blk = blocks[in.prim];
+    // Offsets inside the box; left of or above it they wrap to large values.
+    let x = u32(in.clip.x) - (blk.origin & 0xffffu);
+    let y = u32(in.clip.y) - (blk.origin >> 16u);
+    let w = blk.extent & 0xffffu;
+    if x >= w || y >= (blk.extent >> 16u) {
+        atomicAdd(&alloc.escaped, 1u); // the bound was not conservative: reported as an error
+        return;
+    }
+    let i = blk.start + y * w + x;
+    if i >= alloc.capacity {
+        return; // the allocation pass counted it; the host grows the pool
+    }
+    var node = Node(in.clip.z, 0u, in.color.rg, in.color.ba);
+    node.next = atomicExchange(&heads[pixel_index(in.clip)], i + 1u);
+    store_node(i, node);
+}
+
+struct Cursor {
+    link: u32,
+}
+
+fn cursor_begin(px: u32) -> Cursor {
+    return Cursor(atomicLoad(&heads[px]));
+}
+
+fn cursor_more(c: Cursor) -> bool {
+    return c.link != NIL;
+}
+
+fn cursor_step(c: ptr<function, Cursor>) -> Frag {
+    let i = (*c).link;
+    let node = load_node(i - 1u);
+    (*c).link = node.next;
+    return Frag(node.depth, vec4<f32>(node.rg, node.ba), i);
+}
+//!include common/sweep.wgsl
