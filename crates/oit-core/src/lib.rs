@@ -8,6 +8,7 @@ pub mod method;
 mod pipeline;
 pub mod reference;
 pub mod renderer;
+mod scan;
 pub mod scene;
 pub mod shader;
 mod targets;

@@ -7,6 +7,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/targets.wgsl", include_str!("../../../shaders/common/targets.wgsl")),
     ("common/fullscreen.wgsl", include_str!("../../../shaders/common/fullscreen.wgsl")),
     ("common/pool.wgsl", include_str!("../../../shaders/common/pool.wgsl")),
+    ("common/nodes.wgsl", include_str!("../../../shaders/common/nodes.wgsl")),
     ("common/select.wgsl", include_str!("../../../shaders/common/select.wgsl")),
     ("common/sweep.wgsl", include_str!("../../../shaders/common/sweep.wgsl")),
     ("common/setup.wgsl", include_str!("../../../shaders/common/setup.wgsl")),
@@ -20,6 +21,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("adaptive.wgsl", include_str!("../../../shaders/adaptive.wgsl")),
     ("pall.wgsl", include_str!("../../../shaders/pall.wgsl")),
     ("compact_abuffer.wgsl", include_str!("../../../shaders/compact_abuffer.wgsl")),
+    ("sbuffer.wgsl", include_str!("../../../shaders/sbuffer.wgsl")),
+    ("scan.wgsl", include_str!("../../../shaders/scan.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.

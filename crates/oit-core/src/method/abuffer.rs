@@ -1,7 +1,7 @@
 //! `abuffer`: the exact A-buffer as per-pixel linked lists (Yang et al. 2010), resolved by
 //! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
-use super::lists::{loop_limited, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
+use super::lists::{loop_limited, Aux, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
 use super::{FrameCtx, Limits, Method, MethodInfo, MethodReport};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
@@ -25,7 +25,7 @@ impl ABuffer {
             shader: "abuffer.wgsl",
             node_bytes: std::mem::size_of::<PoolNode>() as u64,
             state_words: STATE_WORDS,
-            prim_bytes: 0,
+            aux: Aux::None,
         }))
     }
 }

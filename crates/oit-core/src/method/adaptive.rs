@@ -3,7 +3,7 @@
 //! full-screen pass that builds a visibility function of at most `nodes` steps in submission
 //! order and composites every fragment by it (shaders/adaptive.wgsl).
 
-use super::lists::{loop_limited, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
+use super::lists::{loop_limited, Aux, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
 use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
 use crate::error::{OitError, Result};
 use crate::gpu_types::PrimNode;
@@ -25,7 +25,7 @@ pub const INFO: MethodInfo = MethodInfo {
             shader: "adaptive.wgsl",
             node_bytes: std::mem::size_of::<PrimNode>() as u64,
             state_words: 0,
-            prim_bytes: 0,
+            aux: Aux::None,
         })))
     },
 };

@@ -4,7 +4,7 @@
 //! from it (shaders/compact_abuffer.wgsl).
 
 use super::abuffer::{check_sweep_budget, STATE_WORDS};
-use super::lists::{ListLayout, ListMethod};
+use super::lists::{Aux, ListLayout, ListMethod};
 use super::{FrameCtx, Method, MethodInfo, MethodReport};
 use crate::error::Result;
 use crate::gpu_types::{CompactNode, PrimShading};
@@ -21,7 +21,7 @@ pub const INFO: MethodInfo = MethodInfo {
             shader: "compact_abuffer.wgsl",
             node_bytes: std::mem::size_of::<CompactNode>() as u64,
             state_words: STATE_WORDS,
-            prim_bytes: std::mem::size_of::<PrimShading>() as u64,
+            aux: Aux::PerTriangle(std::mem::size_of::<PrimShading>() as u64),
         })))
     },
 };

@@ -8,6 +8,7 @@ use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::Alloc;
 use crate::pipeline;
+use crate::scan::Scan;
 use crate::shader::{self, Const};
 use crate::targets::{read_buffer, storage_buffer};
 
@@ -17,6 +18,16 @@ pub const POOL_BINDINGS: u64 = 4;
 pub const BATCH: u32 = 32;
 
 const ALLOC_BYTES: u64 = std::mem::size_of::<Alloc>() as u64;
+
+/// What a list method keeps at binding 7 besides its pool.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Aux {
+    None,
+    /// Bytes per transparent triangle, filled by a `cs_allocate` pass before capture.
+    PerTriangle(u64),
+    /// W * H + 1 words: per-pixel counts scanned into range starts (sbuffer).
+    PixelOffsets,
+}
 
 /// A linked-list node pool with its heads and allocator, shared by list-based methods.
 pub(crate) struct NodePool {
@@ -31,16 +42,16 @@ pub(crate) struct NodePool {
     /// Per-pixel state carried between resolve sweeps (binding 6).
     state: wgpu::Buffer,
     state_words: u64,
-    /// Per-triangle data of the allocation pass (binding 7).
-    prims: wgpu::Buffer,
-    prim_bytes: u64,
-    triangles: u64,
+    /// Binding 7: per-triangle data of the allocation pass, or per-pixel offsets.
+    pub aux: wgpu::Buffer,
+    aux_kind: Aux,
+    aux_len: u64,
     pub layout: wgpu::BindGroupLayout,
     pub group: Option<wgpu::BindGroup>,
 }
 
 impl NodePool {
-    pub fn new(gpu: &GpuContext, limits: &Limits, node_bytes: u64, state_words: u64, prim_bytes: u64) -> Self {
+    pub fn new(gpu: &GpuContext, limits: &Limits, node_bytes: u64, state_words: u64, aux_kind: Aux) -> Self {
         let d = &gpu.device;
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("node pool"),
@@ -64,9 +75,9 @@ impl NodePool {
             pools: Vec::new(),
             state: storage_buffer(d, "sweep state", 4, wgpu::BufferUsages::empty()),
             state_words,
-            prims: storage_buffer(d, "per-triangle data", 4, wgpu::BufferUsages::empty()),
-            prim_bytes,
-            triangles: 0,
+            aux: storage_buffer(d, "list aux", 4, wgpu::BufferUsages::empty()),
+            aux_kind,
+            aux_len: 0,
             layout,
             group: None,
         }
@@ -81,7 +92,7 @@ impl NodePool {
     }
 
     pub fn bytes(&self) -> u64 {
-        self.capacity * self.node_bytes + self.pixels * (4 + 4 * self.state_words) + self.triangles * self.prim_bytes + ALLOC_BYTES
+        self.capacity * self.node_bytes + self.pixels * (4 + 4 * self.state_words) + self.aux_len + ALLOC_BYTES
     }
 
     /// Makes room for `nodes` nodes, `pixels` heads and `triangles` per-triangle records,
@@ -103,18 +114,21 @@ impl NodePool {
             self.pixels = pixels;
             changed = true;
         }
-        let triangles = if self.prim_bytes == 0 { 0 } else { triangles };
-        if triangles != self.triangles {
-            if triangles * self.prim_bytes > gpu.max_binding_bytes() {
+        let aux_len = match self.aux_kind {
+            Aux::None => 0,
+            Aux::PerTriangle(bytes) => triangles * bytes,
+            Aux::PixelOffsets => (pixels + 1) * 4,
+        };
+        if aux_len != self.aux_len {
+            if aux_len > gpu.max_binding_bytes() {
                 return Err(OitError::OutOfMemory(format!(
-                    "{triangles} transparent triangles need {} bytes of per-triangle data, past the adapter's \
-                     {}-byte storage binding limit: split the scene",
-                    triangles * self.prim_bytes,
+                    "this frame needs a {aux_len}-byte buffer of per-triangle or per-pixel data, past the adapter's \
+                     {}-byte storage binding limit: split the scene or render a smaller frame",
                     gpu.max_binding_bytes()
                 )));
             }
-            self.prims = storage_buffer(d, "per-triangle data", triangles * self.prim_bytes, wgpu::BufferUsages::empty());
-            self.triangles = triangles;
+            self.aux = storage_buffer(d, "list aux", aux_len, wgpu::BufferUsages::COPY_SRC);
+            self.aux_len = aux_len;
             changed = true;
         }
         // Grow to what was counted; shrink when less than a quarter is used.
@@ -138,7 +152,7 @@ impl NodePool {
                 resource: b.as_entire_binding(),
             }));
             entries.push(wgpu::BindGroupEntry { binding: 2 + POOL_BINDINGS as u32, resource: self.state.as_entire_binding() });
-            entries.push(wgpu::BindGroupEntry { binding: 3 + POOL_BINDINGS as u32, resource: self.prims.as_entire_binding() });
+            entries.push(wgpu::BindGroupEntry { binding: 3 + POOL_BINDINGS as u32, resource: self.aux.as_entire_binding() });
             self.group = Some(d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("node pool"), layout: &self.layout, entries: &entries }));
         }
         Ok(())
@@ -171,13 +185,15 @@ pub(crate) struct ListMethod {
     pool: NodePool,
     /// Whether the resolve runs `cs_sweep` dispatches before the full-screen pass.
     sweeps: bool,
-    /// Whether a `cs_allocate` pass over the triangles runs before capture.
-    allocate: bool,
+    aux: Aux,
     pipelines: Option<Pipelines>,
+    /// The prefix sum over binding 7, for `Aux::PixelOffsets`, and the pixels it is for.
+    scan: Option<(u64, Scan)>,
 }
 
 struct Pipelines {
     allocate: Option<wgpu::ComputePipeline>,
+    count: Option<wgpu::RenderPipeline>,
     capture: wgpu::RenderPipeline,
     sweep: Option<wgpu::ComputePipeline>,
     resolve: wgpu::RenderPipeline,
@@ -190,8 +206,8 @@ pub(crate) struct ListLayout {
     pub node_bytes: u64,
     /// Per-pixel words carried between resolve sweeps; 0 for a single-pass resolve.
     pub state_words: u64,
-    /// Bytes per triangle filled by a `cs_allocate` pass before capture; 0 for none.
-    pub prim_bytes: u64,
+    /// What binding 7 holds, and so which passes run before capture.
+    pub aux: Aux,
 }
 
 /// Loop iterations llvmpipe allows one shader invocation (all loops together); past them
@@ -209,10 +225,11 @@ impl ListMethod {
         Self {
             shader: layout.shader,
             consts: Vec::new(),
-            pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.prim_bytes),
+            pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.aux),
             sweeps: layout.state_words > 0,
-            allocate: layout.prim_bytes > 0,
+            aux: layout.aux,
             pipelines: None,
+            scan: None,
         }
     }
 
@@ -244,8 +261,35 @@ impl ListMethod {
             })
         };
         let sweep = self.sweeps.then(|| compute("cs_sweep"));
-        let allocate = self.allocate.then(|| compute("cs_allocate"));
-        self.pipelines = Some(Pipelines { allocate, capture, sweep, resolve });
+        let allocate = matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate"));
+        let count = (self.aux == Aux::PixelOffsets)
+            .then(|| pipeline::geometry(d, "list count", &module, &layout, "fs_count", &[], pipeline::depth_test_only()));
+        self.pipelines = Some(Pipelines { allocate, count, capture, sweep, resolve });
+    }
+
+    /// S-buffer preparation: per-pixel counts into binding 7, their exclusive prefix sum in
+    /// place (entry W * H becomes the total), the starts copied to the fill cursors (heads)
+    /// and the total to the allocator's count, so that the capacity check works as for lists.
+    fn count_and_scan(&self, cx: &mut FrameCtx<'_>, enc: &mut wgpu::CommandEncoder, count: &wgpu::RenderPipeline, scan: &Scan, pixels: u64) {
+        let t = cx.targets;
+        let group = self.pool.group.as_ref().expect("reserved");
+        enc.clear_buffer(&self.pool.aux, 0, None);
+        {
+            let mut pass = pipeline::capture_pass(enc, "list count", &t.depth, cx.timer.render_pass("count"));
+            pass.set_pipeline(count);
+            pass.set_bind_group(1, &t.group, &[]);
+            pass.set_bind_group(2, group, &[]);
+            cx.scene.transparent.draw_all(&mut pass);
+        }
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("prefix sum"),
+                timestamp_writes: cx.timer.compute_pass("prefix sum"),
+            });
+            scan.record(&mut pass);
+        }
+        enc.copy_buffer_to_buffer(&self.pool.aux, 0, &self.pool.heads, 0, pixels * 4);
+        enc.copy_buffer_to_buffer(&self.pool.aux, pixels * 4, &self.pool.alloc, 0, 4);
     }
 
     pub fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
@@ -259,6 +303,9 @@ impl ListMethod {
         let sweeps = cx.max_depth_complexity / BATCH + 1;
         let triangles = cx.scene.transparent.triangles as u64;
         self.pool.reserve(cx.gpu, initial, pixels, triangles)?;
+        if self.aux == Aux::PixelOffsets && self.scan.as_ref().is_none_or(|(p, _)| *p != pixels) {
+            self.scan = Some((pixels, Scan::new(cx.gpu, &self.pool.aux, pixels + 1)));
+        }
         let mut regrown = 0.0;
         loop {
             cx.timer.reset();
@@ -277,6 +324,9 @@ impl ListMethod {
                 pass.set_bind_group(2, group, &[]);
                 let groups = (triangles as u32).div_ceil(64);
                 pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+            }
+            if let (Some(count), Some((_, scan))) = (&p.count, &self.scan) {
+                self.count_and_scan(cx, &mut enc, count, scan, pixels);
             }
             {
                 let mut pass = pipeline::capture_pass(&mut enc, "list capture", &t.depth, cx.timer.render_pass("capture"));
@@ -318,7 +368,7 @@ impl ListMethod {
             }
             let count = alloc.count as u64;
             if count <= self.pool.capacity {
-                let memory = self.pool.bytes();
+                let memory = self.pool.bytes() + self.scan.as_ref().map_or(0, |(_, s)| s.bytes);
                 let p = self.pipelines.as_ref().expect("built above");
                 // Shrink for the next frame when this one used little of the pool.
                 if count < self.pool.capacity / 4 {

@@ -6,6 +6,7 @@ mod adaptive;
 mod blend;
 mod compact_abuffer;
 mod pall;
+mod sbuffer;
 pub(crate) mod lists;
 pub mod hybrid;
 pub mod weighted;
@@ -79,7 +80,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY

@@ -4,7 +4,7 @@
 //! block without a global atomic. Resolved exactly like `abuffer` (shaders/pall.wgsl).
 
 use super::abuffer::{check_sweep_budget, STATE_WORDS};
-use super::lists::{ListLayout, ListMethod};
+use super::lists::{Aux, ListLayout, ListMethod};
 use super::{FrameCtx, Method, MethodInfo, MethodReport};
 use crate::error::Result;
 use crate::gpu_types::{PallBlock, PoolNode};
@@ -21,7 +21,7 @@ pub const INFO: MethodInfo = MethodInfo {
             shader: "pall.wgsl",
             node_bytes: std::mem::size_of::<PoolNode>() as u64,
             state_words: STATE_WORDS,
-            prim_bytes: std::mem::size_of::<PallBlock>() as u64,
+            aux: Aux::PerTriangle(std::mem::size_of::<PallBlock>() as u64),
         })))
     },
 };

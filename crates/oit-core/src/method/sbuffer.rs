@@ -1,0 +1,36 @@
+//! `sbuffer`: the S-buffer (Vasilakis & Fudos 2012; the dynamic fragment buffer of Maule et
+//! al. 2012 is the same idea): count fragments per pixel, prefix-sum the counts into
+//! contiguous per-pixel ranges (compute), capture into them, and resolve like `abuffer`.
+//! The pool holds exactly the counted fragments (shaders/sbuffer.wgsl).
+
+use super::abuffer::{check_sweep_budget, STATE_WORDS};
+use super::lists::{Aux, ListLayout, ListMethod};
+use super::{FrameCtx, Method, MethodInfo, MethodReport};
+use crate::error::Result;
+use crate::gpu_types::PoolNode;
+
+pub const INFO: MethodInfo = MethodInfo {
+    name: "sbuffer",
+    summary: "S-buffer: per-pixel counts, a prefix sum, fragments in contiguous per-pixel ranges, exact",
+    exact: true,
+    bounded_memory: false,
+    passes: &["count (geometry)", "prefix sum (compute)", "capture (geometry)", "sweeps (compute)", "resolve (full screen)"],
+    params: &[],
+    create: |gpu, limits| {
+        Box::new(SBuffer(ListMethod::new(gpu, limits, ListLayout {
+            shader: "sbuffer.wgsl",
+            node_bytes: std::mem::size_of::<PoolNode>() as u64,
+            state_words: STATE_WORDS,
+            aux: Aux::PixelOffsets,
+        })))
+    },
+};
+
+struct SBuffer(ListMethod);
+
+impl Method for SBuffer {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+        check_sweep_budget(cx)?;
+        self.0.render(cx)
+    }
+}

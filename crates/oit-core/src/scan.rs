@@ -1,0 +1,113 @@
+//! Exclusive prefix sum of a u32 storage buffer in place (shaders/scan.wgsl): 256-element
+//! blocks scanned in workgroup memory, their totals scanned recursively, then added back.
+
+use crate::context::GpuContext;
+use crate::shader;
+use crate::targets::storage_buffer;
+
+const BLOCK: u64 = 256;
+const MAX_GROUPS_X: u64 = 65_535;
+
+struct Level {
+    group: wgpu::BindGroup,
+    groups: (u32, u32),
+}
+
+pub struct Scan {
+    scan: wgpu::ComputePipeline,
+    add: wgpu::ComputePipeline,
+    levels: Vec<Level>,
+    _buffers: Vec<wgpu::Buffer>,
+    pub bytes: u64,
+}
+
+fn groups_for(n: u64) -> (u32, u32) {
+    let blocks = n.div_ceil(BLOCK).max(1);
+    let x = blocks.min(MAX_GROUPS_X);
+    (x as u32, blocks.div_ceil(x) as u32)
+}
+
+impl Scan {
+    /// A scan of the first `n` words of `data`.
+    pub fn new(gpu: &GpuContext, data: &wgpu::Buffer, n: u64) -> Self {
+        let d = &gpu.device;
+        let module = shader::module(d, "scan.wgsl", &[]);
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let storage = wgpu::BufferBindingType::Storage { read_only: false };
+        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scan"),
+            entries: &[entry(0, storage), entry(1, storage), entry(2, wgpu::BufferBindingType::Uniform)],
+        });
+        let pl = crate::pipeline::layout(d, &[&layout]);
+        let pipeline = |entry: &str| {
+            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pl),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (scan, add) = (pipeline("cs_scan_blocks"), pipeline("cs_add_blocks"));
+        let mut buffers = Vec::new();
+        let mut levels = Vec::new();
+        let mut bytes = 0;
+        let mut len = n;
+        let mut current: Option<wgpu::Buffer> = None;
+        loop {
+            let blocks = len.div_ceil(BLOCK).max(1);
+            let sums = storage_buffer(d, "scan sums", blocks * 4, wgpu::BufferUsages::empty());
+            let groups = groups_for(len);
+            let params = d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("scan params"),
+                size: 16,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            gpu.queue.write_buffer(&params, 0, bytemuck::cast_slice(&[len as u32, groups.0, 0, 0]));
+            let data_buf = current.as_ref().unwrap_or(data);
+            let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("scan level"),
+                layout: &layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: data_buf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: sums.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: params.as_entire_binding() },
+                ],
+            });
+            levels.push(Level { group, groups });
+            bytes += blocks * 4 + 16;
+            buffers.push(params);
+            if let Some(c) = current.take() {
+                buffers.push(c);
+            }
+            if blocks == 1 {
+                buffers.push(sums);
+                break;
+            }
+            current = Some(sums);
+            len = blocks;
+        }
+        Self { scan, add, levels, _buffers: buffers, bytes }
+    }
+
+    /// Records the scan: blocks of every level up, then totals added back down.
+    pub fn record(&self, pass: &mut wgpu::ComputePass<'_>) {
+        pass.set_pipeline(&self.scan);
+        for l in &self.levels {
+            pass.set_bind_group(0, &l.group, &[]);
+            pass.dispatch_workgroups(l.groups.0, l.groups.1, 1);
+        }
+        pass.set_pipeline(&self.add);
+        for l in self.levels.iter().rev().skip(1) {
+            pass.set_bind_group(0, &l.group, &[]);
+            pass.dispatch_workgroups(l.groups.0, l.groups.1, 1);
+        }
+    }
+}

@@ -1,0 +1,62 @@
+// S-buffer (Vasilakis & Fudos 2012): a counting pass, an exclusive prefix sum of the counts
+// (scan.wgsl, compute) that gives every pixel a contiguous range, then a capture pass that
+// writes each fragment into its pixel's range; the pool is allocated to exactly the counted
+// fragments. Resolve: common/sweep.wgsl. docs/methods.md ("sbuffer").
+//!include common/scene.wgsl
+//!include common/targets.wgsl
+//!include common/fullscreen.wgsl
+
+// Mirrors oit_core::gpu_types::PoolNode (the link is unused: ranges are contiguous).
+struct Node {
+    depth: f32,
+    next: u32,
+    rg: vec2<f32>,
+    ba: vec2<f32>,
+}
+// `heads` serves as each pixel's fill cursor (a copy of its range start).
+//!include common/pool.wgsl
+
+@group(2) @binding(6) var<storage, read_write> state: array<u32>;
+// Counts, then (scanned in place) range starts; entry W * H is the total.
+@group(2) @binding(7) var<storage, read_write> offsets: array<atomic<u32>>;
+
+@fragment
+fn fs_count(in: VsOut) {
+    if behind_opaque(in.clip) {
+        return;
+    }
+    atomicAdd(&offsets[pixel_index(in.clip)], 1u);
+}
+
+@fragment
+fn fs_capture(in: VsOut) {
+    if behind_opaque(in.clip) {
+        return;
+    }
+    let i = atomicAdd(&heads[pixel_index(in.clip)], 1u);
+    if i >= alloc.capacity {
+        return; // the scan's total says how many; the host grows the pool
+    }
+    store_node(i, Node(in.clip.z, 0u, in.color.rg, in.color.ba));
+}
+
+struct Cursor {
+    at: u32,
+    end: u32,
+}
+
+fn cursor_begin(px: u32) -> Cursor {
+    return Cursor(atomicLoad(&offsets[px]), atomicLoad(&offsets[px + 1u]));
+}
+
+fn cursor_more(c: Cursor) -> bool {
+    return c.at < c.end;
+}
+
+fn cursor_step(c: ptr<function, Cursor>) -> Frag {
+    let i = (*c).at;
+    let node = load_node(i);
+    (*c).at = i + 1u;
+    return Frag(node.depth, vec4<f32>(node.rg, node.ba), i);
+}
+//!include common/sweep.wgsl
