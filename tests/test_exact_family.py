@@ -61,3 +61,27 @@ def test_pall_allocates_a_conservative_bound(renderer):
     scene = build_scene(random_meshes(4, transparent=6, triangles=4))
     frame = renderer(32, 32).render(scene, IDENTITY, "pall")
     assert frame.stats["pool_nodes"] >= frame.stats["fragments"]
+
+
+@pytest.mark.parametrize("method", ["depth_peeling", "dual_depth_peeling"])
+def test_peeling_with_a_layer_limit_counts_what_it_left(renderer, method):
+    scene = build_scene([layer(z, (0.2 * i, 0.5, 1 - 0.2 * i, 0.4)) for i, z in enumerate((0.1, 0.3, 0.5, 0.7, 0.9))])
+    r = renderer(8, 8)
+    full = r.render(scene, IDENTITY, method)
+    assert full.stats["overflow_fragments"] == 0
+    limited = r.render(scene, IDENTITY, method, layers=2)
+    # Two layers of five peeled at every pixel (dual peels the nearest and the farthest).
+    assert limited.stats["overflow_fragments"] == 3 * 64
+    assert limited.stats["peeled_fragments"] == 2 * 64
+    assert not np.allclose(limited.image, full.image)
+
+
+def test_peeling_separates_coplanar_fragments(renderer):
+    # Three coplanar quads of different colors: a depth-only peel would merge or lose them;
+    # the (depth, triangle) key peels them one by one, in submission order.
+    meshes = [layer(0.5, (1, 0, 0, 0.5)), layer(0.5, (0, 1, 0, 0.5)), layer(0.5, (0, 0, 1, 0.5))]
+    r = renderer(4, 4)
+    for method in ("depth_peeling", "dual_depth_peeling"):
+        f = r.render(build_scene(meshes), IDENTITY, method, background=(0.0, 0.0, 0.0))
+        assert f.stats["overflow_fragments"] == 0
+        np.testing.assert_allclose(f.image[0, 0], [0.5, 0.25, 0.125, 0.875], atol=1e-6)

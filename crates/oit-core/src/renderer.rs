@@ -193,6 +193,7 @@ impl Renderer {
         let counts_raw = read_buffer(&gpu, &self.targets.counts_readback, self.width as u64 * self.height as u64 * 4)?;
         let depth_complexity: Vec<u32> = bytemuck::pod_collect_to_vec(&counts_raw);
         let max_depth_complexity = depth_complexity.iter().copied().max().unwrap_or(0);
+        let fragments: u64 = depth_complexity.iter().map(|&c| c as u64).sum();
 
         let limits = self.limits;
         let method = self.methods.entry(info.name).or_insert_with(|| info.instantiate(&gpu, &limits));
@@ -207,6 +208,7 @@ impl Renderer {
             timer: &mut self.timer,
             params: &params,
             max_depth_complexity,
+            fragments,
         };
         let report = method.render(&mut cx)?;
         let pass_times = self.timer.read(&gpu)?;
@@ -214,7 +216,7 @@ impl Renderer {
         let stats = Stats {
             method: info.name.to_string(),
             params,
-            fragments: depth_complexity.iter().map(|&c| c as u64).sum(),
+            fragments,
             max_depth_complexity,
             memory_bytes: report.memory_bytes,
             target_bytes: self.targets.bytes(),

@@ -23,6 +23,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("compact_abuffer.wgsl", include_str!("../../../shaders/compact_abuffer.wgsl")),
     ("sbuffer.wgsl", include_str!("../../../shaders/sbuffer.wgsl")),
     ("scan.wgsl", include_str!("../../../shaders/scan.wgsl")),
+    ("peel.wgsl", include_str!("../../../shaders/peel.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.
@@ -41,6 +42,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("WEIGHT", 10),
     Const::U32("NODES", 8),
     Const::U32("NODES_PLUS_ONE", 9),
+    Const::U32("DUAL", 1),
     Const::F32("CORE_SCALE", 2147483648.0),
     Const::F32("TAIL_SCALE", 16777216.0),
 ];

@@ -62,6 +62,23 @@ impl PassTimer {
         })
     }
 
+    /// Opens a span that several passes share (e.g. the passes of a peeling loop): pass the
+    /// slot to `span_compute` with `begin` on its first pass and `end` on its
+    /// last; the span's time includes the gaps between its passes.
+    pub fn span(&mut self, label: &'static str) -> Option<u32> {
+        self.slot(label)
+    }
+
+    pub fn span_compute(&self, slot: Option<u32>, begin: bool, end: bool) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        let (set, _, _) = self.queries.as_ref()?;
+        let i = slot?;
+        (begin || end).then_some(wgpu::ComputePassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: begin.then_some(2 * i),
+            end_of_pass_write_index: end.then_some(2 * i + 1),
+        })
+    }
+
     fn slot(&mut self, label: &'static str) -> Option<u32> {
         self.queries.as_ref()?;
         let i = self.labels.len() as u32;

@@ -6,6 +6,7 @@ mod adaptive;
 mod blend;
 mod compact_abuffer;
 mod pall;
+pub mod peel;
 mod sbuffer;
 pub(crate) mod lists;
 pub mod hybrid;
@@ -80,7 +81,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY
@@ -217,6 +218,8 @@ pub(crate) struct FrameCtx<'a> {
     pub params: &'a Params,
     /// Largest transparent fragment count of a pixel, from this frame's census.
     pub max_depth_complexity: u32,
+    /// Transparent fragments of the frame, from the census.
+    pub fragments: u64,
 }
 
 /// What a method reports about its frame, beyond what the renderer measures.
