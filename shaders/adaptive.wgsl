@@ -10,44 +10,16 @@
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
-// Mirrors oit_core::gpu_types::PrimNode.
-struct Node {
-    depth: f32,
-    next: u32,
-    rg: vec2<f32>,
-    ba: vec2<f32>,
-    prim: u32,
-    pad: u32,
-}
-//!include common/pool.wgsl
-
-@group(2) @binding(6) var<storage, read_write> state: array<u32>; // unused: one dispatch
-
-struct Frag {
-    prim: u32,
-    depth: f32,
-    alpha: f32,
-}
-
-fn frag_less(a: Frag, b: Frag) -> bool {
-    return a.prim < b.prim; // a triangle covers a pixel center at most once
-}
-//!include common/select.wgsl
-
-@fragment
-fn fs_capture(in: VsOut) {
-    if behind_opaque(in.clip) || in.color.a <= 0.0 {
-        return;
-    }
-    push_node(pixel_index(in.clip), Node(in.clip.z, 0u, in.color.rg, in.color.ba, in.prim, 0u));
-}
+//!include common/submission.wgsl
 
 // The visibility function: steps at depth[i] down to trans[i], sorted by depth.
 var<private> depth: array<f32, NODES_PLUS_ONE>;
 var<private> trans: array<f32, NODES_PLUS_ONE>;
 var<private> count: u32;
 
-fn insert(z: f32, a: f32) {
+fn visit(f: Frag) {
+    let z = f.depth;
+    let a = f.color.a;
     // After every node at the same or a smaller depth.
     var p = count;
     while p > 0u && depth[p - 1u] > z {
@@ -100,31 +72,8 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let base = base_at(pos);
     let head = atomicLoad(&heads[pixel_index(pos)]);
     count = 0u;
-    // 1. Submission order: each sweep takes the BATCH smallest primitive indices above the
-    //    last one taken.
-    var heap: array<Frag, BATCH>;
-    var last = 0u;
-    var have_last = false;
-    loop {
-        var n = 0u;
-        var i = head;
-        while i != NIL {
-            let node = load_node(i - 1u);
-            i = node.next;
-            if !have_last || node.prim > last {
-                n = heap_offer(&heap, n, Frag(node.prim, node.depth, node.ba.y));
-            }
-        }
-        heap_sort(&heap, n);
-        for (var b = 0u; b < n; b++) {
-            insert(heap[b].depth, heap[b].alpha);
-        }
-        if n < BATCH {
-            break;
-        }
-        last = heap[BATCH - 1u].prim;
-        have_last = true;
-    }
+    // 1. The visibility function, in submission order.
+    visit_in_submission_order(head);
     // 2. Composite every fragment by the approximate visibility.
     var accum = vec3<f32>(0.0);
     var i = head;

@@ -1,8 +1,15 @@
-// Plain over-blending in draw order (unsorted, sorted): the fixed-function blend does
-// C = a * c + (1 - a) * C and A = a + (1 - a) * A.
+// Fixed-function blend methods. Over (unsorted, sorted): C = a c + (1 - a) C; additive:
+// C = a c + C; filter (colored transmission, RTR 5.5): C = C (1 - a (1 - c)). Coverage
+// always blends as A = a + (1 - a) A.
 //!include common/scene.wgsl
 
 @fragment
 fn fs_blend(in: VsOut) -> @location(0) vec4<f32> {
     return in.color;
+}
+
+// Colored transmission: the fraction of each channel the surface lets through.
+@fragment
+fn fs_filter(in: VsOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(1.0 - in.color.a * (1.0 - in.color.rgb), in.color.a);
 }

@@ -163,4 +163,57 @@ def adaptive(z, rgb, alpha, bg, bg_a=0.0, nodes=8):
     return _out(c, trans[-1] if trans else 1.0, bg, bg_a)
 
 
-MODELS = {"abuffer": exact, "hybrid": hybrid, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit, "adaptive": adaptive}
+def additive(z, rgb, alpha, bg, bg_a=0.0):
+    """Additive blending (RTR 5.5): C = sum(alpha c) + background; coverage as over."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    color = (rgb * alpha[:, None]).sum(0) + np.asarray(bg, np.float64)
+    return np.append(color, 1.0 - np.prod(1 - alpha) * (1.0 - bg_a))
+
+
+def filter_(z, rgb, alpha, bg, bg_a=0.0):
+    """Colored transmission (RTR 5.5): the color behind times each 1 - alpha (1 - c)."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    t = np.prod(1.0 - alpha[:, None] * (1.0 - rgb), axis=0) if len(alpha) else np.ones(3)
+    return np.append(np.asarray(bg, np.float64) * t, 1.0 - np.prod(1 - alpha) * (1.0 - bg_a))
+
+
+BAYER4 = np.array([[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]])
+
+
+def screen_door(z, rgb, alpha, bg, bg_a=0.0, pixel=(0, 0)):
+    """Screen door: the nearest fragment whose alpha beats the pixel's 4 x 4 Bayer threshold
+    (pixel = (row, col)), opaque."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    threshold = (BAYER4[pixel[0] % 4, pixel[1] % 4] + 0.5) / 16.0
+    kept = np.flatnonzero(alpha > threshold)
+    if len(kept) == 0:
+        return np.append(np.asarray(bg, np.float64), bg_a)
+    return np.append(rgb[kept[np.argmin(z[kept])]], 1.0)
+
+
+def mlab(z, rgb, alpha, bg, bg_a=0.0, layers=4):
+    """Multi-layer alpha blending (Salvi & Vaidyanathan 2014) in submission order: insert
+    into depth-sorted blended layers, merge the two farthest with over on overflow."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    cs, ts, zs = [], [], []
+    for zi, ci, ai in zip(z, rgb, alpha):
+        p = len(zs)
+        while p > 0 and zs[p - 1] > zi:
+            p -= 1
+        cs.insert(p, ci * ai)
+        ts.insert(p, 1.0 - ai)
+        zs.insert(p, float(zi))
+        if len(zs) > layers:
+            k = layers - 1
+            cs[k] = cs[k] + ts[k] * cs[layers]
+            ts[k] = ts[k] * ts[layers]
+            del cs[layers], ts[layers], zs[layers]
+    c, t = np.zeros(3), 1.0
+    for ci, ti in zip(cs, ts):
+        c += t * ci
+        t *= ti
+    return _out(c, t, bg, bg_a)
+
+
+MODELS = {"abuffer": exact, "hybrid": hybrid, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit, "adaptive": adaptive,
+          "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab}

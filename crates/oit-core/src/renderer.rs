@@ -209,6 +209,7 @@ impl Renderer {
             params: &params,
             max_depth_complexity,
             fragments,
+            frame_uniform: &self.shared.uniform,
         };
         let report = method.render(&mut cx)?;
         let pass_times = self.timer.read(&gpu)?;

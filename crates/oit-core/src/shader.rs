@@ -11,6 +11,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/select.wgsl", include_str!("../../../shaders/common/select.wgsl")),
     ("common/sweep.wgsl", include_str!("../../../shaders/common/sweep.wgsl")),
     ("common/setup.wgsl", include_str!("../../../shaders/common/setup.wgsl")),
+    ("common/submission.wgsl", include_str!("../../../shaders/common/submission.wgsl")),
     ("opaque.wgsl", include_str!("../../../shaders/opaque.wgsl")),
     ("census.wgsl", include_str!("../../../shaders/census.wgsl")),
     ("blend.wgsl", include_str!("../../../shaders/blend.wgsl")),
@@ -24,6 +25,9 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("sbuffer.wgsl", include_str!("../../../shaders/sbuffer.wgsl")),
     ("scan.wgsl", include_str!("../../../shaders/scan.wgsl")),
     ("peel.wgsl", include_str!("../../../shaders/peel.wgsl")),
+    ("screen_door.wgsl", include_str!("../../../shaders/screen_door.wgsl")),
+    ("stochastic.wgsl", include_str!("../../../shaders/stochastic.wgsl")),
+    ("mlab.wgsl", include_str!("../../../shaders/mlab.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.
@@ -43,6 +47,9 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("NODES", 8),
     Const::U32("NODES_PLUS_ONE", 9),
     Const::U32("DUAL", 1),
+    Const::U32("SAMPLES", 8),
+    Const::U32("LAYERS", 4),
+    Const::U32("LAYERS_PLUS_ONE", 5),
     Const::F32("CORE_SCALE", 2147483648.0),
     Const::F32("TAIL_SCALE", 16777216.0),
 ];

@@ -17,6 +17,7 @@ pub struct Targets {
     pub height: u32,
     pub base: wgpu::TextureView,
     pub depth: wgpu::TextureView,
+    pub depth_texture: wgpu::Texture,
     pub out_texture: wgpu::Texture,
     pub out: wgpu::TextureView,
     pub base_texture: wgpu::Texture,
@@ -28,7 +29,7 @@ pub struct Targets {
     pub counts_readback: wgpu::Buffer,
 }
 
-fn texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages) -> wgpu::Texture {
+pub fn texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
@@ -66,7 +67,7 @@ impl Targets {
         let d = &gpu.device;
         use wgpu::TextureUsages as U;
         let base_texture = texture(d, "base", width, height, COLOR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
-        let depth_texture = texture(d, "depth", width, height, DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING);
+        let depth_texture = texture(d, "depth", width, height, DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
         let out_texture = texture(
             d,
             "out",
@@ -103,7 +104,7 @@ impl Targets {
         };
         let image_readback = readback("image readback", padded_row(width, 16) as u64 * height as u64);
         let counts_readback = readback("counts readback", pixels * 4);
-        Self { width, height, base, depth, out_texture, out, base_texture, group, counts, counts_group, image_readback, counts_readback }
+        Self { width, height, base, depth, depth_texture, out_texture, out, base_texture, group, counts, counts_group, image_readback, counts_readback }
     }
 
     /// Bytes of the shared targets (base, depth, out, census counts), not counted per method.

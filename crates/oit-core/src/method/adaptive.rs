@@ -32,20 +32,27 @@ pub const INFO: MethodInfo = MethodInfo {
 
 struct Adaptive(ListMethod);
 
+/// Refuses a frame whose deepest pixel the one-invocation replay of a submission-order
+/// method (adaptive, mlab) could not finish on llvmpipe: (n / BATCH + 1) heap sweeps of the
+/// list, then `per_fragment` loop iterations for each fragment.
+pub(crate) fn check_replay_budget(cx: &FrameCtx<'_>, method: &str, param: &str, value: u32, per_fragment: u64) -> Result<()> {
+    let n = cx.max_depth_complexity as u64;
+    let iterations = (n / BATCH as u64 + 1) * n * 6 + n * per_fragment;
+    if loop_limited(cx.gpu) && iterations > LLVMPIPE_LOOP_LIMIT {
+        return Err(OitError::Unsupported(format!(
+            "{method} with {param} = {value} on a pixel with {n} fragments needs about {iterations} loop iterations in one \
+             shader invocation, and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: use a hardware adapter, \
+             a smaller {param} or fewer layers"
+        )));
+    }
+    Ok(())
+}
+
 impl Method for Adaptive {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let nodes = cx.params.int("nodes") as u32;
-        let n = cx.max_depth_complexity as u64;
-        // One invocation does all of a pixel's work: (n / BATCH + 1) heap sweeps of the list,
-        // then n insertions and n lookups of up to `nodes` steps each.
-        let iterations = (n / BATCH as u64 + 1) * n * 6 + n * 4 * nodes as u64;
-        if loop_limited(cx.gpu) && iterations > LLVMPIPE_LOOP_LIMIT {
-            return Err(OitError::Unsupported(format!(
-                "adaptive with nodes = {nodes} on a pixel with {n} fragments needs about {iterations} loop iterations in one \
-                 shader invocation, and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: use a hardware adapter, \
-                 fewer nodes or layers"
-            )));
-        }
+        // Per fragment: an insertion and a lookup of up to `nodes` steps each.
+        check_replay_budget(cx, "adaptive", "nodes", nodes, 4 * nodes as u64)?;
         self.0.set_consts(vec![Const::U32("NODES", nodes), Const::U32("NODES_PLUS_ONE", nodes + 1)]);
         self.0.render(cx)
     }

@@ -14,7 +14,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["blend"],
     params: &[],
-    create: |_, _| Box::new(Blend::new(false)),
+    create: |_, _| Box::new(Blend::new(Kind::Unsorted)),
 };
 
 pub const SORTED: MethodInfo = MethodInfo {
@@ -24,58 +24,94 @@ pub const SORTED: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["sort meshes (CPU)", "blend"],
     params: &[],
-    create: |_, _| Box::new(Blend::new(true)),
+    create: |_, _| Box::new(Blend::new(Kind::Sorted)),
 };
 
-/// Over operator with straight alpha; alpha accumulates coverage a + (1 - a) * A.
-const OVER: wgpu::BlendState = wgpu::BlendState {
-    color: wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::SrcAlpha,
-        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-        operation: wgpu::BlendOperation::Add,
-    },
-    alpha: wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-        operation: wgpu::BlendOperation::Add,
-    },
+pub const ADDITIVE: MethodInfo = MethodInfo {
+    name: "additive",
+    summary: "additive blending (RTR 5.5): C = sum(alpha c) + background; brightens, never attenuates",
+    exact: false,
+    bounded_memory: true,
+    passes: &["blend"],
+    params: &[],
+    create: |_, _| Box::new(Blend::new(Kind::Additive)),
 };
+
+pub const FILTER: MethodInfo = MethodInfo {
+    name: "filter",
+    summary: "colored transmission (RTR 5.5): the scene behind multiplied by each surface's 1 - alpha (1 - c)",
+    exact: false,
+    bounded_memory: true,
+    passes: &["blend"],
+    params: &[],
+    create: |_, _| Box::new(Blend::new(Kind::Filter)),
+};
+
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Unsorted,
+    Sorted,
+    Additive,
+    Filter,
+}
+
+const fn component(src_factor: wgpu::BlendFactor, dst_factor: wgpu::BlendFactor) -> wgpu::BlendComponent {
+    wgpu::BlendComponent { src_factor, dst_factor, operation: wgpu::BlendOperation::Add }
+}
+
+/// Coverage accumulates as a + (1 - a) * A for every blend method.
+const COVERAGE: wgpu::BlendComponent = component(wgpu::BlendFactor::One, wgpu::BlendFactor::OneMinusSrcAlpha);
+
+impl Kind {
+    fn blend(self) -> wgpu::BlendState {
+        use wgpu::BlendFactor as F;
+        let color = match self {
+            Kind::Unsorted | Kind::Sorted => component(F::SrcAlpha, F::OneMinusSrcAlpha),
+            Kind::Additive => component(F::SrcAlpha, F::One),
+            Kind::Filter => component(F::Zero, F::Src),
+        };
+        wgpu::BlendState { color, alpha: COVERAGE }
+    }
+
+    fn entry(self) -> &'static str {
+        if self == Kind::Filter { "fs_filter" } else { "fs_blend" }
+    }
+}
 
 struct Blend {
-    sort: bool,
+    kind: Kind,
     pipeline: Option<wgpu::RenderPipeline>,
 }
 
 impl Blend {
-    fn new(sort: bool) -> Self {
-        Self { sort, pipeline: None }
+    fn new(kind: Kind) -> Self {
+        Self { kind, pipeline: None }
     }
 }
 
-/// Builds the blend pipeline; shared with the floor measurement of the benchmark.
-pub(crate) fn blend_pipeline(cx: &FrameCtx<'_>) -> Result<wgpu::RenderPipeline> {
+fn blend_pipeline(cx: &FrameCtx<'_>, kind: Kind) -> Result<wgpu::RenderPipeline> {
     if !cx.gpu.has(wgpu::Features::FLOAT32_BLENDABLE) {
         return Err(OitError::Unsupported(format!(
             "adapter '{}' cannot blend into RGBA32F targets (feature FLOAT32_BLENDABLE), which the blend \
-             methods (unsorted, sorted) need; the exact and storage-based methods still work",
+             methods (unsorted, sorted, additive, filter) need; the exact and storage-based methods still work",
             cx.gpu.info.name
         )));
     }
     let d = &cx.gpu.device;
     let module = shader::module(d, "blend.wgsl", &[]);
     let layout = pipeline::layout(d, &[cx.scene_layout]);
-    let target = wgpu::ColorTargetState { format: COLOR_FORMAT, blend: Some(OVER), write_mask: wgpu::ColorWrites::ALL };
-    Ok(pipeline::geometry(d, "blend", &module, &layout, "fs_blend", &[Some(target)], pipeline::depth_test_only()))
+    let target = wgpu::ColorTargetState { format: COLOR_FORMAT, blend: Some(kind.blend()), write_mask: wgpu::ColorWrites::ALL };
+    Ok(pipeline::geometry(d, "blend", &module, &layout, kind.entry(), &[Some(target)], pipeline::depth_test_only()))
 }
 
 impl Method for Blend {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         if self.pipeline.is_none() {
-            self.pipeline = Some(blend_pipeline(cx)?);
+            self.pipeline = Some(blend_pipeline(cx, self.kind)?);
         }
         let geo = &cx.scene.transparent;
         let mut order: Vec<usize> = (0..geo.meshes.len()).collect();
-        if self.sort {
+        if self.kind == Kind::Sorted {
             let vp = cx.camera.matrix_f32();
             // Far to near: larger NDC depth first; meshes behind the eye (w <= 0) go first.
             let key = |i: usize| {

@@ -3,11 +3,14 @@
 
 mod abuffer;
 mod adaptive;
+mod mlab;
 mod blend;
 mod compact_abuffer;
 mod pall;
 pub mod peel;
 mod sbuffer;
+mod screen_door;
+mod stochastic;
 pub(crate) mod lists;
 pub mod hybrid;
 pub mod weighted;
@@ -81,7 +84,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, blend::ADDITIVE, blend::FILTER, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING, screen_door::INFO, stochastic::INFO, mlab::INFO];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY
@@ -220,6 +223,8 @@ pub(crate) struct FrameCtx<'a> {
     pub max_depth_complexity: u32,
     /// Transparent fragments of the frame, from the census.
     pub fragments: u64,
+    /// The frame uniform (`gpu_types::FrameUniform`), for methods that set its `seed`.
+    pub frame_uniform: &'a wgpu::Buffer,
 }
 
 /// What a method reports about its frame, beyond what the renderer measures.

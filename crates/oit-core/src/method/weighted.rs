@@ -50,22 +50,22 @@ pub const WBOIT: MethodInfo = MethodInfo {
     create: |_, _| Box::new(Weighted::new(Kind::Blended)),
 };
 
-const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-const AUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+pub(crate) const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+pub(crate) const AUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// Bytes the weighted methods allocate: an RGBA32F and an R32F target.
 pub fn memory_bytes(pixels: u64) -> u64 {
     pixels * (16 + 4)
 }
 
-const ADD: wgpu::BlendComponent = wgpu::BlendComponent {
+pub(crate) const ADD: wgpu::BlendComponent = wgpu::BlendComponent {
     src_factor: wgpu::BlendFactor::One,
     dst_factor: wgpu::BlendFactor::One,
     operation: wgpu::BlendOperation::Add,
 };
 
 /// dst * (1 - src): revealage, the product of (1 - alpha).
-const REVEAL: wgpu::BlendComponent = wgpu::BlendComponent {
+pub(crate) const REVEAL: wgpu::BlendComponent = wgpu::BlendComponent {
     src_factor: wgpu::BlendFactor::Zero,
     dst_factor: wgpu::BlendFactor::OneMinusSrc,
     operation: wgpu::BlendOperation::Add,
@@ -152,7 +152,7 @@ impl Weighted {
     }
 }
 
-fn target(device: &wgpu::Device, size: (u32, u32), format: wgpu::TextureFormat) -> wgpu::TextureView {
+pub(crate) fn target(device: &wgpu::Device, size: (u32, u32), format: wgpu::TextureFormat) -> wgpu::TextureView {
     device
         .create_texture(&wgpu::TextureDescriptor {
             label: Some("weighted accumulation"),

@@ -1,0 +1,43 @@
+//! `mlab`: multi-layer alpha blending (Salvi & Vaidyanathan 2014), replayed in submission
+//! order over captured lists because WebGPU has no pixel synchronization; memory is that of
+//! the lists, unbounded (shaders/mlab.wgsl).
+
+use super::adaptive::check_replay_budget;
+use super::lists::{Aux, ListLayout, ListMethod};
+use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
+use crate::error::Result;
+use crate::gpu_types::PrimNode;
+use crate::shader::Const;
+
+pub const INFO: MethodInfo = MethodInfo {
+    name: "mlab",
+    summary: "multi-layer alpha blending: `layers` depth-sorted blended layers, the farthest two merged on overflow",
+    exact: false,
+    bounded_memory: false,
+    passes: &["capture (geometry)", "replay in submission order and composite (full screen)"],
+    params: &[ParamInfo {
+        name: "layers",
+        kind: ParamKind::Int { min: 1, max: 32, default: 4 },
+        doc: "blended layers kept per pixel",
+    }],
+    create: |gpu, limits| {
+        Box::new(Mlab(ListMethod::new(gpu, limits, ListLayout {
+            shader: "mlab.wgsl",
+            node_bytes: std::mem::size_of::<PrimNode>() as u64,
+            state_words: 0,
+            aux: Aux::None,
+        })))
+    },
+};
+
+struct Mlab(ListMethod);
+
+impl Method for Mlab {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+        let layers = cx.params.int("layers") as u32;
+        // Per fragment: an insertion shifting up to `layers` entries.
+        check_replay_budget(cx, "mlab", "layers", layers, layers as u64 + 2)?;
+        self.0.set_consts(vec![Const::U32("LAYERS", layers), Const::U32("LAYERS_PLUS_ONE", layers + 1)]);
+        self.0.render(cx)
+    }
+}

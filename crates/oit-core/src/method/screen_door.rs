@@ -1,0 +1,81 @@
+//! `screen_door`: screen-door transparency (RTR 5.5) with a 4 x 4 ordered dither: one
+//! geometry pass that draws the nearest fragment whose alpha beats its pixel's threshold,
+//! opaque (shaders/screen_door.wgsl).
+
+use super::{FrameCtx, Method, MethodInfo, MethodReport};
+use crate::error::Result;
+use crate::pipeline;
+use crate::shader;
+use crate::targets::{texture, COLOR_FORMAT, DEPTH_FORMAT};
+
+pub const INFO: MethodInfo = MethodInfo {
+    name: "screen_door",
+    summary: "screen-door transparency: a 4x4 ordered-dither mask of alpha, nearest survivor drawn opaque",
+    exact: false,
+    bounded_memory: true,
+    passes: &["dithered geometry (depth test and write)"],
+    params: &[],
+    create: |_, _| Box::new(ScreenDoor { pipeline: None, depth: None }),
+};
+
+/// Bytes screen_door allocates: its own depth buffer.
+pub fn memory_bytes(pixels: u64) -> u64 {
+    pixels * 4
+}
+
+struct ScreenDoor {
+    pipeline: Option<wgpu::RenderPipeline>,
+    depth: Option<((u32, u32), wgpu::Texture, wgpu::TextureView)>,
+}
+
+impl Method for ScreenDoor {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+        let d = &cx.gpu.device;
+        let t = cx.targets;
+        if self.pipeline.is_none() {
+            let module = shader::module(d, "screen_door.wgsl", &[]);
+            let depth = wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            };
+            let layout = pipeline::layout(d, &[cx.scene_layout]);
+            self.pipeline = Some(pipeline::geometry(d, "screen door", &module, &layout, "fs_door", &[Some(COLOR_FORMAT.into())], Some(depth)));
+        }
+        let size = (t.width, t.height);
+        if self.depth.as_ref().is_none_or(|(s, _, _)| *s != size) {
+            let tex = texture(d, "screen door depth", size.0, size.1, DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST);
+            let view = tex.create_view(&Default::default());
+            self.depth = Some((size, tex, view));
+        }
+        let (_, depth_tex, depth_view) = self.depth.as_ref().expect("made above");
+        let mut enc = d.create_command_encoder(&Default::default());
+        enc.copy_texture_to_texture(t.base_texture.as_image_copy(), t.out_texture.as_image_copy(), t.out_texture.size());
+        enc.copy_texture_to_texture(t.depth_texture.as_image_copy(), depth_tex.as_image_copy(), depth_tex.size());
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("screen door"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &t.out,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: depth_view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: cx.timer.render_pass("dither"),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(self.pipeline.as_ref().expect("built above"));
+            cx.scene.transparent.draw_all(&mut pass);
+        }
+        cx.gpu.queue.submit([enc.finish()]);
+        Ok(MethodReport { memory_bytes: memory_bytes(size.0 as u64 * size.1 as u64), ..Default::default() })
+    }
+}
