@@ -1,4 +1,5 @@
-"""The survey's approximate methods (issue 4): additive, filter, screen_door and mlab
+"""The survey's approximate methods (issue 4): additive, filter, screen_door, mlab and
+bucket_peeling
 against their CPU models (oit.models) on per-pixel stacks; stochastic transparency is
 deterministic for a seed and its error falls as samples rise."""
 
@@ -29,6 +30,7 @@ def model_image(built, method, **params):
 @pytest.mark.parametrize("method,params,tol", [
     ("additive", {}, 1e-5), ("filter", {}, 2e-6), ("screen_door", {}, 6e-8),
     ("mlab", {"layers": 1}, 2e-6), ("mlab", {"layers": 4}, 2e-6), ("mlab", {"layers": 32}, 2e-6),
+    ("bucket_peeling", {"buckets": 8}, 2e-6), ("bucket_peeling", {"buckets": 32}, 2e-6),
 ])
 @pytest.mark.parametrize("alphas", ["random", "worst"])
 def test_gpu_matches_model(renderer, method, params, tol, alphas):
@@ -68,3 +70,10 @@ def test_stochastic_error_falls_as_samples_rise(renderer):
     # The estimate's noise falls about as 1/sqrt(samples): each 4x step should at least
     # take off a quarter of the error (measured: about half).
     assert errors[1] < 0.75 * errors[0] and errors[2] < 0.75 * errors[1], errors
+
+
+def test_bucket_peeling_counts_what_it_drops(renderer):
+    built = stacks(layers=40, alphas="random", size=SIZE, seed=3)
+    frame = renderer(*SIZE).render(built.scene, built.camera, "bucket_peeling", buckets=8)
+    # At most 8 of 40 fragments survive per pixel.
+    assert frame.stats["overflow_fragments"] >= 32 * SIZE[0] * SIZE[1]

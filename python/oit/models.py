@@ -215,5 +215,29 @@ def mlab(z, rgb, alpha, bg, bg_a=0.0, layers=4):
     return _out(c, t, bg, bg_a)
 
 
+def bucket_peeling(z, rgb, alpha, bg, bg_a=0.0, buckets=32):
+    """Bucket depth peeling: the pixel's depth range split into equal buckets (float32, as
+    the shader), the nearest fragment of each bucket (ties: earlier submission) composited
+    front to back, the others dropped. Alpha-0 fragments take part, as on the GPU."""
+    z = np.asarray(z, np.float32)
+    rgb, alpha = np.asarray(rgb, np.float64).reshape(-1, 3), np.asarray(alpha, np.float64)
+    if len(z) == 0:
+        return _out(np.zeros(3), 1.0, bg, bg_a)
+    lo, hi = z.min(), z.max()
+    if hi <= lo:
+        index = np.zeros(len(z), np.int64)
+    else:
+        index = np.minimum(((z - lo) / (hi - lo) * np.float32(buckets)).astype(np.int64), buckets - 1)
+    c, t = np.zeros(3), 1.0
+    for b in range(buckets):
+        members = np.flatnonzero(index == b)
+        if len(members):
+            i = members[np.lexsort((members, z[members]))[0]]
+            c += t * alpha[i] * rgb[i]
+            t *= 1.0 - alpha[i]
+    return _out(c, t, bg, bg_a)
+
+
 MODELS = {"abuffer": exact, "hybrid": hybrid, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit, "adaptive": adaptive,
-          "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab}
+          "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab,
+          "bucket_peeling": bucket_peeling}

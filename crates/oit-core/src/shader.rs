@@ -28,6 +28,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("screen_door.wgsl", include_str!("../../../shaders/screen_door.wgsl")),
     ("stochastic.wgsl", include_str!("../../../shaders/stochastic.wgsl")),
     ("mlab.wgsl", include_str!("../../../shaders/mlab.wgsl")),
+    ("bucket_peeling.wgsl", include_str!("../../../shaders/bucket_peeling.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.
@@ -50,6 +51,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("SAMPLES", 8),
     Const::U32("LAYERS", 4),
     Const::U32("LAYERS_PLUS_ONE", 5),
+    Const::U32("BUCKETS", 32),
     Const::F32("CORE_SCALE", 2147483648.0),
     Const::F32("TAIL_SCALE", 16777216.0),
 ];

@@ -5,6 +5,7 @@ mod abuffer;
 mod adaptive;
 mod mlab;
 mod blend;
+mod bucket_peeling;
 mod compact_abuffer;
 mod pall;
 pub mod peel;
@@ -84,7 +85,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, blend::ADDITIVE, blend::FILTER, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING, screen_door::INFO, stochastic::INFO, mlab::INFO];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, blend::ADDITIVE, blend::FILTER, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING, screen_door::INFO, stochastic::INFO, mlab::INFO, bucket_peeling::INFO];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY
