@@ -155,8 +155,11 @@ def test_weighted_methods_with_all_alpha_zero_give_the_background(renderer, iden
         assert (f.image[..., 3] == 0).all(), method
 
 
-@pytest.mark.parametrize("method,params", [("hybrid", {"k": 1}), ("hybrid", {"k": 8}), ("ktab", {"k": 32}),
-                                           ("wavg", {}), ("wsum", {}), ("wboit", {}), ("unsorted", {})])
+@pytest.mark.parametrize("method,params", [
+    ("hybrid", {"k": 1}), ("hybrid", {"k": 8}), ("ktab", {"k": 32}), ("wavg", {}), ("wsum", {}), ("wboit", {}),
+    ("unsorted", {}), ("additive", {}), ("filter", {}), ("depth_peeling", {}), ("dual_depth_peeling", {"layers": 2}),
+    ("bucket_peeling", {"buckets": 4}), ("stochastic", {"samples": 16}), ("screen_door", {}),
+])
 def test_bounded_memory_follows_the_formula(renderer, method, params):
     scene, camera = random_scene(2)
     f = renderer(24, 16).render(scene, camera, method, **params)
@@ -171,3 +174,8 @@ def test_wboit_weight_choice(renderer):
     assert not np.array_equal(a, b)
     with pytest.raises(ValueError, match="eq10"):
         r.render(scene, camera, "wboit", weight="eq11")
+
+
+def test_every_bounded_method_has_a_memory_formula():
+    missing = [m["name"] for m in oit.methods() if m["bounded_memory"] and memory_bytes(m["name"], 4, 4) is None]
+    assert not missing

@@ -17,6 +17,14 @@ def memory_bytes(method: str, width: int, height: int, **params) -> int | None:
         return pixels * (2 * k + HYBRID_ACCUM_WORDS) * 4 + 4  # k-TAB, visibility, accumulators, counter
     if method in ("wavg", "wsum", "wboit"):
         return pixels * (16 + 4)  # RGBA32F accumulation and an R32F count or revealage
-    if method in ("unsorted", "sorted"):
+    if method in ("unsorted", "sorted", "additive", "filter"):
         return 0  # blends into the shared output target
+    if method in ("depth_peeling", "dual_depth_peeling"):
+        return pixels * (4 * 8 + 2 * 16 + 9 * 4) + 4  # four 64-bit keys, two layers, accumulators
+    if method == "bucket_peeling":
+        return pixels * (8 + int(params.get("buckets", 32)) * (8 + 16)) + 4  # bounds; key and color a bucket
+    if method == "stochastic":
+        return pixels * (4 * int(params.get("samples", 8)) + 16 + 4)  # sample depths, two float targets
+    if method == "screen_door":
+        return pixels * 4  # its own depth buffer
     return None
