@@ -24,6 +24,7 @@ BG = np.array([0.2, 0.4, 0.6])
 # - wsum is unbounded (sums reach n): float32 relative error 100 * 2^-24 of values up to 50.
 CASES = [
     ("hybrid", {"k": 1}, 2e-6), ("hybrid", {"k": 4}, 2e-6), ("hybrid", {"k": 16}, 2e-6),
+    ("hybrid64", {"k": 1}, 2e-6), ("hybrid64", {"k": 4}, 2e-6), ("hybrid64", {"k": 16}, 2e-6),
     ("ktab", {"k": 4}, 2e-6), ("wavg", {}, 2e-6), ("wboit", {}, 2e-6),
     ("adaptive", {"nodes": 4}, 2e-6), ("adaptive", {"nodes": 8}, 2e-6), ("wsum", {}, 5e-5),
 ]
@@ -157,6 +158,7 @@ def test_weighted_methods_with_all_alpha_zero_give_the_background(renderer, iden
 
 @pytest.mark.parametrize("method,params", [
     ("hybrid", {"k": 1}), ("hybrid", {"k": 8}), ("ktab", {"k": 32}), ("wavg", {}), ("wsum", {}), ("wboit", {}),
+    ("hybrid64", {"k": 8}),
     ("unsorted", {}), ("additive", {}), ("filter", {}), ("depth_peeling", {}), ("dual_depth_peeling", {"layers": 2}),
     ("bucket_peeling", {"buckets": 4}), ("stochastic", {"samples": 16}), ("screen_door", {}),
 ])
@@ -179,3 +181,24 @@ def test_wboit_weight_choice(renderer):
 def test_every_bounded_method_has_a_memory_formula():
     missing = [m["name"] for m in oit.methods() if m["bounded_memory"] and memory_bytes(m["name"], 4, 4) is None]
     assert not missing
+
+
+def test_hybrid64_with_k_at_depth_complexity_is_within_its_quantization(renderer):
+    scene, camera = random_scene(13)
+    r = renderer(32, 32)
+    exact = r.render(scene, camera, "abuffer", background=tuple(BG))
+    k = int(exact.stats["max_depth_complexity"])
+    h = r.render(scene, camera, "hybrid64", background=tuple(BG), k=k)
+    assert h.stats["overflow_fragments"] == 0
+    dc = exact.depth_complexity
+    # 8-bit alpha as in hybrid, plus colors quantized to 11/11/10 bits (<= 1/2046 a channel).
+    bound = (dc * (dc + 1) / 2 + dc) / 510 + 1 / 2046 + 1e-6
+    assert (np.abs(h.image - exact.image).max(-1) <= bound).all()
+
+
+def test_hybrid64_is_order_independent(renderer, identity_camera):
+    layers = [(0.1 * (i + 1), (0.1 * i, 0.5, 1 - 0.1 * i, 0.3)) for i in range(9)]
+    r = renderer(4, 4)
+    a = r.render(quads(layers), identity_camera, "hybrid64", k=3).image
+    b = r.render(quads(layers[::-1]), identity_camera, "hybrid64", k=3).image
+    assert np.array_equal(a, b)

@@ -15,6 +15,8 @@ def memory_bytes(method: str, width: int, height: int, **params) -> int | None:
     if method in ("hybrid", "ktab"):
         k = int(params.get("k", 8))
         return pixels * (2 * k + HYBRID_ACCUM_WORDS) * 4 + 4  # k-TAB, visibility, accumulators, counter
+    if method == "hybrid64":
+        return pixels * (8 * int(params.get("k", 8)) + 9 * 4) + 4  # 64-bit k-TAB, tail sums, counter
     if method in ("wavg", "wsum", "wboit"):
         return pixels * (16 + 4)  # RGBA32F accumulation and an R32F count or revealage
     if method in ("unsorted", "sorted", "additive", "filter"):

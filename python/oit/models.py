@@ -80,6 +80,45 @@ def hybrid(z, rgb, alpha, bg, bg_a=0.0, k=8, tail=True):
     return _out(core + t_core * tail_c, t_core * t_tail, bg, bg_a)
 
 
+def hybrid64_words(z, rgb, alpha):
+    """hybrid64's words before inversion: 24-bit depth, 8-bit alpha, R11G11B10 color."""
+    d = np.minimum((np.asarray(z, np.float32) * np.float32(16777215.0)).astype(np.uint64), DEPTH_MAX)
+    a = np.round(np.clip(np.asarray(alpha, np.float32), 0, 1) * np.float32(255.0)).astype(np.uint64)
+    q = np.round(np.clip(np.asarray(rgb, np.float32), 0, 1) * np.float32([2047.0, 2047.0, 1023.0])).astype(np.uint64)
+    color = (q[:, 0] << np.uint64(21)) | (q[:, 1] << np.uint64(10)) | q[:, 2]
+    return (((d << np.uint64(8)) | a) << np.uint64(32)) | color
+
+
+def _unpack64(word):
+    word = int(word)
+    rgb, a = word & 0xFFFFFFFF, (word >> 32) & 0xFF
+    return np.array([(rgb >> 21) / 2047.0, ((rgb >> 10) & 0x7FF) / 2047.0, (rgb & 0x3FF) / 1023.0]), a / 255.0
+
+
+def hybrid64(z, rgb, alpha, bg, bg_a=0.0, k=8):
+    """Single-pass hybrid: the k nearest words (by depth, alpha, color) composited from their
+    quantized content, every other word's quantized content to the weighted-average tail."""
+    z, rgb, alpha = _visible(z, rgb, alpha)
+    words = np.sort(hybrid64_words(z, rgb, alpha))
+    core, t = np.zeros(3), 1.0
+    for w in words[:k]:
+        c, a = _unpack64(w)
+        core += t * a * c
+        t *= 1.0 - a
+    sum_c, sum_a, n = np.zeros(3), 0.0, 0
+    for w in words[k:]:
+        c, a = _unpack64(w)
+        sum_c += c * a
+        sum_a += a
+        n += 1
+    tail_c, t_tail = np.zeros(3), 1.0
+    if n and sum_a > 0:
+        a_avg = min(sum_a / n, 1.0)
+        t_tail = 0.0 if a_avg >= 1.0 else (1.0 - a_avg) ** n
+        tail_c = sum_c / sum_a * (1.0 - t_tail)
+    return _out(core + t * tail_c, t * t_tail, bg, bg_a)
+
+
 def ktab(z, rgb, alpha, bg, bg_a=0.0, k=8):
     return hybrid(z, rgb, alpha, bg, bg_a, k=k, tail=False)
 
@@ -238,6 +277,6 @@ def bucket_peeling(z, rgb, alpha, bg, bg_a=0.0, buckets=32):
     return _out(c, t, bg, bg_a)
 
 
-MODELS = {"abuffer": exact, "hybrid": hybrid, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit, "adaptive": adaptive,
+MODELS = {"abuffer": exact, "hybrid": hybrid, "hybrid64": hybrid64, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit, "adaptive": adaptive,
           "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab,
           "bucket_peeling": bucket_peeling}

@@ -24,6 +24,7 @@ fn wanted_features() -> wgpu::Features {
         | wgpu::Features::FLOAT32_BLENDABLE
         | wgpu::Features::SHADER_INT64
         | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
+        | wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS
 }
 
 fn adapter_rank(info: &wgpu::AdapterInfo) -> u32 {

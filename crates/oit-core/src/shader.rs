@@ -29,6 +29,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("stochastic.wgsl", include_str!("../../../shaders/stochastic.wgsl")),
     ("mlab.wgsl", include_str!("../../../shaders/mlab.wgsl")),
     ("bucket_peeling.wgsl", include_str!("../../../shaders/bucket_peeling.wgsl")),
+    ("hybrid64.wgsl", include_str!("../../../shaders/hybrid64.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.

@@ -14,6 +14,7 @@ mod screen_door;
 mod stochastic;
 pub(crate) mod lists;
 pub mod hybrid;
+mod hybrid64;
 pub mod weighted;
 
 use std::collections::BTreeMap;
@@ -85,7 +86,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, blend::ADDITIVE, blend::FILTER, hybrid::HYBRID, hybrid::KTAB, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING, screen_door::INFO, stochastic::INFO, mlab::INFO, bucket_peeling::INFO];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, blend::ADDITIVE, blend::FILTER, hybrid::HYBRID, hybrid::KTAB, hybrid64::INFO, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING, screen_door::INFO, stochastic::INFO, mlab::INFO, bucket_peeling::INFO];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY

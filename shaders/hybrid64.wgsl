@@ -1,0 +1,111 @@
+// Single-pass hybrid transparency with 64-bit atomics (the future work of Maule et al.
+// 2013): each k-TAB slot is one 64-bit word holding the whole fragment — 24-bit depth,
+// 8-bit alpha and the shaded color as R11G11B10 unorm — inverted so that a cleared slot is
+// empty and atomicMax keeps the nearest. The atomic bubble (atomicMax returning the old
+// word: SHADER_INT64_ATOMIC_ALL_OPS) inserts a fragment; the word that falls off the last
+// slot is added to the tail sums (fixed point, as in hybrid.wgsl) in the same pass. The
+// resolve composites the sorted core exactly from the words, then the tail (eqs. 7-11).
+// docs/methods.md ("hybrid64").
+//!include common/scene.wgsl
+//!include common/targets.wgsl
+//!include common/fullscreen.wgsl
+
+// Per-pixel accumulator words (mirrors oit_core::method::hybrid64::ACCUM_WORDS).
+const TAIL_R: u32 = 0u;      // 8 words: tail C * alpha (rgb) and alpha, (lo, hi) pairs
+const TAIL_COUNT: u32 = 8u;
+const ACCUM_WORDS: u32 = 9u;
+
+@group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u64>>;
+@group(2) @binding(1) var<storage, read_write> accum: array<atomic<u32>>;
+@group(2) @binding(2) var<storage, read_write> overflow: atomic<u32>;
+//!include common/fixed.wgsl
+
+fn pack_word(z: f32, c: vec4<f32>) -> u64 {
+    let d = min(u32(z * 16777215.0), 0xfffffeu);
+    let a = u32(round(clamp(c.a, 0.0, 1.0) * 255.0));
+    let q = vec3<u32>(round(clamp(c.rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * vec3<f32>(2047.0, 2047.0, 1023.0)));
+    let rgb = (q.r << 21u) | (q.g << 10u) | q.b;
+    return ~((u64((d << 8u) | a) << 32u) | u64(rgb));
+}
+
+fn unpack_color(word: u64) -> vec4<f32> {
+    let w = ~word;
+    let rgb = u32(w & 0xfffffffflu);
+    let a = u32(w >> 32u) & 0xffu;
+    let c = vec3<f32>(f32(rgb >> 21u) / 2047.0, f32((rgb >> 10u) & 0x7ffu) / 2047.0, f32(rgb & 0x3ffu) / 1023.0);
+    return vec4<f32>(c, f32(a) / 255.0);
+}
+
+fn add_tail(acc: u32, word: u64) {
+    let c = unpack_color(word);
+    atomicAdd(&accum[acc + TAIL_COUNT], 1u);
+    add_fixed64(acc + TAIL_R, c.r * c.a);
+    add_fixed64(acc + TAIL_R + 2u, c.g * c.a);
+    add_fixed64(acc + TAIL_R + 4u, c.b * c.a);
+    add_fixed64(acc + TAIL_R + 6u, c.a);
+}
+
+@fragment
+fn fs_insert(in: VsOut) {
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
+        return;
+    }
+    let px = pixel_index(in.clip);
+    let base = px * K;
+    var v = pack_word(in.clip.z, in.color);
+    // Slots only grow, so a word not above a full table's last one goes to the tail now.
+    let last = atomicLoad(&ktab[base + K - 1u]);
+    if last == 0lu || v > last {
+        for (var i = 0u; i < K; i++) {
+            let old = atomicMax(&ktab[base + i], v);
+            if old == 0lu {
+                return; // took an empty slot
+            }
+            v = min(old, v); // the farther of the two moves on
+        }
+    }
+    // Quantized like every stored word, so the tail does not depend on arrival order.
+    add_tail(px * ACCUM_WORDS, v);
+}
+
+fn word(i: u32) -> u32 {
+    return atomicLoad(&accum[i]);
+}
+
+@fragment
+fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let base = base_at(pos);
+    let px = pixel_index(pos);
+    var core = vec3<f32>(0.0);
+    var t_core = 1.0;
+    for (var i = 0u; i < K; i++) {
+        let w = atomicLoad(&ktab[px * K + i]);
+        if w == 0lu {
+            break;
+        }
+        let c = unpack_color(w);
+        core += t_core * c.a * c.rgb;
+        t_core *= 1.0 - c.a;
+    }
+    let acc = px * ACCUM_WORDS;
+    let count = word(acc + TAIL_COUNT);
+    var tail = vec3<f32>(0.0);
+    var t_tail = 1.0;
+    if count > 0u {
+        atomicAdd(&overflow, count);
+        let sum_a = read_fixed64(word(acc + TAIL_R + 6u), word(acc + TAIL_R + 7u));
+        if sum_a > 0.0 {
+            let sum_c = vec3<f32>(
+                read_fixed64(word(acc + TAIL_R), word(acc + TAIL_R + 1u)),
+                read_fixed64(word(acc + TAIL_R + 2u), word(acc + TAIL_R + 3u)),
+                read_fixed64(word(acc + TAIL_R + 4u), word(acc + TAIL_R + 5u)),
+            );
+            let n = f32(count);
+            let a_avg = min(sum_a / n, 1.0);
+            t_tail = select(pow(1.0 - a_avg, n), 0.0, a_avg >= 1.0);
+            tail = (sum_c / sum_a) * (1.0 - t_tail);
+        }
+    }
+    let rgb = core + t_core * (tail + t_tail * base.rgb);
+    return vec4<f32>(rgb, 1.0 - t_core * t_tail * (1.0 - base.a));
+}
