@@ -16,7 +16,9 @@ const TAIL_R: u32 = 3u;      // 8 words: tail C * alpha (rgb) and alpha, (lo, hi
 const TAIL_COUNT: u32 = 11u; // tail fragment count
 const T_CORE: u32 = 12u;     // transmittance behind the core (f32 bits)
 const EVICTED: u32 = 13u;    // nearest key pushed out of the full k-TAB (0: none)
-const ACCUM_WORDS: u32 = 14u;
+const QUANT_W: u32 = 14u;    // sum over core fragments of |alpha - q| * T' (fixed point)
+const QUANT_D: u32 = 15u;    // sum over core fragments of |alpha - q| (fixed point)
+const ACCUM_WORDS: u32 = 16u;
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
 @group(2) @binding(1) var<storage, read_write> vis: array<f32>;
@@ -125,6 +127,10 @@ fn fs_shade(in: VsOut) {
             let a = in.color.a;
             let share = select((1.0 - pow(1.0 - a, f32(m))) / f32(m), a, m == 1u);
             let w = vis[base + lo] * share;
+            // The 8-bit alpha of this key moved every transmittance behind it (error bound).
+            let d = abs(a - key_alpha(key));
+            add_fixed32(acc + QUANT_W, d * vis[base + lo]);
+            add_fixed32(acc + QUANT_D, d);
             add_fixed32(acc + CORE_R, in.color.r * w);
             add_fixed32(acc + CORE_R + 1u, in.color.g * w);
             add_fixed32(acc + CORE_R + 2u, in.color.b * w);
@@ -145,8 +151,14 @@ fn word(i: u32) -> u32 {
     return atomicLoad(&accum[i]);
 }
 
+struct Final {
+    @location(0) color: vec4<f32>,
+    // Per-pixel bound of |this image - the exact composite|, per channel (docs/methods.md).
+    @location(1) bound: f32,
+}
+
 @fragment
-fn fs_final(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
     let base = base_at(pos);
     let acc = pixel_index(pos) * ACCUM_WORDS;
     let core = vec3<f32>(read_fixed32(word(acc + CORE_R)), read_fixed32(word(acc + CORE_R + 1u)), read_fixed32(word(acc + CORE_R + 2u)));
@@ -172,5 +184,13 @@ fn fs_final(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         }
     }
     let rgb = core + t_core * (tail + t_tail * base.rgb);    // eq. 11
-    return vec4<f32>(rgb, 1.0 - t_core * t_tail * (1.0 - base.a));
+    // Quantized core alphas: sum |d| T' plus the second-order D^2; whatever lies behind the
+    // core (tail or, for ktab, nothing) is off by at most T_core; float32 and fixed-point
+    // rounding of K + count terms.
+    let d = read_fixed32(word(acc + QUANT_D));
+    var bound = read_fixed32(word(acc + QUANT_W)) + d * d + f32(K + count + 2u) * 2.4e-7;
+    if count > 0u {
+        bound += t_core;
+    }
+    return Final(vec4<f32>(rgb, 1.0 - t_core * t_tail * (1.0 - base.a)), bound);
 }

@@ -72,12 +72,21 @@ fn word(i: u32) -> u32 {
     return atomicLoad(&accum[i]);
 }
 
+struct Final {
+    @location(0) color: vec4<f32>,
+    // Per-pixel bound of |this image - the exact composite|, per channel (docs/methods.md).
+    @location(1) bound: f32,
+}
+
 @fragment
-fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
     let base = base_at(pos);
     let px = pixel_index(pos);
     var core = vec3<f32>(0.0);
     var t_core = 1.0;
+    // Each core alpha is within 1/510 of the fragment's: sum (T' + drift so far) / 510.
+    var alpha_bound = 0.0;
+    var drift = 0.0;
     for (var i = 0u; i < K; i++) {
         let w = atomicLoad(&ktab[px * K + i]);
         if w == 0lu {
@@ -85,6 +94,8 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         }
         let c = unpack_color(w);
         core += t_core * c.a * c.rgb;
+        alpha_bound += (t_core + drift) / 510.0;
+        drift += 1.0 / 510.0;
         t_core *= 1.0 - c.a;
     }
     let acc = px * ACCUM_WORDS;
@@ -107,5 +118,11 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         }
     }
     let rgb = core + t_core * (tail + t_tail * base.rgb);
-    return vec4<f32>(rgb, 1.0 - t_core * t_tail * (1.0 - base.a));
+    // Core colors quantized to 11/11/10 bits (visibilities sum to at most 1), core alphas as
+    // above, at most T_core for what lies behind when there is a tail, and rounding.
+    var bound = 1.0 / 2046.0 + alpha_bound + f32(K + count + 2u) * 2.4e-7;
+    if count > 0u {
+        bound += t_core;
+    }
+    return Final(vec4<f32>(rgb, 1.0 - t_core * t_tail * (1.0 - base.a)), bound);
 }

@@ -5,8 +5,8 @@ their node pool to the frame's fragments and have no formula in W and H alone.""
 from __future__ import annotations
 
 # Words per pixel of hybrid's accumulators: core RGB (3), tail sums as 64-bit pairs (8),
-# tail count, transmittance behind the core, nearest evicted key.
-HYBRID_ACCUM_WORDS = 14
+# tail count, transmittance behind the core, nearest evicted key, two error-bound sums.
+HYBRID_ACCUM_WORDS = 16
 
 
 def memory_bytes(method: str, width: int, height: int, **params) -> int | None:

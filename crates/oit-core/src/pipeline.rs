@@ -1,7 +1,7 @@
 //! Builders for the two kinds of pipeline every method uses: geometry passes over the
 //! scene (vertex pulling) and full-screen passes.
 
-use crate::targets::{COLOR_FORMAT, DEPTH_FORMAT};
+use crate::targets::{BOUND_FORMAT, COLOR_FORMAT, DEPTH_FORMAT};
 
 /// Depth state of transparent geometry passes: test against the opaque depth, never write.
 pub fn depth_test_only() -> Option<wgpu::DepthStencilState> {
@@ -48,6 +48,22 @@ pub fn geometry(
 
 /// A full-screen pass writing one RGBA32F target with the fragment entry `fs`.
 pub fn fullscreen(device: &wgpu::Device, label: &str, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, fs: &str) -> wgpu::RenderPipeline {
+    fullscreen_targets(device, label, module, layout, fs, &[Some(COLOR_FORMAT.into())])
+}
+
+/// A full-screen pass writing the RGBA32F output and the R32F error bound.
+pub fn fullscreen_with_bound(device: &wgpu::Device, label: &str, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, fs: &str) -> wgpu::RenderPipeline {
+    fullscreen_targets(device, label, module, layout, fs, &[Some(COLOR_FORMAT.into()), Some(BOUND_FORMAT.into())])
+}
+
+fn fullscreen_targets(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    fs: &str,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
@@ -59,7 +75,7 @@ pub fn fullscreen(device: &wgpu::Device, label: &str, module: &wgpu::ShaderModul
             module,
             entry_point: Some(fs),
             compilation_options: Default::default(),
-            targets: &[Some(COLOR_FORMAT.into())],
+            targets,
         }),
         multiview_mask: None,
         cache: None,
@@ -97,6 +113,15 @@ pub fn capture_pass<'e>(
     })
 }
 
+fn cleared(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+    })
+}
+
 /// A pass that writes `target` entirely (full-screen resolves).
 pub fn resolve_pass<'e>(
     enc: &'e mut wgpu::CommandEncoder,
@@ -104,14 +129,28 @@ pub fn resolve_pass<'e>(
     target: &'e wgpu::TextureView,
     timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
 ) -> wgpu::RenderPass<'e> {
+    resolve_targets(enc, label, &[cleared(target)], timestamps)
+}
+
+/// A full-screen resolve that also writes the per-pixel error bound.
+pub fn resolve_with_bound<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    targets: &'e crate::targets::Targets,
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
+) -> wgpu::RenderPass<'e> {
+    resolve_targets(enc, label, &[cleared(&targets.out), cleared(&targets.bound)], timestamps)
+}
+
+fn resolve_targets<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    attachments: &[Option<wgpu::RenderPassColorAttachment<'e>>],
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
+) -> wgpu::RenderPass<'e> {
     enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: target,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
-        })],
+        color_attachments: attachments,
         depth_stencil_attachment: None,
         timestamp_writes: timestamps,
         occlusion_query_set: None,

@@ -12,7 +12,7 @@ use crate::method::{self, FrameCtx, Limits, Method, ParamValue, Params};
 use crate::pipeline;
 use crate::scene::{Camera, Scene};
 use crate::shader;
-use crate::targets::{padded_row, read_buffer, targets_layout, Targets, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::targets::{read_buffer, read_rows, targets_layout, Targets, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::timer::PassTimer;
 use crate::upload::{scene_layout, GpuScene};
 
@@ -43,6 +43,9 @@ pub struct Frame {
     pub image: Vec<f32>,
     /// Transparent fragments per pixel (same layout, one value a pixel).
     pub depth_complexity: Vec<u32>,
+    /// Per-pixel bound of the error against the exact composite (any RGB channel), for the
+    /// methods that derive one.
+    pub error_bound: Option<Vec<f32>>,
     pub stats: Stats,
 }
 
@@ -213,7 +216,9 @@ impl Renderer {
         };
         let report = method.render(&mut cx)?;
         let pass_times = self.timer.read(&gpu)?;
-        let image = self.read_image()?;
+        let t = &self.targets;
+        let image = read_rows(&gpu, &t.out_texture, &t.image_readback, 16)?;
+        let error_bound = if report.error_bound { Some(read_rows(&gpu, &t.bound_texture, &t.bound_readback, 4)?) } else { None };
         let stats = Stats {
             method: info.name.to_string(),
             params,
@@ -228,7 +233,7 @@ impl Renderer {
             wall_time_ms: start.elapsed().as_secs_f64() * 1e3,
             extra: report.extra,
         };
-        Ok(Frame { width: self.width, height: self.height, image, depth_complexity, stats })
+        Ok(Frame { width: self.width, height: self.height, image, depth_complexity, error_bound, stats })
     }
 
     fn upload(&mut self, scene: &Scene) -> Result<()> {
@@ -280,25 +285,4 @@ impl Renderer {
         self.gpu.queue.submit([enc.finish()]);
     }
 
-    fn read_image(&self) -> Result<Vec<f32>> {
-        let t = &self.targets;
-        let row = padded_row(t.width, 16);
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            t.out_texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &t.image_readback,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
-            },
-            t.out_texture.size(),
-        );
-        self.gpu.queue.submit([enc.finish()]);
-        let raw = read_buffer(&self.gpu, &t.image_readback, row as u64 * t.height as u64)?;
-        let mut image = Vec::with_capacity((t.width * t.height * 4) as usize);
-        for r in 0..t.height as usize {
-            let line = &raw[r * row as usize..r * row as usize + t.width as usize * 16];
-            image.extend(bytemuck::pod_collect_to_vec::<u8, f32>(line));
-        }
-        Ok(image)
-    }
 }

@@ -5,6 +5,8 @@ use crate::context::GpuContext;
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Per-pixel error bound written by methods that derive one.
+pub const BOUND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// Bytes per row of a texture readback, padded to wgpu's 256-byte copy alignment.
 pub fn padded_row(width: u32, bytes_per_pixel: u32) -> u32 {
@@ -21,6 +23,9 @@ pub struct Targets {
     pub out_texture: wgpu::Texture,
     pub out: wgpu::TextureView,
     pub base_texture: wgpu::Texture,
+    pub bound_texture: wgpu::Texture,
+    pub bound: wgpu::TextureView,
+    pub bound_readback: wgpu::Buffer,
     /// Group 1 of storage-writing and resolve passes: opaque depth and base color.
     pub group: wgpu::BindGroup,
     pub counts: wgpu::Buffer,
@@ -76,6 +81,8 @@ impl Targets {
             COLOR_FORMAT,
             U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST,
         );
+        let bound_texture = texture(d, "error bound", width, height, BOUND_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
+        let bound = bound_texture.create_view(&Default::default());
         let base = base_texture.create_view(&Default::default());
         let depth = depth_texture.create_view(&Default::default());
         let out = out_texture.create_view(&Default::default());
@@ -104,12 +111,31 @@ impl Targets {
         };
         let image_readback = readback("image readback", padded_row(width, 16) as u64 * height as u64);
         let counts_readback = readback("counts readback", pixels * 4);
-        Self { width, height, base, depth, depth_texture, out_texture, out, base_texture, group, counts, counts_group, image_readback, counts_readback }
+        let bound_readback = readback("bound readback", padded_row(width, 4) as u64 * height as u64);
+        Self {
+            width,
+            height,
+            base,
+            depth,
+            depth_texture,
+            out_texture,
+            out,
+            base_texture,
+            bound_texture,
+            bound,
+            bound_readback,
+            group,
+            counts,
+            counts_group,
+            image_readback,
+            counts_readback,
+        }
     }
 
-    /// Bytes of the shared targets (base, depth, out, census counts), not counted per method.
+    /// Bytes of the shared targets (base, depth, out, census counts, error bound), not
+    /// counted per method.
     pub fn bytes(&self) -> u64 {
-        self.width as u64 * self.height as u64 * (16 + 4 + 16 + 4)
+        self.width as u64 * self.height as u64 * (16 + 4 + 16 + 4 + 4)
     }
 }
 
@@ -140,4 +166,27 @@ pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> crate:
         .to_vec();
     buffer.unmap();
     Ok(data)
+}
+
+/// Reads a float texture back into a row-major Vec (row padding removed).
+pub fn read_rows(gpu: &GpuContext, texture: &wgpu::Texture, readback: &wgpu::Buffer, bytes_per_pixel: u32) -> crate::error::Result<Vec<f32>> {
+    let size = texture.size();
+    let row = padded_row(size.width, bytes_per_pixel);
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: readback,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+        },
+        size,
+    );
+    gpu.queue.submit([enc.finish()]);
+    let raw = read_buffer(gpu, readback, row as u64 * size.height as u64)?;
+    let line = (size.width * bytes_per_pixel) as usize;
+    let mut out = Vec::with_capacity(line / 4 * size.height as usize);
+    for r in 0..size.height as usize {
+        out.extend(bytemuck::pod_collect_to_vec::<u8, f32>(&raw[r * row as usize..r * row as usize + line]));
+    }
+    Ok(out)
 }

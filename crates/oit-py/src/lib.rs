@@ -199,7 +199,8 @@ impl Renderer {
         Ok(d)
     }
 
-    /// Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict).
+    /// Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict,
+    /// error bound (h, w) float32 or None).
     fn render<'py>(
         &self,
         py: Python<'py>,
@@ -227,7 +228,11 @@ impl Renderer {
         let image = frame.image.into_pyarray(py).reshape([h, w, 4])?;
         let dc = frame.depth_complexity.into_pyarray(py).reshape([h, w])?;
         let stats = stats_dict(py, &frame.stats)?;
-        Ok((image, dc, stats).into_pyobject(py)?.into_any())
+        let bound = match frame.error_bound {
+            Some(b) => Some(b.into_pyarray(py).reshape([h, w])?),
+            None => None,
+        };
+        Ok((image, dc, stats, bound).into_pyobject(py)?.into_any())
     }
 }
 

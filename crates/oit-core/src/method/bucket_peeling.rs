@@ -145,6 +145,6 @@ impl Method for Buckets {
         cx.gpu.queue.submit([enc.finish()]);
         let raw = read_buffer(cx.gpu, &b.readback, 4)?;
         let dropped = u32::from_le_bytes(raw[..4].try_into().expect("4 bytes")) as u64;
-        Ok(MethodReport { memory_bytes: memory_bytes(pixels, buckets as u64), overflow_fragments: dropped, extra: Vec::new() })
+        Ok(MethodReport { memory_bytes: memory_bytes(pixels, buckets as u64), overflow_fragments: dropped, ..Default::default() })
     }
 }

@@ -35,7 +35,7 @@ pub const KTAB: MethodInfo = MethodInfo {
 };
 
 /// Words per pixel of the accumulators (mirrors ACCUM_WORDS in shaders/hybrid.wgsl).
-pub const ACCUM_WORDS: u64 = 14;
+pub const ACCUM_WORDS: u64 = 16;
 /// Fixed-point scales of core sums (values in [0, 1], total <= 1) and tail sums.
 pub const CORE_SCALE: f32 = 2147483648.0; // 2^31
 pub const TAIL_SCALE: f32 = 16777216.0; // 2^24
@@ -92,7 +92,7 @@ impl Hybrid {
         let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &layout]);
         let store = pipeline::geometry(d, "hybrid store", &module, &pl, "fs_store", &[], pipeline::depth_test_only());
         let shade = pipeline::geometry(d, "hybrid shade", &module, &pl, "fs_shade", &[], pipeline::depth_test_only());
-        let finish = pipeline::fullscreen(d, "hybrid final", &module, &pl, "fs_final");
+        let finish = pipeline::fullscreen_with_bound(d, "hybrid final", &module, &pl, "fs_final");
         let visibility = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("hybrid visibility"),
             layout: Some(&pl),
@@ -192,7 +192,7 @@ impl Method for Hybrid {
             geo.draw_all(&mut pass);
         }
         {
-            let mut pass = pipeline::resolve_pass(&mut enc, "hybrid final", &t.out, cx.timer.render_pass("final"));
+            let mut pass = pipeline::resolve_with_bound(&mut enc, "hybrid final", t, cx.timer.render_pass("final"));
             pass.set_pipeline(&p.finish);
             pass.set_bind_group(0, &geo.group, &[]);
             pass.set_bind_group(1, &t.group, &[]);
@@ -207,6 +207,7 @@ impl Method for Hybrid {
             memory_bytes: memory_bytes(pixels, k as u64),
             overflow_fragments: overflow,
             extra: vec![("tail_fragments", overflow as f64)],
+            error_bound: true,
         })
     }
 }

@@ -66,7 +66,7 @@ fn build(cx: &FrameCtx<'_>, k: u32) -> Pipelines {
     Pipelines {
         k,
         insert: pipeline::geometry(d, "hybrid64 insert", &module, &pl, "fs_insert", &[], pipeline::depth_test_only()),
-        resolve: pipeline::fullscreen(d, "hybrid64 resolve", &module, &pl, "fs_resolve"),
+        resolve: pipeline::fullscreen_with_bound(d, "hybrid64 resolve", &module, &pl, "fs_resolve"),
         layout,
     }
 }
@@ -135,7 +135,7 @@ impl Method for Hybrid64 {
             geo.draw_all(&mut pass);
         }
         {
-            let mut pass = pipeline::resolve_pass(&mut enc, "hybrid64 resolve", &t.out, cx.timer.render_pass("resolve"));
+            let mut pass = pipeline::resolve_with_bound(&mut enc, "hybrid64 resolve", t, cx.timer.render_pass("resolve"));
             pass.set_pipeline(&p.resolve);
             pass.set_bind_group(0, &geo.group, &[]);
             pass.set_bind_group(1, &t.group, &[]);
@@ -150,6 +150,7 @@ impl Method for Hybrid64 {
             memory_bytes: memory_bytes(pixels, k as u64),
             overflow_fragments: tail,
             extra: vec![("tail_fragments", tail as f64)],
+            error_bound: true,
         })
     }
 }

@@ -379,7 +379,7 @@ impl ListMethod {
                     ("resolve_sweeps", if p.sweep.is_some() { sweeps as f64 } else { 1.0 }),
                     ("pool_nodes", count as f64),
                 ];
-                return Ok(MethodReport { memory_bytes: memory, overflow_fragments: 0, extra });
+                return Ok(MethodReport { memory_bytes: memory, extra, ..Default::default() });
             }
             self.pool.reserve(cx.gpu, count, pixels, triangles)?;
             regrown += 1.0;

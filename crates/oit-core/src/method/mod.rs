@@ -2,6 +2,7 @@
 //! Adding a method: one file here, its WGSL, one line in `REGISTRY`, and its tests.
 
 mod abuffer;
+mod auto;
 mod adaptive;
 mod mlab;
 mod blend;
@@ -86,7 +87,7 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, blend::ADDITIVE, blend::FILTER, hybrid::HYBRID, hybrid::KTAB, hybrid64::INFO, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING, screen_door::INFO, stochastic::INFO, mlab::INFO, bucket_peeling::INFO];
+const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, blend::ADDITIVE, blend::FILTER, hybrid::HYBRID, hybrid::KTAB, hybrid64::INFO, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING, screen_door::INFO, stochastic::INFO, mlab::INFO, bucket_peeling::INFO, auto::INFO];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY
@@ -229,6 +230,25 @@ pub(crate) struct FrameCtx<'a> {
     pub frame_uniform: &'a wgpu::Buffer,
 }
 
+impl FrameCtx<'_> {
+    /// The same frame for another method's parameters (methods that delegate, e.g. auto).
+    pub fn with_params<'b>(&'b mut self, params: &'b Params) -> FrameCtx<'b> {
+        FrameCtx {
+            gpu: self.gpu,
+            scene: self.scene,
+            camera: self.camera,
+            targets: self.targets,
+            targets_layout: self.targets_layout,
+            scene_layout: self.scene_layout,
+            timer: &mut *self.timer,
+            params,
+            max_depth_complexity: self.max_depth_complexity,
+            fragments: self.fragments,
+            frame_uniform: self.frame_uniform,
+        }
+    }
+}
+
 /// What a method reports about its frame, beyond what the renderer measures.
 #[derive(Debug, Default)]
 pub struct MethodReport {
@@ -238,6 +258,8 @@ pub struct MethodReport {
     pub overflow_fragments: u64,
     /// Method-specific numbers (e.g. how often the node pool grew).
     pub extra: Vec<(&'static str, f64)>,
+    /// Whether the method wrote a per-pixel error bound into `targets.bound`.
+    pub error_bound: bool,
 }
 
 pub(crate) trait Method: Send {

@@ -212,6 +212,7 @@ impl Method for Peel {
             memory_bytes: memory_bytes(pixels),
             overflow_fragments: cx.fragments.saturating_sub(peeled),
             extra: vec![("geometry_passes", passes as f64), ("peeled_fragments", peeled as f64)],
+            ..Default::default()
         })
     }
 }

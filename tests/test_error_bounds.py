@@ -1,0 +1,72 @@
+"""Accuracy on demand (issue 8): the per-pixel error bound of hybrid, hybrid64 and ktab is
+never exceeded by the measured error against the A-buffer, and `auto` meets its tolerance
+at the least cost it finds."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import oit
+from oit.scenes import stacks
+from scenes import IDENTITY, PERSPECTIVE, build_scene, random_meshes
+
+
+def measured(frame, exact):
+    return np.abs(frame.image[..., :3].astype(np.float64) - exact.image[..., :3])
+
+
+@pytest.mark.parametrize("method", ["hybrid", "hybrid64", "ktab"])
+@pytest.mark.parametrize("k", [1, 2, 4, 8])
+@pytest.mark.parametrize("alphas", ["random", "worst", "constant"])
+def test_bound_holds_on_stacks(renderer, method, k, alphas):
+    built = stacks(layers=24, alphas=alphas, size=(12, 12), seed=k)
+    r = renderer(12, 12)
+    exact = r.render(built.scene, built.camera, "abuffer")
+    frame = r.render(built.scene, built.camera, method, k=k)
+    assert frame.error_bound is not None and frame.error_bound.shape == (12, 12, 3)
+    assert (measured(frame, exact) <= frame.error_bound).all()
+
+
+@pytest.mark.parametrize("method", ["hybrid", "hybrid64", "ktab"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_bound_holds_on_random_scenes(renderer, method, seed):
+    scene = build_scene(random_meshes(seed, transparent=12, triangles=6, space="world"))
+    r = renderer(40, 40)
+    exact = r.render(scene, PERSPECTIVE, "abuffer")
+    frame = r.render(scene, PERSPECTIVE, method, k=2)
+    assert (measured(frame, exact) <= frame.error_bound).all()
+
+
+def test_methods_without_a_bound_say_why(renderer):
+    scene = build_scene(random_meshes(3))
+    r = renderer(16, 16)
+    for method in ("wavg", "abuffer"):
+        frame = r.render(scene, IDENTITY, method)
+        assert frame.error_bound is None and frame.error_bound_reason
+
+
+@pytest.mark.parametrize("tolerance", [1 / 255, 4 / 255, 16 / 255])
+def test_auto_meets_its_tolerance(renderer, tolerance):
+    built = stacks(layers=60, alphas="random", size=(12, 12), seed=7)
+    r = renderer(12, 12)
+    exact = r.render(built.scene, built.camera, "abuffer")
+    frame = r.render(built.scene, built.camera, "auto", tolerance=tolerance)
+    assert frame.stats["error_bound_max"] <= tolerance
+    assert measured(frame, exact).max() <= tolerance
+    assert (measured(frame, exact) <= frame.error_bound).all()
+
+
+def test_auto_uses_no_more_slots_than_the_depth_complexity(renderer):
+    built = stacks(layers=5, alphas="constant", size=(8, 8), seed=1)
+    frame = renderer(8, 8).render(built.scene, built.camera, "auto", tolerance=0.05)
+    assert frame.stats["auto_k"] == 5 and frame.stats["overflow_fragments"] == 0
+    assert frame.stats["auto_attempts"] == 1
+
+
+def test_auto_falls_back_to_exact_for_a_tiny_tolerance(renderer):
+    built = stacks(layers=60, alphas="random", size=(8, 8), seed=2)
+    frame = renderer(8, 8).render(built.scene, built.camera, "auto", tolerance=1e-4)
+    assert frame.stats["auto_exact"] == 1
+    # The exact composite's own bound: float32 rounding of 62 terms.
+    assert frame.stats["error_bound_max"] == pytest.approx(62 * 2.4e-7, rel=1e-6)
