@@ -104,33 +104,32 @@ def test_adapter_info(renderer):
 
 
 def test_node_pool_split_across_bindings_gives_the_same_image(renderer):
-    # 4096-byte bindings hold 170 nodes each, 680 in all; this scene has 511-680 fragments,
-    # so nodes land in all four bindings.
-    meshes = random_meshes(2, transparent=10, opaque=1, triangles=4, space="ndc", spread=0.9)
-    scene = build_scene(meshes)
-    whole = renderer(16, 16).render(scene, IDENTITY, background=(0.2, 0.2, 0.2))
-    split = renderer(16, 16, max_binding_bytes=4096).render(scene, IDENTITY, background=(0.2, 0.2, 0.2))
-    assert 3 * 170 < split.stats["fragments"] <= 4 * 170
+    # max_binding_bytes applies to every storage binding: at 4 x 4 the per-pixel sweep state
+    # (48 B/pixel) needs 768 bytes. 1024-byte bindings hold 42 nodes each, 168 in all; nine
+    # full-screen layers are 144 fragments, so nodes land in all four bindings.
+    scene = build_scene([layer(0.1 * (i + 1), (0.1 * i, 0.5, 1 - 0.1 * i, 0.3)) for i in range(9)])
+    whole = renderer(4, 4).render(scene, IDENTITY, background=(0.2, 0.2, 0.2))
+    split = renderer(4, 4, max_binding_bytes=1024).render(scene, IDENTITY, background=(0.2, 0.2, 0.2))
+    assert 3 * 42 < split.stats["fragments"] <= 4 * 42
     assert np.array_equal(split.image, whole.image)
 
 
 def test_node_pool_too_small_raises_memory_error(renderer):
-    # 256-byte bindings hold 10 nodes each, 40 in all; 4 x 4 pixels x 4 layers = 64.
-    r = renderer(4, 4, max_binding_bytes=256)
-    scene = build_scene([layer(z, (1, 0, 0, 0.5)) for z in (0.2, 0.4, 0.6, 0.8)])
-    with pytest.raises(MemoryError, match=r"64 transparent fragments.*at most 40.*render at a smaller size"):
+    # 768-byte bindings hold the 4 x 4 sweep state and 32 nodes each, 128 in all;
+    # 4 x 4 pixels x 9 layers = 144.
+    r = renderer(4, 4, max_binding_bytes=768)
+    scene = build_scene([layer(0.1 * (i + 1), (1, 0, 0, 0.5)) for i in range(9)])
+    with pytest.raises(MemoryError, match=r"144 transparent fragments.*at most 128.*render at a smaller size"):
         r.render(scene, IDENTITY)
     # Within the limit, the same renderer works.
     ok = r.render(build_scene([layer(0.5, (1, 0, 0, 0.5))]), IDENTITY)
     assert ok.stats["fragments"] == 16
 
 
-def test_small_node_pool_with_few_fragments_on_a_large_frame(renderer):
-    # 16 x 16 = 256 pixels, but only 16 fragments: well within 40 nodes.
-    positions, indices = geometry.quad((-0.75, 0.75, 0.5), (0.5, 0.5))
-    scene = build_scene([MeshData(positions, indices, np.tile(np.float32([1, 0, 0, 0.5]), (4, 1)))])
-    frame = renderer(16, 16, max_binding_bytes=256).render(scene, IDENTITY)
-    assert frame.stats["fragments"] == 16
+def test_per_pixel_buffers_past_a_lowered_limit_name_what_fits(renderer):
+    # 16 x 16 pixels of 48-byte sweep state do not fit 256-byte bindings: 5 pixels do.
+    with pytest.raises(MemoryError, match=r"at most 5 pixels \(e.g. 2 x 2\)"):
+        renderer(16, 16, max_binding_bytes=256).render(build_scene([layer(0.5, (1, 0, 0, 0.5))]), IDENTITY)
 
 
 @pytest.mark.parametrize("method", METHODS)

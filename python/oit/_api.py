@@ -3,6 +3,7 @@ messages that name the argument and say what to do."""
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
@@ -27,6 +28,19 @@ def _rows(a: np.ndarray, cols: int, name: str) -> np.ndarray:
     if a.ndim != 2 or a.shape[1] != cols:
         raise ValueError(f"{name} must have shape (n, {cols}), got {a.shape}")
     return a
+
+
+def _int(value: Any, name: str, what: str = "an int") -> int:
+    """A Python or numpy integer (not a bool, not a float that happens to be whole)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be {what}, got {type(value).__name__}")
+    return int(value)
+
+
+# The native layer takes sizes as u32 and byte counts as i64; larger Python ints would
+# surface as OverflowError without the argument's name.
+_U32_MAX = 2 ** 32 - 1
+_I64_MAX = 2 ** 63 - 1
 
 
 class Scene:
@@ -73,7 +87,12 @@ class Scene:
 
     def set_mesh_alpha(self, mesh: int, alpha: float) -> None:
         """Sets every vertex alpha of one mesh."""
-        self._native.set_mesh_alpha(int(mesh), float(alpha))
+        index = _int(mesh, "mesh", "an int (the index add_mesh returned)")
+        if isinstance(alpha, (bool, np.bool_)) or not isinstance(alpha, (int, float, np.integer, np.floating)):
+            raise TypeError(f"alpha must be a number in [0, 1], got {type(alpha).__name__}")
+        if not 0 <= index < self.mesh_count:
+            raise ValueError(f"mesh index {index} is out of range: the scene has {self.mesh_count} meshes")
+        self._native.set_mesh_alpha(index, float(alpha))
 
     @property
     def mesh_count(self) -> int:
@@ -147,6 +166,8 @@ class Camera:
     wgpu clip space: x, y in [-1, 1] with y up, z in [0, 1] (smaller is nearer)."""
 
     def __init__(self, view_proj: Any) -> None:
+        if np.iscomplexobj(view_proj):
+            raise TypeError("view_proj must be a 4 x 4 array of real numbers, got complex values")
         try:
             m = np.asarray(view_proj, dtype=np.float64)
         except (TypeError, ValueError) as e:
@@ -157,6 +178,15 @@ class Camera:
             raise ValueError("view_proj has NaN or Inf entries")
         if abs(np.linalg.det(m)) < 1e-300:
             raise ValueError("view_proj is singular: build it with Camera.look_at or Camera.orthographic")
+        # The GPU gets the matrix in float32: entries past its range become Inf, and tiny ones
+        # flush to 0 (a matrix regular in float64 can be singular there).
+        big = float(np.abs(m).max())
+        if big > float(np.finfo(np.float32).max):
+            raise ValueError(f"view_proj has an entry of magnitude {big:.3g}, past float32 (the GPU's precision): "
+                             "rescale it")
+        if abs(np.linalg.det(m.astype(np.float32).astype(np.float64))) < 1e-300:
+            raise ValueError("view_proj is singular in float32 (the GPU's precision): build it with Camera.look_at "
+                             "or Camera.orthographic")
         self.view_proj = np.ascontiguousarray(m)
 
     def __repr__(self) -> str:
@@ -227,11 +257,16 @@ class Camera:
 @dataclass
 class Frame:
     """One rendered frame. `image`: (h, w, 4) float32, linear; RGB is the final color and A
-    the coverage of the background. `depth_complexity`: transparent fragments per pixel."""
+    the coverage of the background. `depth_complexity`: transparent fragments per pixel.
+    `error_bound`: (h, w, 3) float32, a bound of |image RGB - the exact composite| at every
+    pixel and channel, for the methods that derive one (hybrid, hybrid64, ktab, auto);
+    otherwise None, and `error_bound_reason` says why."""
 
     image: np.ndarray
     stats: dict
     depth_complexity: np.ndarray = field(repr=False)
+    error_bound: np.ndarray | None = field(default=None, repr=False)
+    error_bound_reason: str = ""
 
 
 class Renderer:
@@ -240,12 +275,27 @@ class Renderer:
 
     def __init__(self, width: int, height: int, adapter: str | None = None, max_binding_bytes: int | None = None) -> None:
         for name, v in (("width", width), ("height", height)):
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
-                raise TypeError(f"{name} must be an int, got {type(v).__name__}")
-            if v <= 0:
+            if _int(v, name) <= 0:
                 raise ValueError(f"{name} must be positive, got {v}")
+        if adapter is not None and not isinstance(adapter, str):
+            raise TypeError(f"adapter must be a string (part of an adapter's name) or None, "
+                            f"got {type(adapter).__name__}")
+        if max_binding_bytes is not None:
+            if _int(max_binding_bytes, "max_binding_bytes", "an int (bytes) or None") <= 0:
+                raise ValueError(f"max_binding_bytes must be positive, got {max_binding_bytes}")
+            max_binding_bytes = min(int(max_binding_bytes), _I64_MAX)  # the core caps it at the adapter's
         self.width, self.height = int(width), int(height)
-        self._native = _oit.Renderer(self.width, self.height, adapter, max_binding_bytes)
+        # Sizes past u32 are past every adapter's largest texture: let the core say which
+        # size is the largest, about the size asked for.
+        w, h = min(self.width, _U32_MAX), min(self.height, _U32_MAX)
+        try:
+            self._native = _oit.Renderer(w, h, adapter, max_binding_bytes)
+        except MemoryError as e:
+            if (w, h) == (self.width, self.height):
+                raise
+            raise MemoryError(str(e).replace(f"{w} x {h}", f"{self.width} x {self.height}", 1)) from None
+        if (w, h) != (self.width, self.height):  # no adapter has 2^32-pixel textures
+            raise MemoryError(f"{self.width} x {self.height} is past the adapter's largest texture")
 
     @property
     def adapter_info(self) -> dict:
@@ -261,9 +311,15 @@ class Renderer:
         if not isinstance(method, str):
             raise TypeError(f"method must be a string, got {type(method).__name__}")
         bg = _background(background)
-        image, dc, stats = self._native.render(scene._native, camera.view_proj, method, bg, params)
+        image, dc, stats, bound = self._native.render(scene._native, camera.view_proj, method, bg, params)
         stats["adapter"] = self.adapter_info["name"]
-        return Frame(image=image, stats=stats, depth_complexity=dc)
+        if bound is not None:
+            stats["error_bound_max"] = float(bound.max()) if bound.size else 0.0
+            return Frame(image=image, stats=stats, depth_complexity=dc, error_bound=np.repeat(bound[..., None], 3, axis=2))
+        exact = any(m["name"] == method and m["exact"] for m in methods())
+        reason = ("exact method: the error is float32 compositing, at most about (n + 2) * 2**-23 for n layers"
+                  if exact else f"no per-pixel bound is derived for '{method}' (docs/methods.md)")
+        return Frame(image=image, stats=stats, depth_complexity=dc, error_bound_reason=reason)
 
 
 def _background(background: Sequence[float]) -> tuple[float, float, float]:
@@ -289,5 +345,32 @@ def reference(scene: Scene, camera: Camera, width: int, height: int, background:
     equal depths, where a rasterizer may legitimately differ (docs/methods.md)."""
     if not isinstance(scene, Scene) or not isinstance(camera, Camera):
         raise TypeError("reference(scene, camera, width, height): scene must be an oit.Scene and camera an oit.Camera")
-    image, ambiguous, _ = _oit.reference(scene._native, camera.view_proj, int(width), int(height), _background(background))
+    w, h = _int(width, "width"), _int(height, "height")
+    if not (1 <= w <= 65536 and 1 <= h <= 65536):
+        raise ValueError(f"width and height must be in [1, 65536], got {w} x {h}")
+    # float64 RGBA, the ambiguity mask and the depth complexity: a failed allocation in the
+    # core would abort the process, so refuse what this machine cannot hold.
+    need = w * h * (4 * 8 + 1 + 4)
+    avail = _available_memory()
+    if w * h > _U32_MAX or (avail is not None and need > avail):
+        raise MemoryError(f"reference at {w} x {h} needs {need / 2**30:.1f} GiB"
+                          + (f" but {avail / 2**30:.1f} GiB are available" if avail is not None else "")
+                          + ": use a smaller size (it costs 37 bytes a pixel)")
+    image, ambiguous, _ = _oit.reference(scene._native, camera.view_proj, w, h, _background(background))
     return (image, ambiguous) if return_mask else image
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory available to allocate (Linux MemAvailable, else physical memory), or
+    None where neither is known."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None

@@ -55,16 +55,19 @@ fn to_pixels(vp: &DMat4, p: DVec3, w: f64, h: f64) -> Option<DVec2> {
     (c.w > 0.0).then(|| DVec2::new((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h))
 }
 
-/// Signed distances (pixels) from `p` to the three edges of the screen triangle, positive inside.
+/// Signed distances (pixels) from `p` to the three edges of the screen triangle, positive
+/// inside. Each edge is evaluated from its endpoints in a fixed (lexicographic) order, so two
+/// triangles sharing an edge get exactly opposite values and the top-left rule gives the
+/// center to exactly one of them.
 fn edge_distances(s: &[DVec2; 3], p: DVec2) -> [f64; 3] {
     let area = (s[1] - s[0]).perp_dot(s[2] - s[0]);
     let sign = if area >= 0.0 { 1.0 } else { -1.0 };
     let mut d = [0.0; 3];
     for i in 0..3 {
-        let a = s[i];
-        let b = s[(i + 1) % 3];
-        let len = (b - a).length().max(1e-300);
-        d[i] = sign * (b - a).perp_dot(p - a) / len;
+        let (a, b) = (s[i], s[(i + 1) % 3]);
+        let (lo, hi, flip) = if (a.x, a.y) <= (b.x, b.y) { (a, b, 1.0) } else { (b, a, -1.0) };
+        let len = (hi - lo).length().max(1e-300);
+        d[i] = sign * flip * (hi - lo).perp_dot(p - lo) / len;
     }
     d
 }
@@ -125,13 +128,20 @@ pub fn reference(scene: &Scene, camera: &Camera, width: u32, height: u32, backgr
             tris.push(Tri { v, c, opaque: m.opaque, screen });
         }
     }
-    // The BVH is f32: pad each box so that rounding cannot drop a triangle the f64 test hits.
+    // The BVH is f32: pad each box so that rounding cannot drop a triangle the f64 test hits,
+    // and by a thousandth of the scene, so that a pixel center just outside a triangle (within
+    // the edge margin, where the rasterizer's snapping may cover it) still reaches the edge test.
+    let scene_lo = tris.iter().flat_map(|t| t.v).fold(DVec3::splat(f64::MAX), DVec3::min);
+    let scene_hi = tris.iter().flat_map(|t| t.v).fold(DVec3::splat(f64::MIN), DVec3::max);
+    let scene_pad = if tris.is_empty() { 0.0 } else { (scene_hi - scene_lo).max_element() * 1e-3 };
     let bounds: Vec<Bounds> = tris
         .iter()
         .map(|t| {
             let lo = t.v[0].min(t.v[1]).min(t.v[2]);
             let hi = t.v[0].max(t.v[1]).max(t.v[2]);
-            let pad = (hi - lo).max_element().max(lo.abs().max_element()).max(hi.abs().max_element()) * 1e-5 + 1e-30;
+            let pad = ((hi - lo).max_element().max(lo.abs().max_element()).max(hi.abs().max_element()) * 1e-5)
+                .max(scene_pad)
+                + 1e-30;
             Bounds(Aabb::new((lo - pad).as_vec3().into(), (hi + pad).as_vec3().into()))
         })
         .collect();
@@ -195,7 +205,9 @@ fn trace(bvh: &Bvh2, tris: &[Tri], o: DVec3, d: DVec3, center: DVec2, vp: &DMat4
                 u >= 0.0 && v >= 0.0 && u + v <= 1.0
             }
         };
-        if inside && (0.0..=1.0).contains(&tt) {
+        // Depth in [0, 1): the far plane itself is clipped, as the cleared depth buffer
+        // (1.0) rejects it on the GPU.
+        if inside && (0.0..1.0).contains(&tt) {
             let p = o + d * tt;
             let c = *vp * p.extend(1.0);
             let color = t.c[0] * (1.0 - u - v) + t.c[1] * u + t.c[2] * v;

@@ -141,8 +141,13 @@ impl Renderer {
                 "{width} x {height} passes the adapter's largest texture ({max} x {max}): render at most {max} pixels a side"
             )));
         }
+        // The census keeps a count per pixel in one storage binding.
+        method::check_per_pixel(gpu.max_binding_bytes(), width, height, "the fragment census", 4)?;
         let shared = Shared::new(&gpu);
         let targets = Targets::new(&gpu, width, height, &shared.targets_layout, &shared.counts_layout);
+        // Allocation failures are reported through the error handler: surface them now,
+        // rather than at the first render.
+        gpu.take_error()?;
         let timer = PassTimer::new(&gpu);
         let limits = Limits { max_binding_bytes: gpu.max_binding_bytes() };
         Ok(Self { gpu, width, height, shared, targets, scene: None, methods: HashMap::new(), timer, limits })
@@ -213,6 +218,7 @@ impl Renderer {
             max_depth_complexity,
             fragments,
             frame_uniform: &self.shared.uniform,
+            limits: self.limits,
         };
         let report = method.render(&mut cx)?;
         let pass_times = self.timer.read(&gpu)?;

@@ -149,23 +149,30 @@ pub fn storage_buffer(device: &wgpu::Device, label: &str, size: u64, extra: wgpu
     })
 }
 
-/// Maps `buffer` (MAP_READ), waits, and returns a copy of its first `size` bytes.
+/// Maps `buffer` (MAP_READ), waits, and returns a copy of its first `size` bytes. The
+/// buffer is unmapped on every path, so a failed frame leaves it usable for the next.
 pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> crate::error::Result<Vec<u8>> {
+    use crate::error::OitError;
     let slice = buffer.slice(..size);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    gpu.wait()?;
-    rx.recv()
-        .map_err(|_| crate::error::OitError::Device("buffer map callback was dropped".into()))?
-        .map_err(|e| crate::error::OitError::Device(format!("mapping a readback buffer failed: {e}")))?;
-    let data = slice
-        .get_mapped_range()
-        .map_err(|e| crate::error::OitError::Device(format!("reading a mapped buffer failed: {e:?}")))?
-        .to_vec();
-    buffer.unmap();
-    Ok(data)
+    let waited = gpu.wait();
+    let mapped = match rx.try_recv() {
+        Ok(Ok(())) => true,
+        Ok(Err(e)) => return Err(waited.err().unwrap_or_else(|| OitError::Device(format!("mapping a readback buffer failed: {e}")))),
+        Err(_) => false,
+    };
+    let data = if mapped {
+        let view = slice.get_mapped_range().map(|v| v.to_vec());
+        buffer.unmap();
+        view.map_err(|e| OitError::Device(format!("reading a mapped buffer failed: {e:?}")))
+    } else {
+        Err(OitError::Device("a readback buffer was not mapped after the GPU finished".into()))
+    };
+    waited?;
+    data
 }
 
 /// Reads a float texture back into a row-major Vec (row padding removed).

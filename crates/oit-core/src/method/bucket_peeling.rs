@@ -90,13 +90,7 @@ impl Method for Buckets {
         let pixels = t.width as u64 * t.height as u64;
         let p = self.pipelines.as_ref().expect("built above");
         let color_bytes = pixels * buckets as u64 * 16;
-        if color_bytes > cx.gpu.max_binding_bytes() {
-            return Err(OitError::OutOfMemory(format!(
-                "bucket_peeling with {buckets} buckets needs {color_bytes} bytes of colors at this size, past the \
-                 adapter's {}-byte storage binding limit: use fewer buckets or a smaller frame",
-                cx.gpu.max_binding_bytes()
-            )));
-        }
+        cx.check_per_pixel(&format!("bucket_peeling with {buckets} buckets"), 16 * buckets as u64)?;
         if self.buffers.as_ref().is_none_or(|b| b.key != (pixels, buckets)) {
             let bounds = storage_buffer(d, "bucket bounds", pixels * 8, wgpu::BufferUsages::empty());
             let keys = storage_buffer(d, "bucket keys", pixels * buckets as u64 * 8, wgpu::BufferUsages::empty());

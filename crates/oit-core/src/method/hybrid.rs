@@ -3,7 +3,7 @@
 //! fixed point so that frames do not depend on fragment order (docs/methods.md).
 
 use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
-use crate::error::{OitError, Result};
+use crate::error::Result;
 use crate::pipeline;
 use crate::shader::{self, Const};
 use crate::targets::{read_buffer, storage_buffer};
@@ -110,19 +110,10 @@ impl Hybrid {
         }
         self.buffers = None;
         let d = &cx.gpu.device;
-        let max = cx.gpu.max_binding_bytes();
+        let name = if self.tail { "hybrid" } else { "ktab" };
+        cx.check_per_pixel(&format!("{name} with k = {k}"), 4 * (k as u64).max(ACCUM_WORDS))?;
         let ktab_bytes = pixels * k as u64 * 4;
         let accum_bytes = pixels * ACCUM_WORDS * 4;
-        if ktab_bytes.max(accum_bytes) > max {
-            let per_pixel = (k as u64 * 4).max(ACCUM_WORDS * 4);
-            return Err(OitError::OutOfMemory(format!(
-                "hybrid with k = {k} needs {ktab_bytes}-byte buffers at this size, past the adapter's {max}-byte \
-                 storage binding limit: use at most {} pixels (e.g. {} x {}) or a smaller k",
-                max / per_pixel,
-                ((max / per_pixel) as f64).sqrt() as u64,
-                ((max / per_pixel) as f64).sqrt() as u64
-            )));
-        }
         let ktab = storage_buffer(d, "k-TAB", ktab_bytes, wgpu::BufferUsages::empty());
         let vis = storage_buffer(d, "core visibility", ktab_bytes, wgpu::BufferUsages::empty());
         let accum = storage_buffer(d, "hybrid accumulators", accum_bytes, wgpu::BufferUsages::empty());

@@ -92,14 +92,7 @@ impl Method for Hybrid64 {
         let pixels = t.width as u64 * t.height as u64;
         let p = self.pipelines.as_ref().expect("built above");
         let ktab_bytes = pixels * k as u64 * 8;
-        if ktab_bytes.max(pixels * ACCUM_WORDS * 4) > cx.gpu.max_binding_bytes() {
-            return Err(OitError::OutOfMemory(format!(
-                "hybrid64 with k = {k} needs a {ktab_bytes}-byte k-TAB at this size, past the adapter's {}-byte storage \\
-                 binding limit: use at most {} pixels or a smaller k",
-                cx.gpu.max_binding_bytes(),
-                cx.gpu.max_binding_bytes() / (k as u64 * 8)
-            )));
-        }
+        cx.check_per_pixel(&format!("hybrid64 with k = {k}"), (8 * k as u64).max(4 * ACCUM_WORDS))?;
         if self.buffers.as_ref().is_none_or(|b| b.key != (pixels, k)) {
             let ktab = storage_buffer(d, "hybrid64 k-TAB", ktab_bytes, wgpu::BufferUsages::empty());
             let accum = storage_buffer(d, "hybrid64 tail", pixels * ACCUM_WORDS * 4, wgpu::BufferUsages::empty());

@@ -41,7 +41,7 @@ pub(crate) struct NodePool {
     pub pools: Vec<wgpu::Buffer>,
     /// Per-pixel state carried between resolve sweeps (binding 6).
     state: wgpu::Buffer,
-    state_words: u64,
+    pub state_words: u64,
     /// Binding 7: per-triangle data of the allocation pass, or per-pixel offsets.
     pub aux: wgpu::Buffer,
     aux_kind: Aux,
@@ -116,7 +116,8 @@ impl NodePool {
         }
         let aux_len = match self.aux_kind {
             Aux::None => 0,
-            Aux::PerTriangle(bytes) => triangles * bytes,
+            // At least one record: a binding must hold one element even without triangles.
+            Aux::PerTriangle(bytes) => triangles.max(1) * bytes,
             Aux::PixelOffsets => (pixels + 1) * 4,
         };
         if aux_len != self.aux_len {
@@ -298,6 +299,7 @@ impl ListMethod {
         }
         let t = cx.targets;
         let pixels = t.width as u64 * t.height as u64;
+        cx.check_per_pixel(&format!("{} (its per-pixel heads and sweep state)", self.shader.trim_end_matches(".wgsl")), 4 * self.pool.state_words.max(1))?;
         let initial = if self.pool.capacity == 0 { pixels.min(self.pool.max_nodes()) } else { self.pool.capacity };
         // A list of n fragments takes floor(n / BATCH) + 1 sweeps (the last one finds it empty).
         let sweeps = cx.max_depth_complexity / BATCH + 1;

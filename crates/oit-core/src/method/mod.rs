@@ -228,6 +228,8 @@ pub(crate) struct FrameCtx<'a> {
     pub fragments: u64,
     /// The frame uniform (`gpu_types::FrameUniform`), for methods that set its `seed`.
     pub frame_uniform: &'a wgpu::Buffer,
+    /// Limits to size buffers by (the adapter's, or lower ones the caller asked for).
+    pub limits: Limits,
 }
 
 impl FrameCtx<'_> {
@@ -245,8 +247,30 @@ impl FrameCtx<'_> {
             max_depth_complexity: self.max_depth_complexity,
             fragments: self.fragments,
             frame_uniform: self.frame_uniform,
+            limits: self.limits,
         }
     }
+
+    /// Refuses a frame whose per-pixel buffer of `bytes_per_pixel` would pass one storage
+    /// binding, naming the largest frame that fits.
+    pub fn check_per_pixel(&self, what: &str, bytes_per_pixel: u64) -> Result<()> {
+        check_per_pixel(self.limits.max_binding_bytes, self.targets.width, self.targets.height, what, bytes_per_pixel)
+    }
+}
+
+/// See [`FrameCtx::check_per_pixel`].
+pub(crate) fn check_per_pixel(limit: u64, width: u32, height: u32, what: &str, bytes_per_pixel: u64) -> Result<()> {
+    let pixels = width as u64 * height as u64;
+    if pixels * bytes_per_pixel <= limit {
+        return Ok(());
+    }
+    let fits = limit / bytes_per_pixel.max(1);
+    let side = (fits as f64).sqrt() as u64;
+    Err(crate::error::OitError::OutOfMemory(format!(
+        "{what} needs {} bytes at {width} x {height}, past the {limit}-byte storage binding limit: render at most \
+         {fits} pixels (e.g. {side} x {side})",
+        pixels * bytes_per_pixel
+    )))
 }
 
 /// What a method reports about its frame, beyond what the renderer measures.

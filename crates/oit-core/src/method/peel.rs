@@ -103,15 +103,7 @@ impl Peel {
             return Ok(());
         }
         let d = &cx.gpu.device;
-        let max = cx.gpu.max_binding_bytes();
-        if pixels * 32 > max {
-            return Err(OitError::OutOfMemory(format!(
-                "depth peeling needs {} bytes of keys at this size, past the adapter's {max}-byte storage binding \
-                 limit: render at most {} pixels",
-                pixels * 32,
-                max / 32
-            )));
-        }
+        cx.check_per_pixel("depth peeling", 4 * PEEL_WORDS.max(8))?;
         let keys = storage_buffer(d, "peel keys", pixels * 32, wgpu::BufferUsages::empty());
         let layers = storage_buffer(d, "peel layers", pixels * 32, wgpu::BufferUsages::empty());
         let acc = storage_buffer(d, "peel accumulators", pixels * PEEL_WORDS * 4, wgpu::BufferUsages::empty());

@@ -111,14 +111,7 @@ impl Method for Stochastic {
         let d = &cx.gpu.device;
         let p = self.pipelines.as_ref().expect("built above");
         let pixels = t.width as u64 * t.height as u64;
-        if pixels * samples as u64 * 4 > cx.gpu.max_binding_bytes() {
-            return Err(OitError::OutOfMemory(format!(
-                "stochastic with {samples} samples needs {} bytes at this size, past the adapter's {}-byte storage \
-                 binding limit: use fewer samples or a smaller frame",
-                pixels * samples as u64 * 4,
-                cx.gpu.max_binding_bytes()
-            )));
-        }
+        cx.check_per_pixel(&format!("stochastic with {samples} samples"), 4 * samples as u64)?;
         let key = (t.width, t.height, samples);
         if self.buffers.as_ref().is_none_or(|b| b.key != key) {
             let samples_buf = storage_buffer(d, "stochastic samples", pixels * samples as u64 * 4, wgpu::BufferUsages::empty());
