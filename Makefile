@@ -3,7 +3,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 export CARGO_TARGET_DIR ?= $(HOME)/.cache/oit/target
 
-.PHONY: setup demo test test-rust test-python bench
+.PHONY: setup demo test test-rust test-python bench viewer
 
 setup:
 	bash scripts/setup.sh
@@ -21,3 +21,7 @@ test-python:
 
 bench: setup
 	$(PY) -m oit bench --out out/bench
+
+# The interactive viewer (crates/oit-viewer, docs/viewer.md); `python -m oit view` finds it here.
+viewer:
+	cargo build --release -p oit-viewer

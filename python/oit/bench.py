@@ -1,124 +1,273 @@
 """`python -m oit bench`: time, memory and error of every method against the exact A-buffer
-on the built-in scenes, with the floor (one plain blended pass over the same geometry)
-measured in the same run, so that times compare across machines as ratios."""
+on the built-in scenes, with the floor (one plain blended pass over the same geometry,
+`unsorted`) measured in the same run, so that times compare across machines as ratios.
+
+Methods and their parameter values come from `oit.methods()` (a few values across each
+declared range), so new methods join without changes here. A method that fails (an adapter
+limit, a memory budget) gives a row marked failed with the message. With pygfx installed the
+same scenes go through its alpha modes too (oit.peers). Writes results.csv, results.md, and
+with matplotlib the plots of oit.plots into --out."""
 
 from __future__ import annotations
 
 import argparse
 import csv
+import inspect
+import itertools
+import math
 import os
 import statistics
 import sys
 import time
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
 
+from . import formulas, peers
 from . import scenes as scene_lib
-from ._api import Renderer
+from ._api import Renderer, methods as list_methods
+from .imageio import linear_to_srgb
 
-# Parameter sweeps per method (one row per value).
-SWEEPS: dict[str, list[dict[str, Any]]] = {
-    "abuffer": [{}],
-    "unsorted": [{}],
-    "sorted": [{}],
-    "hybrid": [{"k": k} for k in (1, 2, 4, 8, 16, 32)],
-    "ktab": [{"k": k} for k in (4, 8, 16, 32)],
-    "wavg": [{}],
-    "wsum": [{}],
-    "wboit": [{"weight": "eq10"}, {"weight": "eq7"}],
-    "adaptive": [{"nodes": n} for n in (4, 8, 16)],
+# Values tried for integer parameters (k, nodes, samples, layers), clipped to the declared range.
+INT_SWEEP = (1, 2, 4, 8, 16, 32)
+QUICK_SIZE = 64  # --quick caps frames at this size: a smoke test of the bench, not a measurement
+# --quick also thins the scenes: depth peeling costs a geometry pass per layer, so a full hair
+# (192,000 triangles, 340 layers) takes 25 s even at 64 x 64 on lavapipe.
+QUICK_SCENE_ARGS: dict[str, dict[str, Any]] = {
+    "hair": {"strands": 600}, "smoke": {"particles": 150}, "foliage": {"leaves": 1500}, "dragons": {"max_triangles": 800},
 }
-QUICK_SWEEPS: dict[str, list[dict[str, Any]]] = {
-    "abuffer": [{}], "unsorted": [{}], "hybrid": [{"k": 4}, {"k": 8}], "ktab": [{"k": 8}],
-    "wavg": [{}], "wboit": [{}], "adaptive": [{"nodes": 8}],
-}
+# Parameters that choose a random stream rather than a point on the speed-accuracy trade.
+HELD_AT_DEFAULT = ("seed",)
+ERRORS = ("mean_err", "mean_err_all", "max_err", "rmse", "psnr", "flip")
+Params = dict[str, Any]
 
 
-def rgb_errors(image: np.ndarray, exact: np.ndarray, mask: np.ndarray) -> dict[str, float]:
-    """Per-pixel RGB distance (the hybrid paper's measure) over the pixels with at least one
-    transparent fragment: mean and max, RMSE over channels, PSNR (peak 1); `mean_err_all`
-    is the mean over every pixel of the frame (background pixels count as 0 error)."""
+def sweep(method: dict, quick: bool = False) -> list[Params]:
+    """Parameter sets to run for one entry of oit.methods(): each parameter varied alone over
+    its range, the others at their defaults (ints: INT_SWEEP within [min, max]; choices: all;
+    floats: min and max), always including the default. --quick runs the defaults only."""
+    defaults = {p["name"]: p["default"] for p in method["params"]}
+    if quick or not method["params"]:
+        return [defaults]
+    runs: list[Params] = []
+    for p in method["params"]:
+        if p["name"] in HELD_AT_DEFAULT:
+            continue
+        if p["type"] == "choice":
+            values = list(p["choices"])
+        elif p["type"] == "int":
+            values = sorted({v for v in INT_SWEEP if p["min"] <= v <= p["max"]} | {p["default"]})
+        else:
+            values = sorted({p["min"], p["default"], p["max"]})
+        runs += [run for run in ({**defaults, p["name"]: v} for v in values) if run not in runs]
+    return runs
+
+
+def flip_missing() -> str | None:
+    """Why mean FLIP cannot be computed here, or None when it can."""
+    try:
+        import flip_evaluator  # noqa: F401
+    except ImportError as e:
+        return f"the flip column is empty: flip-evaluator is not installed ({e}); `pip install flip-evaluator` adds it"
+    return None
+
+
+def image_errors(image: np.ndarray, exact: np.ndarray, covered: np.ndarray, flip: bool = True) -> dict[str, float]:
+    """Errors of `image` against `exact` (both linear): the per-pixel RGB distance (the hybrid
+    paper's measure) averaged (`mean_err`) and maximized (`max_err`) over the pixels with at
+    least one transparent fragment (`covered`), its mean over every pixel (`mean_err_all`),
+    RMSE over channels of covered pixels, PSNR (peak 1), and the mean FLIP of the sRGB-encoded
+    images over the whole frame (NaN without flip-evaluator)."""
     d = image[..., :3].astype(np.float64) - exact[..., :3].astype(np.float64)
     full = np.sqrt((d ** 2).sum(-1))
-    dist = full[mask]
-    if dist.size == 0:
-        return {"mean_err": 0.0, "mean_err_all": 0.0, "max_err": 0.0, "rmse": 0.0, "psnr": float("inf")}
-    rmse = float(np.sqrt((d[mask] ** 2).mean()))
-    return {
-        "mean_err": float(dist.mean()),
-        "mean_err_all": float(full.mean()),
-        "max_err": float(dist.max()),
-        "rmse": rmse,
-        "psnr": float("inf") if rmse == 0 else float(20 * np.log10(1.0 / rmse)),
-    }
+    out = {"mean_err": 0.0, "mean_err_all": float(full.mean()), "max_err": 0.0, "rmse": 0.0, "psnr": math.inf}
+    if covered.any():
+        rmse = float(np.sqrt((d[covered] ** 2).mean()))
+        out.update(mean_err=float(full[covered].mean()), max_err=float(full[covered].max()), rmse=rmse,
+                   psnr=math.inf if rmse == 0 else float(20 * np.log10(1.0 / rmse)))
+    out["flip"] = flip_error(image, exact) if flip and flip_missing() is None else math.nan
+    return out
 
 
-def measure(renderer: Renderer, built: scene_lib.BuiltScene, method: str, params: dict, repeat: int) -> tuple[Any, dict]:
+def flip_error(image: np.ndarray, exact: np.ndarray) -> float:
+    """Mean FLIP (LDR) of the two images, sRGB-encoded as a display would show them."""
+    import flip_evaluator
+
+    srgb = lambda a: np.ascontiguousarray(linear_to_srgb(a[..., :3]), dtype=np.float32)  # noqa: E731
+    return float(flip_evaluator.evaluate(srgb(exact), srgb(image), "LDR", inputsRGB=True, applyMagma=False)[1])
+
+
+def timed(render: Callable[[], Any], repeat: int) -> tuple[Any, list[float], list[float]]:
     """Renders once to warm up (pipelines, pool sizes), then `repeat` times; returns the last
-    frame and the medians of GPU and wall time."""
-    frame = renderer.render(built.scene, built.camera, method, **params)
+    frame, the GPU times (where the adapter has timestamps) and the wall times in ms."""
+    frame = render()
     gpu, wall = [], []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        frame = renderer.render(built.scene, built.camera, method, **params)
+        frame = render()
         wall.append((time.perf_counter() - t0) * 1e3)
-        if frame.stats["gpu_time_ms"] is not None:
+        if frame.stats.get("gpu_time_ms") is not None:
             gpu.append(frame.stats["gpu_time_ms"])
-    return frame, {
-        "gpu_ms": statistics.median(gpu) if gpu else float("nan"),
-        "wall_ms": statistics.median(wall),
-    }
+    return frame, gpu, wall
 
 
-def progress(i: int, n: int, label: str) -> None:
-    width = 28
-    done = int(width * i / max(n, 1))
-    sys.stderr.write(f"\r[{'#' * done}{'.' * (width - done)}] {i}/{n} {label[:40]:<40}")
-    sys.stderr.flush()
-    if i == n:
-        sys.stderr.write("\n")
+class Progress:
+    """A one-line progress bar on stderr: done/total, elapsed time, the current row."""
+
+    def __init__(self, total: int, enabled: bool = True) -> None:
+        self.total, self.done, self.enabled, self.start = total, 0, enabled, time.perf_counter()
+
+    def show(self, label: str) -> None:
+        if not self.enabled:
+            return
+        width = 28
+        filled = int(width * self.done / max(self.total, 1))
+        elapsed = time.perf_counter() - self.start
+        sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {self.done}/{self.total} {elapsed:6.0f}s {label[:44]:<44}")
+        sys.stderr.flush()
+
+    def step(self, label: str) -> None:
+        self.done += 1
+        self.show(label)
+        if self.done == self.total and self.enabled:
+            sys.stderr.write("\n")
 
 
-def run(scenes: list[str], methods: list[str] | None, size: int | None, repeat: int, quick: bool) -> list[dict]:
-    sweeps = QUICK_SWEEPS if quick else SWEEPS
-    chosen = [m for m in sweeps if methods is None or m in methods]
-    rows: list[dict] = []
-    jobs = [(s, m, p) for s in scenes for m in chosen for p in sweeps[m]]
-    done = 0
-    for scene_name in scenes:
-        kwargs = {"strands": 1500} if quick and scene_name == "hair" else {}
-        built = scene_lib.SCENES[scene_name](**kwargs)
+@dataclass
+class Result:
+    """A bench run: one row per scene x size x method x parameter set (peers included), and
+    for the image sheets the exact image and each method's default-parameter image."""
+
+    rows: list[dict]
+    sheets: dict[tuple[str, str], dict[str, np.ndarray]] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+
+def _row(scene: str, size: str, method: str, params: Params, **values: Any) -> dict:
+    row = {"scene": scene, "size": size, "method": method, "params": " ".join(f"{k}={v}" for k, v in params.items()),
+           "status": "ok", "gpu_ms": math.nan, "wall_ms": math.nan, "memory_mib": math.nan, "formula_mib": math.nan,
+           "fragments": math.nan, "max_depth": math.nan, "overflow": math.nan, **{e: math.nan for e in ERRORS},
+           "adapter": "", "message": ""}
+    row.update(values)
+    return row
+
+
+def _build(name: str, size: int | None, quick: bool) -> scene_lib.BuiltScene:
+    """Builds a scene (thinned for --quick); one whose geometry depends on the frame (stacks:
+    one stack per pixel) is built for the size."""
+    builder = scene_lib.SCENES[name]
+    kwargs = dict(QUICK_SCENE_ARGS.get(name, {})) if quick else {}
+    if size and "size" in inspect.signature(builder).parameters:
+        kwargs["size"] = (size, size)
+    return builder(**kwargs)
+
+
+def run(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | None = None, repeat: int = 5,
+        quick: bool = False, with_peers: bool = True, show_progress: bool = True) -> Result:
+    """Measures every method of oit.methods() (or those named) on each scene at each size
+    (default: the scene's own; --quick caps it at QUICK_SIZE)."""
+    infos = [m for m in list_methods() if methods is None or m["name"] in methods]
+    if methods is not None:
+        unknown = sorted(set(methods) - {m["name"] for m in list_methods()})
+        if unknown:
+            raise ValueError(f"unknown method(s) {', '.join(unknown)}; `python -m oit methods` lists them")
+    # (method, parameters, whether they are the defaults: those rows go on the image sheet)
+    plan = [(m["name"], p, p == sweep(m, quick=True)[0]) for m in infos for p in sweep(m, quick)]
+    peer_reason = peers.pygfx_missing() if with_peers else "peers not requested (--no-peers)"
+    peer_modes = peers.PYGFX_MODES if peer_reason is None else ()
+    result = Result(rows=[])
+    if peer_reason and with_peers:
+        result.notes.append(f"pygfx rows are missing: {peer_reason}")
+    if flip_missing():
+        result.notes.append(flip_missing())
+    jobs = [(s, z) for s in scenes for z in (sizes or [None])]
+    progress = Progress(len(jobs) * (2 + len(plan) + len(peer_modes)), show_progress)
+    renderers: dict[tuple[int, int], Renderer] = {}  # one per size: pipelines compile once
+    for scene_name, size in jobs:
+        built = _build(scene_name, size, quick)
         w, h = (size, size) if size else built.size
         if quick:
-            w, h = min(w, 192), min(h, 192)
-        renderer = Renderer(w, h)
-        exact, _ = measure(renderer, built, "abuffer", {}, 1)
-        covered = exact.depth_complexity > 0
-        _, floor = measure(renderer, built, "unsorted", {}, repeat)
-        for method in chosen:
-            for params in sweeps[method]:
-                progress(done, len(jobs), f"{scene_name} {method} {params}")
-                frame, t = measure(renderer, built, method, params, repeat)
-                s = frame.stats
-                row = {
-                    "scene": scene_name, "size": f"{w}x{h}", "method": method,
-                    "params": " ".join(f"{k}={v}" for k, v in params.items()),
-                    "gpu_ms": t["gpu_ms"], "wall_ms": t["wall_ms"],
-                    "x_floor": t["gpu_ms"] / floor["gpu_ms"],
-                    "memory_mib": s["memory_bytes"] / 2 ** 20,
-                    "fragments": s["fragments"], "max_depth": s["max_depth_complexity"],
-                    "overflow": s["overflow_fragments"],
-                    **rgb_errors(frame.image, exact.image, covered),
-                    "adapter": s["adapter"],
-                }
-                rows.append(row)
-                done += 1
-    progress(done, len(jobs), "done")
-    abuffer_ms = {r["scene"]: r["gpu_ms"] for r in rows if r["method"] == "abuffer"}
-    for r in rows:
-        r["abuffer_speedup"] = abuffer_ms.get(r["scene"], float("nan")) / r["gpu_ms"]
-    return rows
+            w, h = min(w, QUICK_SIZE), min(h, QUICK_SIZE)
+        if (w, h) not in renderers:
+            renderers[(w, h)] = Renderer(w, h)
+        renderer = renderers[(w, h)]
+        _run_scene(result, scene_name, built, renderer, plan, peer_modes, repeat, progress)
+    return result
+
+
+def _run_scene(result: Result, scene_name: str, built: scene_lib.BuiltScene, renderer: Renderer,
+               plan: list[tuple[str, Params, bool]], peer_modes: tuple[str, ...], repeat: int, progress: Progress) -> None:
+    w, h = renderer.width, renderer.height
+    size = f"{w}x{h}"
+    adapter = renderer.adapter_info["name"]
+    progress.show(f"{scene_name} {size} abuffer (reference)")
+    try:
+        exact_frame = renderer.render(built.scene, built.camera, "abuffer")
+        exact, covered = exact_frame.image, exact_frame.depth_complexity > 0
+    except (RuntimeError, MemoryError) as e:
+        exact, covered = None, None
+        result.notes.append(f"{scene_name} {size}: no errors, the exact A-buffer failed: {e}")
+    progress.step(f"{scene_name} {size} floor")
+    floor = {"gpu_ms": math.nan, "wall_ms": math.nan}
+    try:
+        _, floor_gpu, floor_wall = timed(lambda: renderer.render(built.scene, built.camera, "unsorted"), repeat)
+        floor = {"gpu_ms": statistics.median(floor_gpu) if floor_gpu else math.nan, "wall_ms": statistics.median(floor_wall)}
+    except RuntimeError as e:
+        result.notes.append(f"{scene_name} {size}: no ratios to the floor, `unsorted` failed: {e}")
+    progress.step(f"{scene_name} {size}")
+    rows: list[dict] = []
+    sheet = {} if exact is None else {"abuffer": exact}
+    for method, params, is_default in plan:
+        progress.show(f"{scene_name} {size} {method} {' '.join(map(str, params.values()))}")
+        try:
+            frame, gpu, wall = timed(lambda: renderer.render(built.scene, built.camera, method, **params), repeat)
+        except (RuntimeError, MemoryError, ValueError) as e:
+            rows.append(_row(scene_name, size, method, params, status="failed", adapter=adapter, message=str(e).splitlines()[0]))
+            progress.step(method)
+            continue
+        s = frame.stats
+        formula = formulas.memory_bytes(method, w, h, **params)
+        row = _row(scene_name, size, method, params, gpu_ms=statistics.median(gpu) if gpu else math.nan,
+                   wall_ms=statistics.median(wall), memory_mib=s["memory_bytes"] / 2 ** 20,
+                   formula_mib=math.nan if formula is None else formula / 2 ** 20, fragments=s["fragments"],
+                   max_depth=s["max_depth_complexity"], overflow=s["overflow_fragments"], adapter=adapter)
+        if exact is not None:
+            row.update(image_errors(frame.image, exact, covered))
+            if is_default:
+                sheet[method] = frame.image
+        rows.append(row)
+        progress.step(method)
+    for mode in peer_modes:
+        rows.append(_peer_row(scene_name, built, w, h, mode, repeat, exact, covered, sheet))
+        progress.step(f"pygfx {mode}")
+    for row in rows:
+        row["x_floor"] = row["gpu_ms"] / floor["gpu_ms"]
+        row["wall_x_floor"] = row["wall_ms"] / floor["wall_ms"]
+    abuffer = next((r for r in rows if r["method"] == "abuffer" and r["status"] == "ok"), None)
+    for row in rows:
+        row["abuffer_speedup"] = abuffer["gpu_ms"] / row["gpu_ms"] if abuffer else math.nan
+    result.rows += rows
+    result.sheets[(scene_name, size)] = sheet
+
+
+def _peer_row(scene_name: str, built: scene_lib.BuiltScene, w: int, h: int, mode: str, repeat: int,
+              exact: np.ndarray | None, covered: np.ndarray | None, sheet: dict[str, np.ndarray]) -> dict:
+    label = f"pygfx-{mode}"
+    try:
+        pg = peers.pygfx_renderer(w, h)
+        pg.render(built, mode)  # warm-up: shaders and pipelines
+        wall, image = [], None
+        for _ in range(repeat):
+            image, ms = pg.render(built, mode)
+            wall.append(ms)
+    except Exception as e:  # noqa: BLE001 - a third-party renderer fails in its own ways; the row says how
+        return _row(scene_name, f"{w}x{h}", label, {}, status="failed", message=f"{type(e).__name__}: {e}".splitlines()[0])
+    row = _row(scene_name, f"{w}x{h}", label, {}, wall_ms=statistics.median(wall), adapter=pg.adapter)
+    if exact is not None:
+        row.update(image_errors(image, exact, covered))
+        sheet[label] = image
+    return row
 
 
 FIGURE7_KS = (1, 2, 4, 8, 16)
@@ -134,7 +283,7 @@ def figure7_errors(renderer: Renderer, layers: int, alphas: str, seed: int = 0) 
     (oit.scenes.stacks, black background), mean RGB distance to the exact A-buffer for wavg
     (k = 0) and for hybrid, ktab and adaptive at each k in FIGURE7_KS."""
     built = scene_lib.stacks(layers=layers, alphas=alphas, size=(renderer.width, renderer.height), seed=seed)
-    render = lambda m, **p: renderer.render(built.scene, built.camera, m, background=(0.0, 0.0, 0.0), **p).image
+    render = lambda m, **p: renderer.render(built.scene, built.camera, m, background=(0.0, 0.0, 0.0), **p).image  # noqa: E731
     exact = render("abuffer")
     errors = {("wavg", 0): mean_rgb_distance(render("wavg"), exact)}
     for k in FIGURE7_KS:
@@ -157,44 +306,77 @@ def figure7_table(size: int = 20) -> str:
     return "\n".join(lines)
 
 
+# Markdown columns and formats; every row field goes to the CSV.
 COLUMNS = [
-    ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("params", "{}"), ("gpu_ms", "{:.2f}"),
-    ("x_floor", "{:.2f}"), ("abuffer_speedup", "{:.2f}"), ("wall_ms", "{:.1f}"), ("memory_mib", "{:.2f}"),
-    ("mean_err", "{:.5f}"), ("mean_err_all", "{:.5f}"), ("max_err", "{:.4f}"), ("rmse", "{:.5f}"), ("psnr", "{:.1f}"), ("overflow", "{}"),
+    ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("params", "{}"), ("gpu_ms", "{:.2f}"), ("x_floor", "{:.2f}"),
+    ("abuffer_speedup", "{:.2f}"), ("wall_ms", "{:.1f}"), ("wall_x_floor", "{:.2f}"), ("memory_mib", "{:.2f}"),
+    ("mean_err", "{:.5f}"), ("mean_err_all", "{:.5f}"), ("max_err", "{:.4f}"), ("rmse", "{:.5f}"), ("psnr", "{:.1f}"),
+    ("flip", "{:.4f}"), ("max_depth", "{}"), ("overflow", "{}"),
 ]
 
 
+def _cell(value: Any, fmt: str) -> str:
+    if isinstance(value, float) and math.isnan(value):
+        return ""
+    return fmt.format(value)
+
+
 def markdown(rows: list[dict]) -> str:
-    head = "| " + " | ".join(c for c, _ in COLUMNS) + " |"
-    sep = "|" + "|".join("---" for _ in COLUMNS) + "|"
+    """The rows as a Markdown table; failed rows carry their message in the last column."""
+    head = "| " + " | ".join(c for c, _ in COLUMNS) + " | note |"
+    sep = "|" + "---|" * (len(COLUMNS) + 1)
     lines = [head, sep]
     for r in rows:
-        lines.append("| " + " | ".join(f.format(r[c]) for c, f in COLUMNS) + " |")
+        note = f"failed: {r['message']}" if r["status"] != "ok" else ""
+        lines.append("| " + " | ".join(_cell(r[c], f) for c, f in COLUMNS) + f" | {note} |")
     return "\n".join(lines)
 
 
+def write_csv(path: str, rows: list[dict]) -> None:
+    fields = list(dict.fromkeys(itertools.chain.from_iterable(rows)))
+    with open(path, "w", newline="") as f:
+        wr = csv.DictWriter(f, fieldnames=fields)
+        wr.writeheader()
+        wr.writerows({k: ("" if isinstance(v, float) and math.isnan(v) else v) for k, v in r.items()} for r in rows)
+
+
 def add_arguments(ap: argparse.ArgumentParser) -> None:
-    ap.add_argument("--scenes", nargs="+", default=["hair"], choices=sorted(scene_lib.SCENES))
-    ap.add_argument("--methods", nargs="+", default=None, help="methods to run (default: all)")
-    ap.add_argument("--sizes", type=int, default=None, help="square frame size (default: the scene's)")
+    ap.add_argument("--scenes", nargs="+", default=list(scene_lib.SHOWCASE), choices=sorted(scene_lib.SCENES),
+                    help="scenes to run (default: %(default)s)")
+    ap.add_argument("--methods", nargs="+", default=None, help="methods to run (default: every method of `oit methods`)")
+    ap.add_argument("--sizes", type=int, nargs="+", default=None, help="square frame sizes (default: each scene's own)")
     ap.add_argument("--repeat", type=int, default=5, help="timed renders per row after one warm-up (median)")
-    ap.add_argument("--out", default="out/bench", help="directory for results.csv and results.md")
-    ap.add_argument("--quick", action="store_true", help="small frames and few rows: a smoke test of the bench")
+    ap.add_argument("--out", default="out/bench", help="directory for results.csv, results.md and the plots")
+    ap.add_argument("--quick", action="store_true",
+                    help=f"default parameters only, one timed render, frames of at most {QUICK_SIZE} pixels: a smoke test")
+    ap.add_argument("--no-peers", action="store_true", help="skip pygfx even when it is installed")
+    ap.add_argument("--no-plots", action="store_true", help="skip the matplotlib plots")
     ap.add_argument("--figure7", action="store_true", help="also run the hybrid paper's Figure 7 experiment (400 stacks)")
 
 
 def run_cli(a: argparse.Namespace) -> int:
-    rows = run(a.scenes, a.methods, a.sizes, 1 if a.quick else max(1, a.repeat), a.quick)
+    result = run(a.scenes, a.methods, a.sizes, 1 if a.quick else max(1, a.repeat), a.quick, with_peers=not a.no_peers)
     os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "results.csv"), "w", newline="") as f:
-        wr = csv.DictWriter(f, fieldnames=list(rows[0]))
-        wr.writeheader()
-        wr.writerows(rows)
+    rows = result.rows
+    write_csv(os.path.join(a.out, "results.csv"), rows)
+    adapters = ", ".join(dict.fromkeys(r["adapter"] for r in rows if r["adapter"]))
+    notes = "".join(f"Note: {n}\n" for n in result.notes)
     table = markdown(rows)
     with open(os.path.join(a.out, "results.md"), "w") as f:
-        f.write(f"Adapter: {rows[0]['adapter']}\n\n{table}\n")
-    print(f"adapter: {rows[0]['adapter']}")
+        f.write(f"Adapter: {adapters}\n\n{notes}\n{table}\n")
+    print(f"adapter: {adapters}")
+    for n in result.notes:
+        print(f"note: {n}")
     print(table)
+    if not a.no_plots:
+        from . import plots
+
+        missing = plots.matplotlib_missing()
+        if missing:
+            print(f"note: no plots: {missing}")
+        else:
+            for path in plots.write_all(result, a.out):
+                print(f"wrote {path}")
     if a.figure7:
         fig7 = figure7_table()
         with open(os.path.join(a.out, "figure7.md"), "w") as f:

@@ -173,6 +173,47 @@ def _bench(args: argparse.Namespace) -> int:
     return bench.run_cli(args)
 
 
+# ---- view
+
+
+def _add_view(p: argparse.ArgumentParser) -> None:
+    p.add_argument("files", nargs="*", metavar="FILE", help=".oitscene, OBJ, PLY, STL, glTF or GLB files")
+    p.add_argument("--scene", default=None, help="a built-in scene: hair, smoke, foliage, dragons, glass, stacks")
+    p.add_argument("-m", "--method", default=None, help="the method to start with (default: hybrid)")
+    p.add_argument("--alpha", type=_unit_float, default=None, help="alpha of every transparent mesh")
+    p.add_argument("--param", type=str, action="append", default=[], metavar="NAME=VALUE",
+                   help="a parameter of the method; repeat for several")
+    p.add_argument("--screenshot", default=None, metavar="PATH", help="save the window as PNG and exit")
+    p.add_argument("--frames", type=_positive_int, default=None, help="frames to run before --screenshot (default: 3)")
+    p.add_argument("--compare", choices=("off", "split", "toggle"), default=None, help="compare with abuffer")
+    p.add_argument("--view", choices=("image", "complexity", "error"), default=None, help="what the view shows")
+    p.add_argument("--size", type=_positive_int, nargs=2, metavar=("W", "H"), default=None, help="window size in points")
+    p.add_argument("--adapter", default=None, help="substring of the adapter name (default: OIT_ADAPTER or the best one)")
+    p.add_argument("--export", default=None, metavar="PATH",
+                   help="write the --scene to a scene file instead of starting the viewer")
+
+
+def _view(args: argparse.Namespace) -> int:
+    from . import view
+
+    if args.export is not None:
+        if args.scene is None:
+            raise ValueError("--export writes the --scene NAME: name a scene")
+        _ensure_parent(args.export)
+        view.export_scene(args.scene, args.export)
+        print(f"wrote {args.export}")
+        return 0
+    extra: List[str] = []
+    for flag, value in (("--method", args.method), ("--alpha", args.alpha), ("--screenshot", args.screenshot),
+                        ("--frames", args.frames), ("--compare", args.compare), ("--view", args.view),
+                        ("--size", args.size), ("--adapter", args.adapter)):
+        if value is not None:
+            extra += [flag, *map(str, value if isinstance(value, list) else [value])]
+    for p in args.param:
+        extra += ["--param", p]
+    return view.run(args.files, scene=args.scene, extra=extra)
+
+
 Subcommand = Tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]
 
 SUBCOMMANDS: Sequence[Subcommand] = (
@@ -180,6 +221,7 @@ SUBCOMMANDS: Sequence[Subcommand] = (
     ("render", "render a mesh file with one method into a PNG", _add_render, _render),
     ("methods", "list the methods with their properties and parameters", _add_methods, _methods),
     ("bench", "time, memory and error of every method against the exact A-buffer", _add_bench, _bench),
+    ("view", "open meshes or a built-in scene in the interactive viewer (crates/oit-viewer)", _add_view, _view),
 )
 
 

@@ -127,3 +127,69 @@ def torus(center: Vec3 = (0.0, 0.0, 0.0), major_radius: float = 1.0, minor_radiu
     a0, a1, b0, b1 = idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1)
     tris = np.concatenate([np.stack([a0, b1, b0], -1).reshape(-1, 3), np.stack([a0, a1, b1], -1).reshape(-1, 3)])
     return _out(positions.reshape(-1, 3), tris)
+
+
+def blob(center: Vec3 = (0.0, 0.0, 0.0), size: Union[float, Vec3] = 1.0, bumps: float = 0.3, rings: int = 24,
+         segments: int = 48, seed: int = 0) -> Mesh:
+    """A closed, non-convex lump: a uv_sphere whose radius is modulated by a few random
+    low-frequency waves (amplitude `bumps`), then scaled by `size` per axis. It folds over
+    itself enough that a ray crosses it four or more times in places, like a scanned figure."""
+    s = _vec3(size, "size")
+    if not (s > 0).all():
+        raise ValueError(f"size must be positive, got {size!r}")
+    if not 0 <= bumps < 0.5:
+        raise ValueError(f"bumps must be in [0, 0.5) so that the radius stays positive, got {bumps!r}")
+    positions, indices = uv_sphere(radius=1.0, rings=rings, segments=segments)
+    rng = np.random.default_rng(seed)
+    d = positions.astype(np.float64)
+    waves = rng.normal(0.0, 2.5, (4, 3))
+    phase = rng.uniform(0.0, 2 * np.pi, 4)
+    # Four waves of amplitude bumps / 2 each: the radius stays in (1 - 2 bumps, 1 + 2 bumps) > 0.
+    r = 1.0 + (bumps / 2) * np.sin(d @ waves.T + phase).sum(1)
+    return _out(_vec3(center, "center") + d * r[:, None] * s, indices)
+
+
+def decimate(positions: np.ndarray, indices: np.ndarray, max_triangles: int) -> Mesh:
+    """At most `max_triangles` triangles by vertex clustering: vertices are merged per cell of
+    a grid over the bounding box (each cluster at its mean), triangles that collapse or repeat
+    are dropped; the grid coarsens until the count fits. Topology is not preserved, which is
+    harmless for rendering a dense scan as a stand-in for itself."""
+    max_triangles = _count(max_triangles, "max_triangles", 1)
+    p = np.asarray(positions, dtype=np.float64)
+    idx = np.asarray(indices, dtype=np.int64)
+    if len(idx) <= max_triangles:
+        return _out(p, idx)
+    lo, extent = p.min(0), np.ptp(p, 0).max()
+    # A closed surface of t triangles sampled at n cells per side keeps about t * (n / sqrt(t / 2))^2
+    # triangles; start there and shrink the grid by 10% until the count fits.
+    cells = max(2.0, np.sqrt(max_triangles / 2.0))
+    while True:
+        key = np.floor((p - lo) / extent * cells).astype(np.int64)
+        _, cluster = np.unique(key, axis=0, return_inverse=True)
+        cluster = cluster.reshape(-1)
+        tris = cluster[idx]
+        keep = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
+        tris = tris[keep]
+        _, first = np.unique(np.sort(tris, axis=1), axis=0, return_index=True)
+        tris = tris[np.sort(first)]
+        if len(tris) <= max_triangles or cells <= 2.0:
+            break
+        cells = max(2.0, cells * 0.9)
+    counts = np.bincount(cluster)
+    centers = np.stack([np.bincount(cluster, weights=p[:, a]) for a in range(3)], 1) / counts[:, None]
+    c = centers[tris]
+    area2 = np.linalg.norm(np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]), axis=1)
+    tris = tris[area2 > 1e-12 * extent ** 2]  # three distinct clusters can still lie on a line
+    used, tris = np.unique(tris, return_inverse=True)
+    return _out(centers[used], tris.reshape(-1, 3))
+
+
+def vertex_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """Unit normals per vertex: the area-weighted sum of the normals of its triangles."""
+    p = np.asarray(positions, dtype=np.float64)
+    idx = np.asarray(indices, dtype=np.int64)
+    face = np.cross(p[idx[:, 1]] - p[idx[:, 0]], p[idx[:, 2]] - p[idx[:, 0]])  # length = 2 * area
+    normals = np.zeros_like(p)
+    for corner in range(3):
+        np.add.at(normals, idx[:, corner], face)
+    return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)

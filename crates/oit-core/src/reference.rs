@@ -147,7 +147,7 @@ pub fn reference(scene: &Scene, camera: &Camera, width: u32, height: u32, backgr
         .collect();
     let bvh = if tris.is_empty() { None } else { Some(build_bvh2(&bounds, BvhBuildParams::fast_build(), &mut Default::default())) };
 
-    let pixels = (width * height) as usize;
+    let pixels = width as usize * height as usize;
     let mut image = vec![0.0f64; pixels * 4];
     let mut ambiguous = vec![false; pixels];
     let mut complexity = vec![0u32; pixels];

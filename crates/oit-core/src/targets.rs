@@ -159,7 +159,8 @@ pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> crate:
         let _ = tx.send(r);
     });
     let waited = gpu.wait();
-    let mapped = match rx.try_recv() {
+    // Another thread polling the same device may be the one running the callback: wait for it.
+    let mapped = match rx.recv_timeout(std::time::Duration::from_secs(30)) {
         Ok(Ok(())) => true,
         Ok(Err(e)) => return Err(waited.err().unwrap_or_else(|| OitError::Device(format!("mapping a readback buffer failed: {e}")))),
         Err(_) => false,

@@ -2,6 +2,8 @@
 //! discarded. Two geometry passes, a visibility pass and a final composite; accumulation in
 //! fixed point so that frames do not depend on fragment order (docs/methods.md).
 
+use std::collections::HashMap;
+
 use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
 use crate::error::Result;
 use crate::pipeline;
@@ -47,12 +49,10 @@ pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
 }
 
 struct Pipelines {
-    k: u32,
     store: wgpu::RenderPipeline,
     visibility: wgpu::ComputePipeline,
     shade: wgpu::RenderPipeline,
     finish: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
 }
 
 struct Buffers {
@@ -67,21 +67,19 @@ struct Buffers {
 
 struct Hybrid {
     tail: bool,
-    pipelines: Option<Pipelines>,
+    layout: Option<wgpu::BindGroupLayout>,
+    /// Pipelines by k (k is a shader constant): switching k, as auto does, rebuilds nothing.
+    pipelines: HashMap<u32, Pipelines>,
     buffers: Option<Buffers>,
 }
 
 impl Hybrid {
     fn new(tail: bool) -> Self {
-        Self { tail, pipelines: None, buffers: None }
+        Self { tail, layout: None, pipelines: HashMap::new(), buffers: None }
     }
 
-    fn build(&self, cx: &FrameCtx<'_>, k: u32) -> Pipelines {
+    fn build(&self, cx: &FrameCtx<'_>, layout: &wgpu::BindGroupLayout, k: u32) -> Pipelines {
         let d = &cx.gpu.device;
-        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("hybrid"),
-            entries: &(0..4).map(pipeline::storage_entry).collect::<Vec<_>>(),
-        });
         let consts = [
             Const::U32("K", k),
             Const::U32("TAIL", self.tail as u32),
@@ -89,7 +87,7 @@ impl Hybrid {
             Const::F32("TAIL_SCALE", TAIL_SCALE),
         ];
         let module = shader::module(d, "hybrid.wgsl", &consts);
-        let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &layout]);
+        let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, layout]);
         let store = pipeline::geometry(d, "hybrid store", &module, &pl, "fs_store", &[], pipeline::depth_test_only());
         let shade = pipeline::geometry(d, "hybrid shade", &module, &pl, "fs_shade", &[], pipeline::depth_test_only());
         let finish = pipeline::fullscreen_with_bound(d, "hybrid final", &module, &pl, "fs_final");
@@ -101,7 +99,7 @@ impl Hybrid {
             compilation_options: Default::default(),
             cache: None,
         });
-        Pipelines { k, store, visibility, shade, finish, layout }
+        Pipelines { store, visibility, shade, finish }
     }
 
     fn reserve(&mut self, cx: &FrameCtx<'_>, pixels: u64, k: u32) -> Result<()> {
@@ -124,10 +122,9 @@ impl Hybrid {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let p = self.pipelines.as_ref().expect("built before reserve");
         let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("hybrid"),
-            layout: &p.layout,
+            layout: self.layout.as_ref().expect("made before reserve"),
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: ktab.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: vis.as_entire_binding() },
@@ -143,14 +140,20 @@ impl Hybrid {
 impl Method for Hybrid {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let k = cx.params.int("k") as u32;
-        if self.pipelines.as_ref().is_none_or(|p| p.k != k) {
-            self.pipelines = Some(self.build(cx, k));
-            self.buffers = None;
+        if self.layout.is_none() {
+            self.layout = Some(cx.gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("hybrid"),
+                entries: &(0..4).map(pipeline::storage_entry).collect::<Vec<_>>(),
+            }));
+        }
+        if !self.pipelines.contains_key(&k) {
+            let built = self.build(cx, self.layout.as_ref().expect("made above"), k);
+            self.pipelines.insert(k, built);
         }
         let t = cx.targets;
         let pixels = t.width as u64 * t.height as u64;
         self.reserve(cx, pixels, k)?;
-        let p = self.pipelines.as_ref().expect("built above");
+        let p = &self.pipelines[&k];
         let b = self.buffers.as_ref().expect("reserved above");
         let geo = &cx.scene.transparent;
         let mut enc = cx.gpu.device.create_command_encoder(&Default::default());

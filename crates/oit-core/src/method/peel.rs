@@ -103,7 +103,8 @@ impl Peel {
             return Ok(());
         }
         let d = &cx.gpu.device;
-        cx.check_per_pixel("depth peeling", 4 * PEEL_WORDS.max(8))?;
+        let name = if self.dual { "dual_depth_peeling" } else { "depth_peeling" };
+        cx.check_per_pixel(name, 4 * PEEL_WORDS.max(8))?;
         let keys = storage_buffer(d, "peel keys", pixels * 32, wgpu::BufferUsages::empty());
         let layers = storage_buffer(d, "peel layers", pixels * 32, wgpu::BufferUsages::empty());
         let acc = storage_buffer(d, "peel accumulators", pixels * PEEL_WORDS * 4, wgpu::BufferUsages::empty());

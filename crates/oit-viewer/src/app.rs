@@ -1,0 +1,439 @@
+//! The application state and its frame loop: settings, meshes, camera, and when to render.
+//! The engine renders only when something it depends on changed; the picture on screen is
+//! recomposed (CPU) when only the way of showing it changed.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use eframe::egui::{self, Color32, ColorImage, Rect, TextureHandle, TextureOptions};
+use oit_core::{Camera, Frame, GpuContext, Mesh, ParamValue, Renderer, Scene};
+
+use crate::heatmap::{self, ErrorMap};
+use crate::orbit::ViewCamera;
+use crate::scenefile::SceneData;
+use crate::{gpu, panels, screenshot, view};
+
+/// The method compare mode and the error view measure against.
+pub const EXACT: &str = "abuffer";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewMode {
+    Image,
+    Complexity,
+    Error,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compare {
+    Off,
+    Split,
+    Toggle,
+}
+
+/// What the user chose; everything here is plain data the panels edit.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    pub method: String,
+    /// Every method's parameters, defaults filled in, kept when switching methods.
+    pub params: BTreeMap<String, Vec<(String, ParamValue)>>,
+    /// Linear RGB.
+    pub background: [f32; 3],
+    pub show_opaque: bool,
+    pub view: ViewMode,
+    pub compare: Compare,
+    /// Toggle mode: showing the exact frame.
+    pub show_exact: bool,
+    /// Split mode: where the exact half starts, as a fraction of the width.
+    pub split: f32,
+    /// Error at the top of the heatmap's colormap.
+    pub error_scale: f32,
+    /// Render at this fraction of the view's pixels (software adapters are slow).
+    pub render_scale: f32,
+}
+
+impl Settings {
+    pub fn new(method: &str) -> Self {
+        let params = oit_core::methods()
+            .iter()
+            .map(|m| {
+                let p = m.resolve_params(&[]).expect("defaults are valid");
+                (m.name.to_string(), p.0.into_iter().map(|(k, v)| (k.to_string(), v)).collect())
+            })
+            .collect();
+        Self {
+            method: method.to_string(),
+            params,
+            background: [1.0; 3],
+            show_opaque: true,
+            view: ViewMode::Image,
+            compare: Compare::Off,
+            show_exact: false,
+            split: 0.5,
+            error_scale: 0.1,
+            render_scale: 1.0,
+        }
+    }
+
+    pub fn method_params(&self, method: &str) -> Vec<(String, ParamValue)> {
+        self.params.get(method).cloned().unwrap_or_default()
+    }
+
+    /// Sets one parameter of the current method.
+    pub fn set_param(&mut self, name: &str, value: ParamValue) {
+        let list = self.params.entry(self.method.clone()).or_default();
+        match list.iter_mut().find(|(k, _)| k == name) {
+            Some(slot) => slot.1 = value,
+            None => list.push((name.to_string(), value)),
+        }
+    }
+
+    pub fn needs_exact(&self) -> bool {
+        self.compare != Compare::Off || self.view == ViewMode::Error
+    }
+}
+
+/// One mesh as loaded, and what the user does to it.
+#[derive(Clone, Debug)]
+pub struct MeshControl {
+    pub name: String,
+    pub original: Mesh,
+    pub visible: bool,
+    /// The mesh's alpha when all its vertices share one, else a factor on its alphas.
+    pub alpha: f32,
+    pub uniform_alpha: bool,
+}
+
+impl MeshControl {
+    fn new(name: String, mesh: Mesh) -> Self {
+        let first = mesh.colors.first().map_or(1.0, |c| c[3]);
+        let uniform_alpha = mesh.colors.iter().all(|c| c[3] == first);
+        Self { name, original: mesh, visible: true, alpha: if uniform_alpha { first } else { 1.0 }, uniform_alpha }
+    }
+
+    fn mesh(&self) -> Mesh {
+        let mut m = self.original.clone();
+        if !m.opaque {
+            let (a, uniform) = (self.alpha, self.uniform_alpha);
+            m.colors.iter_mut().for_each(|c| c[3] = if uniform { a } else { (c[3] * a).clamp(0.0, 1.0) });
+        }
+        m
+    }
+}
+
+/// Everything one engine render depends on.
+#[derive(Clone, Debug, PartialEq)]
+struct RenderKey {
+    method: String,
+    params: Vec<(String, ParamValue)>,
+    background: [f32; 3],
+    size: [u32; 2],
+    camera: [[f64; 4]; 4],
+    scene: u64,
+}
+
+/// Everything the picture on screen depends on, beyond the frames.
+#[derive(Clone, Debug, PartialEq)]
+struct ShowKey {
+    renders: u64,
+    view: ViewMode,
+    compare: Compare,
+    show_exact: bool,
+    split: f32,
+    error_scale: f32,
+}
+
+/// `--screenshot`: after `frames` frames, grab the window, save it, and maybe quit.
+#[derive(Clone, Debug)]
+pub struct ScreenshotJob {
+    pub path: PathBuf,
+    pub frames: u32,
+    pub crop_view: bool,
+    pub exit: bool,
+    requested: bool,
+}
+
+impl ScreenshotJob {
+    pub fn new(path: PathBuf, frames: u32, crop_view: bool, exit: bool) -> Self {
+        Self { path, frames, crop_view, exit, requested: false }
+    }
+}
+
+pub struct ViewerApp {
+    pub settings: Settings,
+    pub meshes: Vec<MeshControl>,
+    pub camera: ViewCamera,
+    pub title: String,
+    pub show_panel: bool,
+    pub gpu: Result<Arc<GpuContext>, String>,
+    renderer: Option<Renderer>,
+    scene: Scene,
+    /// Bumped whenever the meshes change; the scene is rebuilt from `meshes`.
+    scene_rev: u64,
+    built_rev: u64,
+    pub frame: Option<Frame>,
+    exact: Option<Frame>,
+    key: Option<RenderKey>,
+    exact_key: Option<RenderKey>,
+    pub error: Option<ErrorMap>,
+    pub render_error: Option<String>,
+    /// Engine renders so far (the method's and the exact one's).
+    pub renders: u64,
+    texture: Option<TextureHandle>,
+    shown: Option<ShowKey>,
+    /// Where the picture was last painted, in points.
+    pub view_rect: Rect,
+    pub screenshot: Option<ScreenshotJob>,
+    pub status: String,
+}
+
+impl ViewerApp {
+    pub fn new(cc: &eframe::CreationContext<'_>, data: SceneData, settings: Settings, title: String) -> Self {
+        let gpu = gpu::context(cc.wgpu_render_state.as_ref());
+        let camera = ViewCamera::new(data.camera.as_ref(), &data.meshes);
+        let meshes = data.meshes.into_iter().map(|m| MeshControl::new(m.name, m.mesh)).collect();
+        Self {
+            settings,
+            meshes,
+            camera,
+            title,
+            show_panel: true,
+            gpu,
+            renderer: None,
+            scene: Scene::new(),
+            scene_rev: 1,
+            built_rev: 0,
+            frame: None,
+            exact: None,
+            key: None,
+            exact_key: None,
+            error: None,
+            render_error: None,
+            renders: 0,
+            texture: None,
+            shown: None,
+            view_rect: Rect::NOTHING,
+            screenshot: None,
+            status: String::new(),
+        }
+    }
+
+    /// Call after changing `meshes` or `settings.show_opaque`.
+    pub fn meshes_changed(&mut self) {
+        self.scene_rev += 1;
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.scene.meshes().iter().map(Mesh::triangle_count).sum()
+    }
+
+    /// The exact frame: the method's own when the method is the exact one.
+    pub fn exact_frame(&self) -> Option<&Frame> {
+        if self.settings.method == EXACT {
+            self.frame.as_ref()
+        } else {
+            self.exact.as_ref()
+        }
+    }
+
+    fn rebuild_scene(&mut self) {
+        if self.built_rev == self.scene_rev {
+            return;
+        }
+        let mut scene = Scene::new();
+        for m in self.meshes.iter().filter(|m| m.visible && (self.settings.show_opaque || !m.original.opaque)) {
+            scene.add_mesh(m.mesh());
+        }
+        self.scene = scene;
+        self.built_rev = self.scene_rev;
+    }
+
+    /// Renders what changed at `size` pixels; returns whether anything was rendered.
+    pub fn update_frames(&mut self, size: [u32; 2]) -> bool {
+        let gpu = match &self.gpu {
+            Ok(g) => g.clone(),
+            Err(e) => {
+                self.render_error = Some(e.clone());
+                return false;
+            }
+        };
+        self.rebuild_scene();
+        let rows = self.camera.rows(size[0] as f64 / size[1] as f64);
+        let key = RenderKey {
+            method: self.settings.method.clone(),
+            params: self.settings.method_params(&self.settings.method),
+            background: self.settings.background,
+            size,
+            camera: rows,
+            scene: self.scene_rev,
+        };
+        let exact_key = RenderKey { method: EXACT.into(), params: vec![], ..key.clone() };
+        let want_exact = self.settings.needs_exact() && self.settings.method != EXACT;
+        let stale = self.key.as_ref() != Some(&key);
+        let exact_stale = want_exact && self.exact_key.as_ref() != Some(&exact_key);
+        if !stale && !exact_stale {
+            return false;
+        }
+        if self.renderer.as_ref().map(|r| r.size()) != Some((size[0], size[1])) {
+            self.renderer = None; // free the old targets first
+            match Renderer::new(gpu, size[0], size[1]) {
+                Ok(r) => self.renderer = Some(r),
+                Err(e) => {
+                    self.render_error = Some(e.to_string());
+                    return false;
+                }
+            }
+        }
+        let renderer = self.renderer.as_mut().expect("created above");
+        let camera = match Camera::from_rows(rows) {
+            Ok(c) => c,
+            Err(e) => {
+                self.render_error = Some(e.to_string());
+                return false;
+            }
+        };
+        let mut run = |k: &RenderKey| renderer.render(&self.scene, &camera, &k.method, &k.params, k.background);
+        if stale {
+            self.key = Some(key.clone());
+            self.renders += 1;
+            match run(&key) {
+                Ok(f) => {
+                    self.frame = Some(f);
+                    self.render_error = None;
+                }
+                Err(e) => {
+                    self.frame = None;
+                    self.render_error = Some(format!("{}: {e}", key.method));
+                }
+            }
+        }
+        if exact_stale {
+            self.exact_key = Some(exact_key.clone());
+            self.renders += 1;
+            match run(&exact_key) {
+                Ok(f) => self.exact = Some(f),
+                Err(e) => {
+                    self.exact = None;
+                    self.render_error = Some(format!("{EXACT}: {e}"));
+                }
+            }
+        }
+        self.error = match (self.frame.as_ref(), self.exact_frame()) {
+            (Some(f), Some(x)) if self.settings.needs_exact() && f.image.len() == x.image.len() => {
+                Some(ErrorMap::new(&f.image, &x.image))
+            }
+            _ => None,
+        };
+        true
+    }
+
+    /// The picture for the current frames and settings.
+    fn compose(&self) -> Option<ColorImage> {
+        let f = self.frame.as_ref()?;
+        let s = &self.settings;
+        let picture = |fr: &Frame| match s.view {
+            ViewMode::Complexity => {
+                heatmap::complexity_image(fr.width, fr.height, &fr.depth_complexity, fr.stats.max_depth_complexity)
+            }
+            _ => heatmap::color_image(fr.width, fr.height, &fr.image),
+        };
+        if s.view == ViewMode::Error {
+            return self.error.as_ref().map(|e| e.image(f.width, f.height, s.error_scale));
+        }
+        let exact = self.exact_frame().filter(|x| x.image.len() == f.image.len());
+        Some(match (s.compare, exact) {
+            (Compare::Split, Some(x)) => heatmap::split(&picture(f), &picture(x), s.split),
+            (Compare::Toggle, Some(x)) if s.show_exact => picture(x),
+            _ => picture(f),
+        })
+    }
+
+    /// Uploads the picture when it changed; returns the texture to paint.
+    pub fn texture(&mut self, ctx: &egui::Context) -> Option<&TextureHandle> {
+        let s = &self.settings;
+        let key = ShowKey {
+            renders: self.renders,
+            view: s.view,
+            compare: s.compare,
+            show_exact: s.show_exact,
+            split: s.split,
+            error_scale: s.error_scale,
+        };
+        if self.shown.as_ref() != Some(&key) || self.texture.is_none() {
+            self.shown = Some(key);
+            match self.compose() {
+                Some(img) => match &mut self.texture {
+                    Some(t) => t.set(img, TextureOptions::NEAREST),
+                    None => self.texture = Some(ctx.load_texture("oit-frame", img, TextureOptions::NEAREST)),
+                },
+                None => self.texture = None,
+            }
+        }
+        self.texture.as_ref()
+    }
+
+    /// Saves the window picture of a finished screenshot request.
+    fn take_screenshot(&mut self, ctx: &egui::Context) {
+        let Some(job) = self.screenshot.as_mut() else { return };
+        let events = ctx.input(|i| i.raw.events.clone());
+        for e in events {
+            let egui::Event::Screenshot { image, .. } = e else { continue };
+            let ppp = ctx.pixels_per_point();
+            let img = if job.crop_view { image.region(&self.view_rect, Some(ppp)) } else { (*image).clone() };
+            let result = screenshot::write_png(&job.path, &img);
+            let ok = result.is_ok();
+            let job = self.screenshot.take().expect("checked above");
+            match result {
+                Ok(()) => {
+                    self.status = format!("saved {}", job.path.display());
+                    println!("oit-viewer: wrote {} ({} x {})", job.path.display(), img.width(), img.height());
+                }
+                Err(e) => {
+                    self.status = format!("screenshot failed: {e}");
+                    eprintln!("oit-viewer: {}", self.status);
+                }
+            }
+            if job.exit {
+                if !ok {
+                    std::process::exit(1);
+                }
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+            return;
+        }
+        if job.frames > 0 {
+            job.frames -= 1;
+        } else if !job.requested {
+            job.requested = true;
+            ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(Default::default()));
+        }
+        ctx.request_repaint();
+    }
+
+    /// A screenshot of the window into the working directory, named by the time.
+    pub fn request_screenshot(&mut self) {
+        let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+        self.screenshot = Some(ScreenshotJob::new(PathBuf::from(format!("oit-viewer-{secs}.png")), 0, false, false));
+    }
+}
+
+impl eframe::App for ViewerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.take_screenshot(&ctx);
+        if self.show_panel {
+            egui::Panel::left("settings").default_size(290.0).resizable(true).show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(ui, self));
+            });
+        }
+        egui::CentralPanel::no_frame().show(ui, |ui| view::central(ui, self));
+        if !ctx.egui_wants_keyboard_input() {
+            view::shortcuts(&ctx, self);
+        }
+    }
+
+    fn clear_color(&self, _visuals: &egui::Visuals) -> [f32; 4] {
+        let c = Color32::from_gray(40);
+        egui::Rgba::from(c).to_array()
+    }
+}

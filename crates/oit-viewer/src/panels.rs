@@ -1,0 +1,185 @@
+//! The side panel: method and parameters (from `oit_core::methods()`, so a new method shows
+//! up by itself), view and compare modes, background, meshes, and the frame's numbers.
+
+use eframe::egui::{self, RichText};
+use oit_core::{MethodInfo, ParamInfo, ParamKind, ParamValue};
+
+use crate::app::{Compare, ViewMode, ViewerApp, EXACT};
+
+pub fn side_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    ui.heading(&app.title);
+    if let Ok(g) = &app.gpu {
+        ui.label(RichText::new(g.info.name.clone()).small().weak());
+    }
+    ui.separator();
+    method_section(ui, app);
+    ui.separator();
+    view_section(ui, app);
+    ui.separator();
+    stats_section(ui, app);
+    ui.separator();
+    meshes_section(ui, app);
+}
+
+fn method_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    let s = &mut app.settings;
+    egui::ComboBox::from_label("method").selected_text(s.method.clone()).show_ui(ui, |ui| {
+        for m in oit_core::methods() {
+            let text = if m.exact { format!("{} (exact)", m.name) } else { m.name.to_string() };
+            ui.selectable_value(&mut s.method, m.name.to_string(), text).on_hover_text(m.summary);
+        }
+    });
+    let Some(info) = oit_core::methods().iter().find(|m| m.name == s.method) else { return };
+    ui.label(RichText::new(info.summary).small());
+    for p in info.params {
+        let mut value = s.method_params(info.name).into_iter().find(|(k, _)| k == p.name).map(|(_, v)| v);
+        let Some(v) = value.as_mut() else { continue };
+        if param_widget(ui, info, p, v) {
+            s.set_param(p.name, v.clone());
+        }
+    }
+}
+
+/// A slider for small integer and float ranges, a number field for wide ones (seeds, "0 =
+/// all layers"), a list for choices. Returns whether the value changed.
+fn param_widget(ui: &mut egui::Ui, method: &MethodInfo, p: &ParamInfo, v: &mut ParamValue) -> bool {
+    let changed = match (p.kind, v) {
+        (ParamKind::Int { min, max, .. }, ParamValue::Int(x)) if max - min <= 4096 => {
+            ui.add(egui::Slider::new(x, min..=max).text(p.name).logarithmic(max >= 64 && min >= 0)).changed()
+        }
+        (ParamKind::Int { min, max, .. }, ParamValue::Int(x)) => {
+            ui.horizontal(|ui| {
+                let r = ui.add(egui::DragValue::new(x).range(min..=max));
+                let label = ui.label(p.name);
+                r.labelled_by(label.id).changed()
+            })
+            .inner
+        }
+        (ParamKind::Float { min, max, .. }, ParamValue::Float(x)) => ui.add(egui::Slider::new(x, min..=max).text(p.name)).changed(),
+        (ParamKind::Choice { choices, .. }, ParamValue::Str(x)) => {
+            let mut changed = false;
+            egui::ComboBox::from_label(p.name).selected_text(x.clone()).show_ui(ui, |ui| {
+                for c in choices {
+                    changed |= ui.selectable_value(x, c.to_string(), *c).changed();
+                }
+            });
+            changed
+        }
+        (_, v) => {
+            ui.label(format!("{}.{} = {v:?}", method.name, p.name));
+            false
+        }
+    };
+    if !p.doc.is_empty() {
+        ui.label(RichText::new(p.doc).small().weak());
+    }
+    changed
+}
+
+fn view_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    let s = &mut app.settings;
+    ui.horizontal(|ui| {
+        ui.label("show");
+        ui.selectable_value(&mut s.view, ViewMode::Image, "image");
+        ui.selectable_value(&mut s.view, ViewMode::Complexity, "depth complexity");
+        ui.selectable_value(&mut s.view, ViewMode::Error, "error");
+    });
+    ui.horizontal(|ui| {
+        ui.label(format!("compare with {EXACT}"));
+        ui.selectable_value(&mut s.compare, Compare::Off, "off");
+        ui.selectable_value(&mut s.compare, Compare::Split, "split");
+        ui.selectable_value(&mut s.compare, Compare::Toggle, "toggle");
+    });
+    match s.compare {
+        Compare::Split => {
+            ui.add(egui::Slider::new(&mut s.split, 0.0..=1.0).text("split"));
+        }
+        Compare::Toggle => {
+            ui.checkbox(&mut s.show_exact, "show the exact frame (Space)");
+        }
+        Compare::Off => {}
+    }
+    if s.view == ViewMode::Error {
+        ui.add(egui::Slider::new(&mut s.error_scale, 0.001..=1.0).logarithmic(true).text("error scale"));
+    }
+    ui.horizontal(|ui| {
+        ui.color_edit_button_rgb(&mut s.background);
+        ui.label("background");
+    });
+    ui.add(egui::Slider::new(&mut s.render_scale, 0.25..=1.0).text("render scale"))
+        .on_hover_text("render at a fraction of the view's pixels: faster on software adapters");
+    ui.horizontal(|ui| {
+        if ui.add_enabled(!app.camera.is_home(), egui::Button::new("reset view")).on_hover_text("R, or double-click the view").clicked() {
+            app.camera.reset();
+        }
+        if ui.button("screenshot").on_hover_text("saves the window as oit-viewer-<time>.png here").clicked() {
+            app.request_screenshot();
+        }
+    });
+    if !app.status.is_empty() {
+        ui.label(RichText::new(&app.status).small());
+    }
+}
+
+fn mib(bytes: u64) -> String {
+    format!("{:.2} MiB", bytes as f64 / (1u64 << 20) as f64)
+}
+
+fn stats_section(ui: &mut egui::Ui, app: &ViewerApp) {
+    let Some(f) = &app.frame else {
+        ui.label("no frame yet");
+        return;
+    };
+    let st = &f.stats;
+    egui::Grid::new("stats").num_columns(2).striped(true).show(ui, |ui| {
+        let mut row = |k: &str, v: String| {
+            ui.label(k);
+            ui.label(v);
+            ui.end_row();
+        };
+        row("frame", format!("{} x {}, {} triangles", f.width, f.height, app.triangle_count()));
+        row("GPU time", st.gpu_time_ms.map_or("n/a (no timestamp queries)".into(), |t| format!("{t:.2} ms")));
+        row("wall time", format!("{:.1} ms", st.wall_time_ms));
+        row("fragments", st.fragments.to_string());
+        row("max depth complexity", st.max_depth_complexity.to_string());
+        row("memory (method)", mib(st.memory_bytes));
+        row("memory (targets, scene)", format!("{}, {}", mib(st.target_bytes), mib(st.scene_bytes)));
+        row("overflow fragments", st.overflow_fragments.to_string());
+        for (k, v) in &st.extra {
+            row(k, format!("{v}"));
+        }
+        if let Some(e) = &app.error {
+            row("mean error", format!("{:.5}", e.mean));
+            row("max error", format!("{:.5}", e.max));
+        }
+    });
+    if !st.pass_times_ms.is_empty() {
+        egui::CollapsingHeader::new("pass times").show(ui, |ui| {
+            for (name, t) in &st.pass_times_ms {
+                ui.label(format!("{name}: {t:.3} ms"));
+            }
+        });
+    }
+}
+
+fn meshes_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    let mut changed = false;
+    if app.meshes.iter().any(|m| m.original.opaque) {
+        changed |= ui.checkbox(&mut app.settings.show_opaque, "show opaque geometry").changed();
+    }
+    egui::CollapsingHeader::new(format!("meshes ({})", app.meshes.len())).default_open(app.meshes.len() <= 8).show(ui, |ui| {
+        for (i, m) in app.meshes.iter_mut().enumerate() {
+            ui.push_id(i, |ui| {
+                let label = if m.original.opaque { format!("{} (opaque)", m.name) } else { m.name.clone() };
+                changed |= ui.checkbox(&mut m.visible, label).changed();
+                if !m.original.opaque {
+                    let text = if m.uniform_alpha { "alpha" } else { "alpha ×" };
+                    changed |= ui.add(egui::Slider::new(&mut m.alpha, 0.0..=1.0).text(text)).changed();
+                }
+            });
+        }
+    });
+    if changed {
+        app.meshes_changed();
+    }
+}

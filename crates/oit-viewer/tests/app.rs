@@ -1,0 +1,167 @@
+//! The viewer driven through its UI with egui_kittest, rendered by egui-wgpu and oit-core on
+//! one device (lavapipe here). The snapshots in tests/snapshots are checked in; each test
+//! also checks the app's numbers against the engine itself, not only against the pictures.
+//! Update the pictures with `UPDATE_SNAPSHOTS=1 cargo test --release -p oit-viewer`.
+
+use std::sync::Arc;
+
+use eframe::egui::accesskit::Role;
+use eframe::egui::Key;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::{Harness, SnapshotOptions};
+use oit_core::{Camera, Mesh, Renderer};
+use oit_viewer::scenefile::{CameraSpec, NamedMesh, SceneData};
+use oit_viewer::{gpu, Compare, Settings, ViewMode, ViewerApp};
+
+const SIZE: [f32; 2] = [720.0, 440.0];
+
+fn quad(z: f32, offset: f32, rgba: [f32; 4], opaque: bool) -> NamedMesh {
+    let s = 0.6;
+    let p = |x: f32, y: f32| [x + offset, y + offset * 0.5, z];
+    let mesh = Mesh::new(vec![p(-s, -s), p(s, -s), p(s, s), p(-s, s)], vec![[0, 1, 2], [0, 2, 3]], vec![rgba], opaque).unwrap();
+    NamedMesh { name: format!("quad z={z}"), mesh }
+}
+
+/// Three transparent quads submitted front to back (the worst order for blending) over an
+/// opaque one, seen by a perspective camera.
+fn scene() -> SceneData {
+    SceneData {
+        meshes: vec![
+            quad(0.3, -0.35, [0.9, 0.2, 0.1, 0.6], false),
+            quad(0.0, 0.0, [0.1, 0.8, 0.2, 0.5], false),
+            quad(-0.3, 0.35, [0.1, 0.3, 0.9, 0.7], false),
+            quad(-0.6, 0.6, [0.25, 0.25, 0.3, 1.0], true),
+        ],
+        camera: Some(CameraSpec::LookAt { eye: [0.4, 0.3, 3.0], target: [0.0; 3], up: [0.0, 1.0, 0.0], fov_y: 45.0, near: 1.0, far: 5.0 }),
+        size: None,
+    }
+}
+
+fn harness(method: &str) -> Harness<'static, ViewerApp> {
+    let mut h = Harness::builder()
+        .with_size(SIZE)
+        .with_pixels_per_point(1.0)
+        .wgpu_setup(gpu::setup(None, true))
+        .build_eframe(move |cc| ViewerApp::new(cc, scene(), Settings::new(method), "test scene".into()));
+    h.run();
+    h
+}
+
+/// Text and widgets render the same on every lavapipe run; the tolerance is kittest's
+/// default per-pixel threshold, with a few pixels spare for antialiased text edges. Times
+/// ("... ms") change from run to run and are masked.
+fn check(h: &mut Harness<'_, ViewerApp>, name: &str) {
+    let timings: Vec<_> = h.query_all_by(|n| [n.label(), n.value()].into_iter().flatten().any(|l| l.ends_with(" ms"))).map(|n| n.rect()).collect();
+    assert!(!timings.is_empty(), "the stats show times");
+    // A fixed width: the text's own width changes with the number.
+    timings.into_iter().for_each(|r| h.mask(eframe::egui::Rect::from_min_size(r.min, [120.0, r.height()].into())));
+    h.snapshot_options(name, &SnapshotOptions::new().max_failed_pixels(16));
+}
+
+fn method_of(h: &Harness<'_, ViewerApp>) -> String {
+    h.state().frame.as_ref().expect("a frame was rendered").stats.method.clone()
+}
+
+#[test]
+fn switch_methods_and_move_a_slider() {
+    let mut h = harness("hybrid");
+    assert_eq!(method_of(&h), "hybrid");
+    assert!(h.state().render_error.is_none(), "{:?}", h.state().render_error);
+
+    h.get_by_label("method").click();
+    h.run();
+    h.get_by_label("abuffer (exact)").click();
+    h.run();
+    assert_eq!(h.state().settings.method, "abuffer");
+    assert_eq!(method_of(&h), "abuffer");
+
+    h.get_by_label("method").click();
+    h.run();
+    h.get_by_label("hybrid").click();
+    h.run();
+    assert_eq!(method_of(&h), "hybrid");
+    let k = |h: &Harness<'_, ViewerApp>| h.state().frame.as_ref().unwrap().stats.params.int("k");
+    assert_eq!(k(&h), 8);
+    h.get_by_role_and_label(Role::Slider, "k").focus();
+    h.run();
+    h.key_press(Key::ArrowLeft);
+    h.run();
+    assert_eq!(k(&h), 7, "the slider moved and the frame was rendered again with it");
+    check(&mut h, "hybrid_k7");
+}
+
+#[test]
+fn compare_mode_split_and_error_heatmap() {
+    let mut h = harness("unsorted");
+    assert!(h.state().error.is_none());
+    h.get_by_label("split").click();
+    h.run();
+    assert_eq!(h.state().settings.compare, Compare::Split);
+    let e = h.state().error.clone().expect("compare mode measures the error");
+    // Front-to-back submission makes over-blending visibly wrong where the quads overlap.
+    assert!(e.max > 0.05 && e.mean > 0.0, "unsorted vs abuffer: mean {} max {}", e.mean, e.max);
+    check(&mut h, "unsorted_split");
+
+    h.get_by_label("error").click();
+    h.run();
+    assert_eq!(h.state().settings.view, ViewMode::Error);
+    check(&mut h, "unsorted_error");
+
+    h.get_by_label("method").click();
+    h.run();
+    h.get_by_label("abuffer (exact)").click();
+    h.run();
+    assert_eq!(h.state().error.as_ref().unwrap().max, 0.0, "the exact method against itself");
+}
+
+#[test]
+fn depth_complexity_view_and_toggle() {
+    let mut h = harness("wavg");
+    h.get_by_label("depth complexity").click();
+    h.run();
+    let f = h.state().frame.as_ref().unwrap();
+    assert_eq!(f.stats.max_depth_complexity, 3);
+    h.get_by_label("toggle").click();
+    h.run();
+    h.key_press(Key::Space);
+    h.run();
+    assert!(h.state().settings.show_exact);
+    check(&mut h, "complexity_toggle_exact");
+}
+
+#[test]
+fn renders_only_when_something_changed() {
+    let mut h = harness("wsum");
+    let n = h.state().renders;
+    h.run_steps(5);
+    assert_eq!(h.state().renders, n, "idle frames do not render");
+    h.state_mut().settings.background = [0.0, 0.0, 0.0];
+    h.run();
+    assert_eq!(h.state().renders, n + 1);
+    h.state_mut().camera.moved().rotate(40.0, 10.0);
+    h.run();
+    assert_eq!(h.state().renders, n + 2);
+    h.key_press(Key::R); // reset view
+    h.run();
+    assert!(h.state().camera.is_home());
+}
+
+/// On eframe's device the viewer's frame is the engine's frame: the same scene, camera and
+/// size rendered by a Renderer of its own (oit_core::shared_context) gives the same image.
+#[test]
+fn the_frame_is_the_engines_frame() {
+    let h = harness("abuffer");
+    let app = h.state();
+    let f = app.frame.as_ref().unwrap();
+    let camera = Camera::from_rows(app.camera.rows(f.width as f64 / f.height as f64)).unwrap();
+    let mut own_scene = oit_core::Scene::new();
+    scene().meshes.into_iter().for_each(|m| {
+        own_scene.add_mesh(m.mesh);
+    });
+    let gpu = oit_core::shared_context(None).unwrap();
+    let mut r = Renderer::new(Arc::clone(&gpu), f.width, f.height).unwrap();
+    let own = r.render(&own_scene, &camera, "abuffer", &[], [1.0; 3]).unwrap();
+    let diff = own.image.iter().zip(&f.image).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    assert!(diff < 1e-6, "max difference {diff}");
+    assert_eq!(own.stats.fragments, f.stats.fragments);
+}

@@ -1,0 +1,147 @@
+"""Plots of a bench run (matplotlib, an optional dependency: `pip install matplotlib`):
+per scene and size, the speed-accuracy trade (mean error against GPU time, wall time and
+memory, with the Pareto front marked) and an image sheet (each method's picture above its
+error heatmap, beside the exact A-buffer)."""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Any, Sequence
+
+import numpy as np
+
+from .imageio import linear_to_srgb
+
+# Axes of the trade-off panels: (row field, axis label, log scale).
+TRADE_AXES = (
+    ("gpu_ms", "GPU time (ms)", True),
+    ("wall_ms", "wall time per frame (ms)", True),
+    ("memory_mib", "memory the method allocated (MiB)", False),
+)
+# Errors below this are float32 rounding of an exact method: drawn on this line, marked "exact".
+EXACT_BELOW = 1e-5
+# The heatmaps' fixed logarithmic scale, the same on every sheet: 1e-3 (black) is a quarter of
+# an 8-bit step, 1 (white) a fully wrong pixel.
+HEAT_RANGE = (1e-3, 1.0)
+SHEET_COLUMNS = 7
+
+
+def matplotlib_missing() -> str | None:
+    """Why the plots cannot be drawn here, or None when they can."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError as e:
+        return f"matplotlib is not installed ({e}); `pip install matplotlib` adds it"
+    return None
+
+
+def pareto_front(points: Sequence[tuple[float, float]]) -> list[int]:
+    """Indices of the points no other point beats on both coordinates (smaller is better),
+    in increasing x: the best error reachable at each cost."""
+    order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))
+    front, best = [], math.inf
+    for i in order:
+        if points[i][1] < best:
+            front.append(i)
+            best = points[i][1]
+    return front
+
+
+def _label(row: dict) -> str:
+    return f"{row['method']} {row['params']}".strip()
+
+
+def tradeoff(rows: list[dict], title: str, path: str) -> None:
+    """Mean error (over covered pixels) against each of TRADE_AXES, one marker color per
+    method, parameter values written beside their points, the Pareto front as a dashed step
+    line. Rows below EXACT_BELOW sit on that line, marked 'exact'."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ok = [r for r in rows if r["status"] == "ok" and math.isfinite(r["mean_err"])]
+    methods = list(dict.fromkeys(r["method"] for r in ok))
+    palette = [plt.get_cmap(name)(i) for name in ("tab20", "tab20b") for i in range(20)]
+    colors = {m: palette[i % len(palette)] for i, m in enumerate(methods)}
+    fig, axes = plt.subplots(1, len(TRADE_AXES), figsize=(6 * len(TRADE_AXES), 5))
+    for ax, (key, xlabel, log_x) in zip(axes, TRADE_AXES):
+        pts = [(r[key], max(r["mean_err"], EXACT_BELOW), r) for r in ok if math.isfinite(r[key])]
+        for m in methods:
+            mine = [(x, y, r) for x, y, r in pts if r["method"] == m]
+            if mine:
+                ax.scatter([p[0] for p in mine], [p[1] for p in mine], color=colors[m], label=m, s=30, zorder=3,
+                           marker="^" if m.startswith("pygfx") else "o")
+            for x, y, r in mine:
+                # The first parameter's value (k, nodes, samples, layers) names the point.
+                text = "exact" if r["mean_err"] < EXACT_BELOW else r["params"].split(" ")[0].partition("=")[2]
+                if text:
+                    ax.annotate(text, (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
+        front = [pts[i] for i in pareto_front([(p[0], p[1]) for p in pts])]
+        if front:
+            ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="0.4", linestyle="--",
+                    linewidth=1, label="Pareto front", zorder=2)
+        ax.set_yscale("log")
+        if log_x:
+            ax.set_xscale("log")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("mean RGB distance to abuffer (covered pixels)")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[1].legend(fontsize=7, ncol=2)  # the wall-time panel has every row, peers included
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def image_sheet(images: dict[str, np.ndarray], title: str, path: str) -> None:
+    """Each image (linear RGBA, first the exact `abuffer`) above its per-pixel RGB distance to
+    the exact image, on the fixed logarithmic scale HEAT_RANGE."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm
+
+    exact = images["abuffer"][..., :3].astype(np.float64)
+    names = list(images)
+    cols = min(SHEET_COLUMNS, len(names))
+    lines = -(-len(names) // cols)
+    fig, axes = plt.subplots(2 * lines, cols, figsize=(2.0 * cols + 1.0, 4.3 * lines + 0.5), squeeze=False,
+                             layout="constrained")
+    for ax in axes.flat:
+        ax.axis("off")
+    norm = LogNorm(*HEAT_RANGE, clip=True)
+    shown: Any = None
+    for i, name in enumerate(names):
+        top, bottom = axes[2 * (i // cols), i % cols], axes[2 * (i // cols) + 1, i % cols]
+        top.imshow(linear_to_srgb(images[name][..., :3]))
+        top.set_title(name, fontsize=8)
+        if name != "abuffer":
+            dist = np.sqrt(((images[name][..., :3] - exact) ** 2).sum(-1))
+            shown = bottom.imshow(np.maximum(dist, HEAT_RANGE[0]), cmap="magma", norm=norm)
+            bottom.set_title(f"frame mean {dist.mean():.4f}", fontsize=7)
+    if shown is not None:
+        fig.colorbar(shown, ax=axes[:, -1].tolist(), shrink=0.6, label="RGB distance to abuffer")
+    fig.suptitle(title)
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def write_all(result: Any, out: str) -> list[str]:
+    """The trade-off plot and the image sheet of every scene and size of a bench.Result, as
+    PNGs in `out`; returns their paths."""
+    paths = []
+    for scene, size in dict.fromkeys((r["scene"], r["size"]) for r in result.rows):
+        rows = [r for r in result.rows if r["scene"] == scene and r["size"] == size]
+        adapter = next((r["adapter"] for r in rows if r["adapter"]), "")
+        path = os.path.join(out, f"tradeoff-{scene}-{size}.png")
+        tradeoff(rows, f"{scene} {size} on {adapter}", path)
+        paths.append(path)
+        sheet = result.sheets.get((scene, size), {})
+        if "abuffer" in sheet:
+            path = os.path.join(out, f"sheet-{scene}-{size}.png")
+            image_sheet(sheet, f"{scene} {size}: each method (default parameters) and its error", path)
+            paths.append(path)
+    return paths

@@ -1,0 +1,272 @@
+"""Helpers of the numerics tests (test_numerics_*.py): per-pixel fragment stacks with known
+depths, what each method should return on them (oit.models, or a local model of the plain
+blends), and the float32 error bounds the tests allow, each derived in a comment.
+
+Which method promises what is read from `oit.methods()` where it is declared there
+(`exact`, `bounded_memory`, parameters, passes); what only docs/methods.md states (hybrid,
+hybrid64 and ktab are bit-for-bit order independent, the blended sums are commutative) is
+listed here by name.
+"""
+
+from __future__ import annotations
+
+import inspect
+from dataclasses import dataclass
+from typing import Callable, Dict, List, Optional, Sequence
+
+import numpy as np
+
+import oit
+from oit import models
+
+BG = np.array([0.2, 0.4, 0.6])
+INFO: Dict[str, dict] = {m["name"]: m for m in oit.methods()}
+NAMES: List[str] = list(INFO)
+EXACT = [n for n in NAMES if INFO[n]["exact"]]
+BOUNDED = [n for n in NAMES if INFO[n]["bounded_memory"]]
+# Methods with a `seed` parameter are randomized per fragment (by triangle index): adding
+# triangles, even invisible ones, changes their noise.
+RANDOMIZED = [n for n in NAMES if any(p["name"] == "seed" for p in INFO[n]["params"])]
+# Methods that draw the scene once per layer (their passes are declared "per layer ..."):
+# n layers at a pixel cost n geometry passes, ~10 s for 4,000 layers on lavapipe.
+PER_LAYER = [n for n in NAMES if any(p.startswith("per ") for p in INFO[n]["passes"])]
+# docs/methods.md, "depth_peeling and dual_depth_peeling": the exact peeling methods order
+# fragments at equal depth by submission (their (depth, triangle) keys), not by color as the
+# A-buffer and the reference do: exact, but order-dependent where depths tie exactly.
+SUBMISSION_TIES = [n for n in EXACT if n in PER_LAYER]
+
+# docs/methods.md, "Determinism": hybrid, hybrid64 and ktab accumulate in fixed point, so
+# their images repeat bit for bit under any submission order, as the exact methods' do.
+BIT_ORDER_INDEPENDENT = sorted(set(EXACT) | ({"hybrid", "hybrid64", "ktab"} & set(NAMES)))
+# Commutative float accumulation (additive or multiplicative blending): a reordered
+# submission changes only the last bits (docs/methods.md).
+SUM_ORDER_INDEPENDENT = sorted({"wsum", "wavg", "wboit", "additive", "filter"} & set(NAMES))
+
+U = 2.0 ** -24  # float32 unit roundoff
+# WGSL: log2 has an absolute error below 2^-21 on [0.5, 2], and pow(x, y) is exp2(y log2 x),
+# so pow(1 - a, n) carries a relative error up to n 2^-21 (ln 2 < 1).
+POW_LOG2 = 2.0 ** -21
+
+
+def params_for(name: str, **overrides) -> dict:
+    """The method's parameters at their defaults, with `overrides` for those it has."""
+    own = {p["name"]: p["default"] for p in INFO[name]["params"]}
+    own.update({k: v for k, v in overrides.items() if k in own})
+    return own
+
+
+def over_blend(rgb: np.ndarray, alpha: np.ndarray, bg: Sequence[float], bg_a: float = 0.0) -> np.ndarray:
+    """Fixed-function over-blending in the given order (first = farthest), float64."""
+    c, a = np.asarray(bg, np.float64).copy(), float(bg_a)
+    for ci, ai in zip(np.asarray(rgb, np.float64), np.asarray(alpha, np.float64)):
+        c = ai * ci + (1.0 - ai) * c
+        a = ai + (1.0 - ai) * a
+    return np.append(c, a)
+
+
+def expected(name: str, z, rgb, alpha, bg=BG, bg_a: float = 0.0, mesh_per_fragment: bool = False,
+             pixel=(0, 0), **params) -> Optional[np.ndarray]:
+    """RGBA that `name` should return on one pixel's stack given in submission order, or None
+    when there is no CPU model of it. `mesh_per_fragment`: each fragment is its own mesh
+    (what `sorted` sorts); otherwise all of them are one mesh, drawn in submission order.
+    `pixel` (row, col) goes to models that depend on it (screen_door's dither)."""
+    z, rgb, alpha = np.asarray(z, np.float64), np.asarray(rgb, np.float64).reshape(-1, 3), np.asarray(alpha, np.float64)
+    if INFO[name]["exact"]:
+        return models.exact(z, rgb, alpha, bg, bg_a)
+    if name == "unsorted" or (name == "sorted" and not mesh_per_fragment):
+        return over_blend(rgb, alpha, bg, bg_a)
+    if name == "sorted":
+        back_to_front = np.argsort(-z, kind="stable")
+        return over_blend(rgb[back_to_front], alpha[back_to_front], bg, bg_a)
+    if name not in models.MODELS:
+        return None
+    p = dict(params)
+    if name == "wboit":
+        p = {"eq": int(str(p.get("weight", "eq10"))[2:])}
+    model = models.MODELS[name]
+    if "pixel" in inspect.signature(model).parameters:
+        p["pixel"] = tuple(pixel)
+    return model(z, rgb, alpha, bg, bg_a, **p)
+
+
+def expected_image(name: str, width: int, height: int, z, rgb, alpha, bg=BG, **kw) -> Optional[np.ndarray]:
+    """(h, w, 4) expected image of one stack drawn on every pixel (full-screen layers)."""
+    out = [expected(name, z, rgb, alpha, bg, pixel=(r, c), **kw) for r in range(height) for c in range(width)]
+    return None if out[0] is None else np.array(out).reshape(height, width, 4)
+
+
+# Methods whose output sums sum(alpha c) unnormalized: values (and float32 rounding) grow
+# with the alphas' sum.
+UNNORMALIZED_SUMS = {"wsum", "additive"}
+
+
+def tolerance(name: str, n: int, mass: float = 1.0) -> float:
+    """Largest allowed |GPU - expected(...)| on a pixel of n fragments whose alphas sum to
+    `mass`. The base is the A-buffer's bound in docs/methods.md: one float32 rounding per
+    layer (n 2^-24, plus one for the float32 background); a float32 sum of n + 1 terms is off
+    by at most (n + 1) 2^-24 times their magnitude, which unnormalized sums (background
+    included) bound by 1 + mass. Method terms:"""
+    tol = (n + 1) * U * ((1.0 + mass) if name in UNNORMALIZED_SUMS else 1.0)
+    if name in ("hybrid", "hybrid64"):
+        # Tail sums in fixed point at 2^-24 per unit (<= 2^-25 per term), and the tail's
+        # transmittance pow(1 - α_avg, t) with t <= n (docs/methods.md, hybrid error bounds).
+        tol += n * 2.0 ** -25 + n * POW_LOG2
+    elif name == "ktab":
+        tol += n * 2.0 ** -32  # core sums in fixed point at 2^-31 per unit
+    elif name == "wavg":
+        tol += n * POW_LOG2  # u = pow(1 - α_avg, n)
+    elif name == "wboit":
+        # Weights 3e3 pow(1 - z, 3) with relative error 3 2^-21 each; a weighted average of
+        # colors in [0, 1] moves by at most twice that.
+        tol += 6 * POW_LOG2
+    return tol
+
+
+def color_quantum(name: str) -> float:
+    """How far a method may move a fragment's own color by storing it: hybrid64 packs colors
+    as R11G11B10 unorm, <= 1/2046 a channel (docs/methods.md); the others keep float32."""
+    return 1.0 / 2046 if name == "hybrid64" else 0.0
+
+
+def exact_in_submission_order(z, rgb, alpha, bg=BG, bg_a: float = 0.0) -> np.ndarray:
+    """The exact composite with equal depths in submission order (the peeling methods' rule)."""
+    z, rgb, alpha = np.asarray(z, np.float64), np.asarray(rgb, np.float64).reshape(-1, 3), np.asarray(alpha, np.float64)
+    c, t = np.zeros(3), 1.0
+    for i in np.argsort(z, kind="stable"):
+        c += t * alpha[i] * rgb[i]
+        t *= 1.0 - alpha[i]
+    return np.append(c + t * np.asarray(bg, np.float64), 1.0 - t * (1.0 - bg_a))
+
+
+def assert_within_error_bound(frame, exact_image: np.ndarray) -> None:
+    """Where a method reports `frame.error_bound` (hybrid, hybrid64, ktab, auto), the RGB error
+    against the exact composite is within it at every pixel and channel."""
+    if getattr(frame, "error_bound", None) is None:
+        return
+    err = np.abs(frame.image[..., :3].astype(np.float64) - exact_image[..., :3])
+    over = err - frame.error_bound
+    worst = np.unravel_index(np.argmax(over), over.shape)
+    assert (over <= 0).all(), f"error {err[worst]:.3g} > bound {frame.error_bound[worst]:.3g} at {worst}"
+
+
+def hybrid_tail_count(z, alpha, k: int) -> int:
+    """Fragments hybrid and ktab send to the tail (stats["overflow_fragments"]): the model's
+    k-TAB with its tie rule (oit.models.hybrid), alpha-0 fragments skipped."""
+    z, alpha = np.asarray(z, np.float64), np.asarray(alpha, np.float64)
+    keys = [int(x) for x in models.hybrid_keys(z[alpha > 0], alpha[alpha > 0])]
+    ranked = sorted(keys, reverse=True)
+    table = ranked[:k]
+    if len(table) < k:
+        return 0
+    evicted = ranked[k] if len(ranked) > k else 0
+    bound = table[-1] + 1 if evicted != 0 and evicted == table[-1] else table[-1]
+    core = {x for x in table if x >= bound}
+    return sum(1 for key in keys if key not in core)
+
+
+def expected_overflow(name: str, z, alpha, **params) -> Optional[int]:
+    """What stats["overflow_fragments"] should say for one pixel's stack, or None when no
+    model of it is known here. Only hybrid and ktab have a bounded structure that overflows;
+    the blends have none, and the list methods grow theirs."""
+    if name in ("hybrid", "ktab"):
+        return hybrid_tail_count(z, alpha, int(params["k"]))
+    if name in ("unsorted", "sorted", "wavg", "wsum", "wboit", "adaptive") or INFO[name]["exact"]:
+        return 0
+    return None
+
+
+# ---- scenes
+
+
+@dataclass
+class Stacks:
+    """Per-pixel fragment stacks: `z`, `rgb`, `alpha` of each pixel in submission order
+    (row-major pixels), and the scene that draws them under the identity camera."""
+
+    scene: oit.Scene
+    width: int
+    height: int
+    z: List[np.ndarray]
+    rgb: List[np.ndarray]
+    alpha: List[np.ndarray]
+
+    def expect(self, name: str, bg=BG, **params) -> np.ndarray:
+        """(h, w, 4) float64 expected image, or None without a model."""
+        out = [expected(name, z, c, a, bg, pixel=divmod(p, self.width), **params)
+               for p, (z, c, a) in enumerate(zip(self.z, self.rgb, self.alpha))]
+        if any(o is None for o in out):
+            return None
+        return np.array(out).reshape(self.height, self.width, 4)
+
+
+def pixel_quads(width: int, height: int, cells: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """(m, 4, 3) positions of small quads (0.3 pixel half-size) around the centers of the
+    pixels `cells` (row-major indices), at depths z."""
+    row, col = np.divmod(cells, width)
+    cx = (col + 0.5) * 2.0 / width - 1.0
+    cy = 1.0 - (row + 0.5) * 2.0 / height
+    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], np.float64)
+    pos = np.empty((len(cells), 4, 3))
+    pos[:, :, 0] = cx[:, None] + corners[None, :, 0] * (0.6 / width)
+    pos[:, :, 1] = cy[:, None] + corners[None, :, 1] * (0.6 / height)
+    pos[:, :, 2] = np.asarray(z)[:, None]
+    return pos
+
+
+def stacks(width: int, height: int, layers: int, seed: int = 0, alpha: Callable = None,
+           z_range=(0.01, 0.99)) -> Stacks:
+    """`layers` fragments on every pixel at distinct float32 depths (evenly spaced in
+    z_range, so float32 and the 24-bit keys keep them apart), random colors, alphas from
+    `alpha(rng, n)` (default uniform in [0.05, 0.95]), one mesh, globally shuffled order."""
+    rng = np.random.default_rng(seed)
+    pixels = width * height
+    depths = np.linspace(*z_range, layers).astype(np.float32)
+    z = np.stack([rng.permutation(depths) for _ in range(pixels)])
+    rgb = rng.uniform(0, 1, (pixels, layers, 3)).astype(np.float32)
+    draw_alpha = alpha or (lambda r, n: r.uniform(0.05, 0.95, n))
+    a = np.stack([draw_alpha(rng, layers) for _ in range(pixels)]).astype(np.float32)
+    order = rng.permutation(pixels * layers)  # submission order of (pixel, layer) quads
+    pix, lay = np.divmod(order, layers)
+    pos = pixel_quads(width, height, pix, z[pix, lay]).astype(np.float32)
+    colors = np.repeat(np.concatenate([rgb[pix, lay], a[pix, lay][:, None]], 1), 4, axis=0)
+    quad = np.array([[0, 1, 2], [0, 2, 3]])
+    idx = (np.arange(len(order))[:, None, None] * 4 + quad[None]).reshape(-1, 3)
+    scene = oit.Scene()
+    scene.add_mesh(pos.reshape(-1, 3), idx, colors)
+    # Each pixel's fragments in submission order.
+    zs, cs, als = [], [], []
+    for p in range(pixels):
+        mine = lay[pix == p]
+        zs.append(z[p, mine].astype(np.float64))
+        cs.append(rgb[p, mine].astype(np.float64))
+        als.append(a[p, mine].astype(np.float64))
+    return Stacks(scene, width, height, zs, cs, als)
+
+
+def full_screen_layers(layers: Sequence, opaque: Sequence[int] = ()) -> oit.Scene:
+    """One full-screen quad per (z, (r, g, b, a)), each its own mesh, in the given order;
+    the indices in `opaque` are opaque meshes. Under the identity camera the quads' shared
+    diagonal is drawn once (top-left rule): exactly one fragment a pixel per layer."""
+    s = oit.Scene()
+    for i, (z, rgba) in enumerate(layers):
+        p = np.array([[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]], np.float32)
+        s.add_mesh(p, [[0, 1, 2], [0, 2, 3]], tuple(float(c) for c in rgba), opaque=i in opaque)
+    return s
+
+
+def layer_arrays(layers: Sequence):
+    """z, rgb, alpha arrays (float64 of the float32 values the GPU sees) of (z, rgba) layers."""
+    z = np.array([np.float32(l[0]) for l in layers], np.float64)
+    rgba = np.array([l[1] for l in layers], np.float32).astype(np.float64)
+    return z, rgba[:, :3], rgba[:, 3]
+
+
+def render_or_limit(renderer: oit.Renderer, scene: oit.Scene, name: str, **kw):
+    """Renders, or returns the RuntimeError when the adapter refuses the frame for a loop
+    limit it names (llvmpipe's 65,535 iterations per invocation, docs/methods.md)."""
+    try:
+        return renderer.render(scene, oit.Camera(np.eye(4)), name, **kw)
+    except RuntimeError as e:
+        if "llvmpipe" in renderer.adapter_info["name"] and "65535" in str(e):
+            return e
+        raise

@@ -1,0 +1,177 @@
+"""The bench on a tiny configuration (a smoke test of its outputs and their consistency, not
+a timing test), its parameter sweeps and error measures, and the pygfx peer's input match."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+import numpy as np
+import pytest
+
+import oit
+from oit import bench, cli, formulas, geometry, peers, plots, scenes
+from oit.imageio import linear_to_srgb
+
+TINY = dict(scenes=["glass"], methods=["abuffer", "unsorted", "sorted", "hybrid", "wboit"], sizes=[32], repeat=1,
+            quick=True, with_peers=False, show_progress=False)
+
+
+@pytest.fixture(scope="module")
+def tiny():
+    return bench.run(**TINY)
+
+
+def by_method(rows):
+    return {r["method"]: r for r in rows}
+
+
+def test_rows_are_consistent(tiny):
+    rows = by_method(tiny.rows)
+    assert set(rows) == set(TINY["methods"])
+    assert all(r["status"] == "ok" and r["size"] == "32x32" for r in rows.values())
+    # Every method saw the same geometry.
+    assert len({(r["fragments"], r["max_depth"]) for r in rows.values()}) == 1
+    assert rows["abuffer"]["mean_err"] == 0 and rows["abuffer"]["abuffer_speedup"] == 1
+    # Glass defeats sorting; hybrid with k = 8 > 6 layers is exact up to its 8-bit alphas.
+    assert rows["sorted"]["mean_err"] > 0.05
+    assert rows["hybrid"]["mean_err"] < 0.01 < rows["wboit"]["mean_err"]
+    for r in rows.values():
+        assert r["mean_err_all"] <= r["mean_err"] <= r["max_err"]
+        assert r["x_floor"] > 0 and r["wall_x_floor"] > 0
+        formula = formulas.memory_bytes(r["method"], 32, 32, **dict(p.split("=") for p in r["params"].split()))
+        if formula is not None:
+            assert r["memory_mib"] == r["formula_mib"] == formula / 2 ** 20
+    assert set(tiny.sheets[("glass", "32x32")]) == set(TINY["methods"])
+
+
+def test_a_failing_method_gives_a_failed_row(monkeypatch):
+    real = oit.Renderer.render
+
+    def render(self, scene, camera, method="abuffer", **kw):
+        if method == "hybrid":
+            raise RuntimeError("adapter limit: too many layers for this adapter\nsecond line")
+        return real(self, scene, camera, method, **kw)
+
+    monkeypatch.setattr(oit.Renderer, "render", render)
+    rows = by_method(bench.run(**TINY).rows)
+    assert rows["hybrid"]["status"] == "failed"
+    assert rows["hybrid"]["message"] == "adapter limit: too many layers for this adapter"
+    assert math.isnan(rows["hybrid"]["mean_err"])
+    assert rows["wboit"]["status"] == "ok"
+    assert "| hybrid | k=8 |" in bench.markdown(list(rows.values()))
+    assert "failed: adapter limit" in bench.markdown(list(rows.values()))
+
+
+def test_cli_writes_tables_and_plots(tmp_path, capsys):
+    out = tmp_path / "bench"
+    code = cli.main(["bench", "--quick", "--scenes", "glass", "--sizes", "32", "--methods", "abuffer", "unsorted",
+                     "hybrid", "--no-peers", "--out", str(out)])
+    assert code == 0
+    with open(out / "results.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["method"] for r in rows] == ["abuffer", "unsorted", "hybrid"]
+    table = (out / "results.md").read_text()
+    assert table.startswith("Adapter: ") and sum(line.startswith("| glass |") for line in table.splitlines()) == 3
+    if plots.matplotlib_missing() is None:
+        assert (out / "tradeoff-glass-32x32.png").stat().st_size > 0
+        assert (out / "sheet-glass-32x32.png").stat().st_size > 0
+    else:
+        assert "no plots: matplotlib is not installed" in capsys.readouterr().out
+
+
+def test_unknown_method_is_named():
+    with pytest.raises(ValueError, match="unknown method.*hybird"):
+        bench.run(["glass"], ["hybird"], [8], quick=True, with_peers=False, show_progress=False)
+
+
+def test_sweep_follows_the_declared_ranges():
+    method = {"name": "m", "params": [
+        {"name": "k", "type": "int", "min": 2, "max": 12, "default": 3},
+        {"name": "w", "type": "choice", "choices": ["a", "b"], "default": "a"},
+        {"name": "t", "type": "float", "min": 0.0, "max": 1.0, "default": 0.5},
+        {"name": "seed", "type": "int", "min": 0, "max": 2 ** 32 - 1, "default": 0},
+    ]}
+    runs = bench.sweep(method)
+    base = {"k": 3, "w": "a", "t": 0.5, "seed": 0}
+    assert base in runs and len(runs) == len({tuple(r.items()) for r in runs})
+    assert sorted(r["k"] for r in runs if r["w"] == "a" and r["t"] == 0.5) == [2, 3, 4, 8]
+    assert {r["w"] for r in runs} == {"a", "b"} and {r["t"] for r in runs} == {0.0, 0.5, 1.0}
+    assert {r["seed"] for r in runs} == {0}
+    assert bench.sweep(method, quick=True) == [base]
+    assert bench.sweep({"name": "plain", "params": []}) == [{}]
+
+
+def test_image_errors():
+    exact = np.zeros((4, 4, 4), np.float32)
+    image = exact.copy()
+    image[:2, :, :3] = 0.1  # the top half is off by 0.1 per channel
+    covered = np.zeros((4, 4), bool)
+    covered[:2] = True
+    e = bench.image_errors(image, exact, covered)
+    assert e["mean_err"] == pytest.approx(0.1 * math.sqrt(3)) == e["max_err"]
+    assert e["mean_err_all"] == pytest.approx(0.05 * math.sqrt(3))
+    assert e["rmse"] == pytest.approx(0.1) and e["psnr"] == pytest.approx(20.0)
+    assert bench.image_errors(exact, exact, covered)["psnr"] == math.inf
+    if bench.flip_missing() is None:
+        assert e["flip"] > 0 and bench.image_errors(exact, exact, covered)["flip"] == 0
+    else:
+        assert math.isnan(e["flip"])
+
+
+def test_pareto_front():
+    points = [(1.0, 5.0), (2.0, 3.0), (3.0, 4.0), (4.0, 1.0), (2.0, 6.0)]
+    assert plots.pareto_front(points) == [0, 1, 3]
+
+
+# ---- pygfx, the peer: the same input gives the same picture
+
+needs_pygfx = pytest.mark.skipif(peers.pygfx_missing() is not None, reason=str(peers.pygfx_missing()))
+PEER_SIZE = 48
+
+
+def srgb8(image):
+    return np.rint(linear_to_srgb(image[..., :3]) * 255.0)
+
+
+@needs_pygfx
+def test_pygfx_draws_an_opaque_scene_as_we_do(renderer):
+    """Opaque meshes with random linear vertex colors under a perspective camera, on a colored
+    background: if colors, camera or background were converted differently, whole regions
+    would differ; pygfx stores 8-bit sRGB, so one step of that is the tolerance."""
+    rng = np.random.default_rng(5)
+    meshes = []
+    for _ in range(5):
+        p, i = geometry.uv_sphere(rng.uniform(-0.5, 0.5, 3), rng.uniform(0.2, 0.4), 8, 16)
+        meshes.append(scenes.MeshArrays(p, i, rng.uniform(0, 1, (len(p), 4)).astype(np.float32), opaque=True))
+    camera = oit.Camera.look_at(eye=(0.7, 0.5, 2.5), target=(0.0, 0.0, 0.0), fov_y=45.0, near=1.0, far=5.0)
+    built = scenes.from_meshes(meshes, camera)
+    background = (0.2, 0.5, 0.9)
+    ours = renderer(PEER_SIZE, PEER_SIZE).render(built.scene, built.camera, "abuffer", background=background).image
+    theirs, _ = peers.pygfx_renderer(PEER_SIZE, PEER_SIZE).render(built, "solid", background)
+    assert np.abs(srgb8(ours) - srgb8(theirs)).max() <= 1
+
+
+@needs_pygfx
+def test_pygfx_blend_sorts_objects_back_to_front_as_sorted_does(renderer):
+    """Three transparent quads, separate in depth, submitted nearest first: pygfx's blend mode
+    sorts objects by their view depth, so it must agree with our `sorted` (not `unsorted`); a
+    camera passed with the wrong depth direction would reverse its order."""
+    camera = oit.Camera.look_at(eye=(0.3, 0.2, 3.0), target=(0.0, 0.0, 0.0), fov_y=45.0, near=1.0, far=6.0)
+    meshes = [scenes.MeshArrays(*geometry.quad((0.1 * k, 0.0, 0.5 - 0.5 * k), 1.2), np.tile(rgba, (4, 1)).astype(np.float32))
+              for k, rgba in enumerate([(0.9, 0.1, 0.1, 0.5), (0.1, 0.9, 0.1, 0.5), (0.1, 0.1, 0.9, 0.5)])]
+    built = scenes.from_meshes(meshes, camera)
+    r = renderer(PEER_SIZE, PEER_SIZE)
+    ours = {m: r.render(built.scene, built.camera, m).image for m in ("sorted", "unsorted")}
+    theirs, _ = peers.pygfx_renderer(PEER_SIZE, PEER_SIZE).render(built, "blend")
+    assert np.abs(srgb8(ours["sorted"]) - srgb8(theirs)).max() <= 2
+    assert np.abs(srgb8(ours["unsorted"]) - srgb8(theirs)).max() > 30
+
+
+@needs_pygfx
+def test_bench_puts_pygfx_rows_in_the_table():
+    rows = by_method(bench.run(**{**TINY, "methods": ["abuffer", "unsorted"], "with_peers": True}).rows)
+    for mode in peers.PYGFX_MODES:
+        row = rows[f"pygfx-{mode}"]
+        assert row["status"] == "ok" and row["wall_ms"] > 0 and row["mean_err"] >= 0, row
+        assert row["adapter"].startswith("pygfx on ") and math.isnan(row["gpu_ms"])

@@ -1,0 +1,139 @@
+"""The viewer (crates/oit-viewer): scene files, `python -m oit view`, and `--screenshot` under
+Xvfb compared with the library's render of the same scene and camera. The screenshot tests
+are skipped without the binary (`make viewer`) or without `xvfb-run` (Debian's xvfb)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import oit
+from oit import cli, scenefile, scenes, view
+from oit.imageio import to_srgb8
+from oit.scenefile import LookAt
+
+
+def _viewer():
+    try:
+        return view.find_viewer()
+    except RuntimeError:
+        return None
+
+
+VIEWER = _viewer()
+needs_screen = pytest.mark.skipif(VIEWER is None or shutil.which("xvfb-run") is None,
+                                  reason="needs the oit-viewer binary (`make viewer`) and xvfb-run (apt-get install xvfb)")
+
+
+def read_png(path: Path) -> np.ndarray:
+    """(h, w, 4) uint8 of an 8-bit RGBA PNG as the viewer writes it (no row filters)."""
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    at, idat, size = 8, b"", None
+    while at < len(data):
+        length, kind = struct.unpack(">I4s", data[at:at + 8])
+        body = data[at + 8:at + 8 + length]
+        if kind == b"IHDR":
+            w, h, depth, color = struct.unpack(">IIBB", body[:10])
+            assert (depth, color) == (8, 6), "expected 8-bit RGBA"
+            size = (w, h)
+        elif kind == b"IDAT":
+            idat += body
+        at += 12 + length
+    w, h = size
+    rows = np.frombuffer(zlib.decompress(idat), np.uint8).reshape(h, 1 + 4 * w)
+    assert (rows[:, 0] == 0).all(), "the viewer writes PNG rows unfiltered"
+    return rows[:, 1:].reshape(h, w, 4)
+
+
+def screenshot(tmp_path: Path, args, size=(480, 320), env=None) -> np.ndarray:
+    out = tmp_path / "shot.png"
+    w, h = size
+    command = ["xvfb-run", "-a", "-s", f"-screen 0 {w + 64}x{h + 64}x24", str(VIEWER), *args, "--size", str(w), str(h),
+               "--hide-panel", "--screenshot", str(out), "--frames", "2", "--crop-view"]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=180, env={**os.environ, **(env or {})})
+    assert done.returncode == 0, done.stdout + done.stderr
+    return read_png(out)
+
+
+def assert_matches(shot: np.ndarray, frame_image: np.ndarray) -> None:
+    """The screenshot shows the frame: the 8-bit sRGB encoding of its linear RGB. On lavapipe
+    (Mesa llvmpipe) the display path (egui samples an sRGB texture and writes the window) is
+    exact: 0 pixels differ. The slack, one level on at most 0.1% of the pixels, is for
+    drivers that round the texture round trip differently."""
+    expected = to_srgb8(frame_image[..., :3]).astype(np.int16)
+    got = shot[..., :3].astype(np.int16)
+    assert got.shape == expected.shape
+    background = (got == 255).all(axis=2).mean()
+    assert 0.05 < background < 0.95, f"the screenshot is blank or all scene ({background:.1%} background)"
+    diff = np.abs(got - expected).max(axis=2)
+    assert diff.max() <= 1 and (diff > 0).mean() <= 0.001, \
+        f"{(diff > 0).sum()} of {diff.size} pixels differ, by up to {diff.max()} levels"
+
+
+def test_scene_file_round_trip(tmp_path):
+    built = scenes.glass(detail=8)
+    path = tmp_path / "glass.oitscene"
+    scenefile.save_scene(built, path)
+    meshes, camera, size = scenefile.load_scene(path)
+    assert size == built.size and np.array_equal(camera.view_proj, built.camera.view_proj)
+    for a, b in zip(meshes, built.meshes):
+        assert a.opaque == b.opaque
+        for x, y in ((a.positions, b.positions), (a.indices, b.indices), (a.colors, b.colors)):
+            assert np.array_equal(x, y)
+    look = LookAt(eye=(0.0, 0.0, 3.0), target=(0.0, 0.0, 0.0), fov_y=40.0, near=1.0, far=5.0)
+    scenefile.save_scene(built.meshes[:1], path, camera=look)
+    assert scenefile.load_scene(path)[1] == look
+    with pytest.raises(TypeError, match="BuiltScene"):
+        scenefile.save_scene(built.scene, path)
+
+
+def test_view_export_writes_the_builtin_scene(tmp_path):
+    out = tmp_path / "stacks.oitscene"
+    assert cli.main(["view", "--scene", "stacks", "--export", str(out)]) == 0
+    meshes, camera, size = scenefile.load_scene(out)
+    assert len(meshes) == 1 and size == (10, 10) and np.array_equal(camera.view_proj, np.eye(4))
+    assert cli.main(["view", "--scene", "nope", "--export", str(out)]) == 2
+
+
+def test_view_without_the_binary_says_how_to_build_it(tmp_path, monkeypatch, capsys):
+    monkeypatch.delenv("OIT_VIEWER", raising=False)
+    monkeypatch.setenv("CARGO_TARGET_DIR", str(tmp_path))
+    monkeypatch.setenv("PATH", str(tmp_path))
+    monkeypatch.setattr(view.Path, "home", lambda: tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["view", "--scene", "glass"]) == 1
+    assert "make viewer" in capsys.readouterr().err
+
+
+@needs_screen
+def test_screenshot_equals_the_library_render(tmp_path):
+    """A look-at camera: the viewer re-aims it at the view's aspect as Camera.look_at does."""
+    built = scenes.glass(detail=12)
+    look = LookAt(eye=(1.2, 0.9, 1.8), target=(0.0, 0.0, 0.0), fov_y=45.0, near=1.0, far=5.0)
+    path = tmp_path / "glass.oitscene"
+    scenefile.save_scene(built.meshes, path, camera=look)
+    shot = screenshot(tmp_path, [str(path), "--method", "abuffer"], size=(480, 320))
+    h, w = shot.shape[:2]
+    assert (w, h) == (480, 320)
+    frame = oit.Renderer(w, h).render(scenefile.scene_of(built.meshes), look.camera(aspect=w / h), method="abuffer")
+    assert_matches(shot, frame.image)
+
+
+@needs_screen
+def test_builtin_scene_through_python_keeps_its_camera(tmp_path):
+    """--scene delegates to `python -m oit view --export`; the BuiltScene's matrix camera is
+    read back into a look-at, so a square view shows exactly the library's frame."""
+    built = scenes.glass()
+    shot = screenshot(tmp_path, ["--scene", "glass", "--method", "abuffer"], size=(256, 256),
+                      env={"OIT_PYTHON": sys.executable})
+    frame = oit.Renderer(256, 256).render(built.scene, built.camera, method="abuffer")
+    assert_matches(shot, frame.image)
