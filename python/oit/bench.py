@@ -150,6 +150,8 @@ def _row(scene: str, size: str, method: str, params: Params, **values: Any) -> d
            "fragments": math.nan, "max_depth": math.nan, "overflow": math.nan, **{e: math.nan for e in ERRORS},
            "adapter": "", "message": ""}
     row.update(values)
+    # Other work on the machine skews times: the CSV keeps the 1-minute load average at each row.
+    row["load_avg"] = os.getloadavg()[0] if hasattr(os, "getloadavg") else math.nan
     return row
 
 
