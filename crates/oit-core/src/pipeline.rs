@@ -82,6 +82,18 @@ fn fullscreen_targets(
     })
 }
 
+/// A compute pipeline for the entry `entry` of `module`.
+pub fn compute(device: &wgpu::Device, layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
 /// Layout entry of a read-write storage buffer visible to fragment and compute shaders.
 pub fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {

@@ -44,16 +44,7 @@ impl Scan {
             entries: &[entry(0, storage), entry(1, storage), entry(2, wgpu::BufferBindingType::Uniform)],
         });
         let pl = crate::pipeline::layout(d, &[&layout]);
-        let pipeline = |entry: &str| {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let pipeline = |entry: &str| crate::pipeline::compute(d, &pl, &module, entry);
         let (scan, add) = (pipeline("cs_scan_blocks"), pipeline("cs_add_blocks"));
         let mut buffers = Vec::new();
         let mut levels = Vec::new();

@@ -188,8 +188,13 @@ pub struct ViewerApp {
 }
 
 impl ViewerApp {
+    /// The app on eframe's device (`cc.wgpu_render_state`).
     pub fn new(cc: &eframe::CreationContext<'_>, data: SceneData, settings: Settings, title: String) -> Self {
-        let gpu = gpu::context(cc.wgpu_render_state.as_ref());
+        Self::with_gpu(gpu::context(cc.wgpu_render_state.as_ref()), data, settings, title)
+    }
+
+    /// The app on a given engine context (tests build it on their own egui-wgpu device).
+    pub fn with_gpu(gpu: Result<Arc<GpuContext>, String>, data: SceneData, settings: Settings, title: String) -> Self {
         let camera = ViewCamera::new(data.camera.as_ref(), &data.meshes);
         let meshes = data.meshes.into_iter().map(|m| MeshControl::new(m.name, m.mesh)).collect();
         Self {
@@ -417,8 +422,9 @@ impl ViewerApp {
     }
 }
 
-impl eframe::App for ViewerApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+impl ViewerApp {
+    /// One frame of the whole window.
+    pub fn show(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.take_screenshot(&ctx);
         if self.show_panel {
@@ -430,6 +436,12 @@ impl eframe::App for ViewerApp {
         if !ctx.egui_wants_keyboard_input() {
             view::shortcuts(&ctx, self);
         }
+    }
+}
+
+impl eframe::App for ViewerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.show(ui);
     }
 
     fn clear_color(&self, _visuals: &egui::Visuals) -> [f32; 4] {

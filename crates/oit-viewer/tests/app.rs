@@ -3,7 +3,7 @@
 //! also checks the app's numbers against the engine itself, not only against the pictures.
 //! Update the pictures with `UPDATE_SNAPSHOTS=1 cargo test --release -p oit-viewer`.
 
-use std::sync::Arc;
+mod common;
 
 use eframe::egui::accesskit::Role;
 use eframe::egui::Key;
@@ -11,7 +11,7 @@ use egui_kittest::kittest::Queryable;
 use egui_kittest::{Harness, SnapshotOptions};
 use oit_core::{Camera, Mesh, Renderer};
 use oit_viewer::scenefile::{CameraSpec, NamedMesh, SceneData};
-use oit_viewer::{gpu, Compare, Settings, ViewMode, ViewerApp};
+use oit_viewer::{Compare, Settings, ViewMode, ViewerApp};
 
 const SIZE: [f32; 2] = [720.0, 440.0];
 
@@ -37,12 +37,15 @@ fn scene() -> SceneData {
     }
 }
 
+/// The app on the test renderer's device, as eframe would run it.
 fn harness(method: &str) -> Harness<'static, ViewerApp> {
+    let renderer = common::WgpuRenderer::new();
+    let app = ViewerApp::with_gpu(renderer.context(), scene(), Settings::new(method), "test scene".into());
     let mut h = Harness::builder()
         .with_size(SIZE)
         .with_pixels_per_point(1.0)
-        .wgpu_setup(gpu::setup(None, true))
-        .build_eframe(move |cc| ViewerApp::new(cc, scene(), Settings::new(method), "test scene".into()));
+        .renderer(renderer)
+        .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app);
     h.run();
     h
 }
@@ -159,7 +162,7 @@ fn the_frame_is_the_engines_frame() {
         own_scene.add_mesh(m.mesh);
     });
     let gpu = oit_core::shared_context(None).unwrap();
-    let mut r = Renderer::new(Arc::clone(&gpu), f.width, f.height).unwrap();
+    let mut r = Renderer::new(gpu, f.width, f.height).unwrap();
     let own = r.render(&own_scene, &camera, "abuffer", &[], [1.0; 3]).unwrap();
     let diff = own.image.iter().zip(&f.image).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
     assert!(diff < 1e-6, "max difference {diff}");

@@ -91,14 +91,7 @@ impl Hybrid {
         let store = pipeline::geometry(d, "hybrid store", &module, &pl, "fs_store", &[], pipeline::depth_test_only());
         let shade = pipeline::geometry(d, "hybrid shade", &module, &pl, "fs_shade", &[], pipeline::depth_test_only());
         let finish = pipeline::fullscreen_with_bound(d, "hybrid final", &module, &pl, "fs_final");
-        let visibility = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("hybrid visibility"),
-            layout: Some(&pl),
-            module: &module,
-            entry_point: Some("cs_visibility"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let visibility = pipeline::compute(d, &pl, &module, "cs_visibility");
         Pipelines { store, visibility, shade, finish }
     }
 

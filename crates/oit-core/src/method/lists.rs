@@ -251,16 +251,7 @@ impl ListMethod {
         let layout = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &self.pool.layout]);
         let capture = pipeline::geometry(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::depth_test_only());
         let resolve = pipeline::fullscreen(d, "list resolve", &module, &layout, "fs_resolve");
-        let compute = |entry: &str| {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let compute = |entry: &str| pipeline::compute(d, &layout, &module, entry);
         let sweep = self.sweeps.then(|| compute("cs_sweep"));
         let allocate = matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate"));
         let count = (self.aux == Aux::PixelOffsets)

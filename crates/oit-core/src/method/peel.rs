@@ -79,16 +79,7 @@ impl Peel {
         });
         let module = shader::module(d, "peel.wgsl", &[Const::U32("DUAL", self.dual as u32)]);
         let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &layout]);
-        let compute = |entry: &str| {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let compute = |entry: &str| pipeline::compute(d, &pl, &module, entry);
         Pipelines {
             init: compute("cs_init"),
             peel: pipeline::geometry(d, "peel", &module, &pl, "fs_peel", &[], pipeline::depth_test_only()),
