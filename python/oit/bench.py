@@ -144,8 +144,13 @@ class Result:
     notes: list[str] = field(default_factory=list)
 
 
+def format_params(params: Params) -> str:
+    """'k=8', 'samples=8 seed=0', 'tolerance=0.00392157' (floats to 6 significant digits)."""
+    return " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+
+
 def _row(scene: str, size: str, method: str, params: Params, **values: Any) -> dict:
-    row = {"scene": scene, "size": size, "method": method, "params": " ".join(f"{k}={v}" for k, v in params.items()),
+    row = {"scene": scene, "size": size, "method": method, "params": format_params(params),
            "status": "ok", "gpu_ms": math.nan, "wall_ms": math.nan, "memory_mib": math.nan, "formula_mib": math.nan,
            "fragments": math.nan, "max_depth": math.nan, "overflow": math.nan, **{e: math.nan for e in ERRORS},
            "adapter": "", "message": ""}
