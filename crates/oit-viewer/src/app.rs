@@ -176,6 +176,8 @@ pub struct ViewerApp {
     key: Option<RenderKey>,
     exact_key: Option<RenderKey>,
     pub error: Option<ErrorMap>,
+    /// `renders` when `error` was computed.
+    error_at: Option<u64>,
     pub render_error: Option<String>,
     /// Engine renders so far (the method's and the exact one's).
     pub renders: u64,
@@ -213,6 +215,7 @@ impl ViewerApp {
             key: None,
             exact_key: None,
             error: None,
+            error_at: None,
             render_error: None,
             renders: 0,
             texture: None,
@@ -277,6 +280,7 @@ impl ViewerApp {
         let stale = self.key.as_ref() != Some(&key);
         let exact_stale = want_exact && self.exact_key.as_ref() != Some(&exact_key);
         if !stale && !exact_stale {
+            self.refresh_error();
             return false;
         }
         if self.renderer.as_ref().map(|r| r.size()) != Some((size[0], size[1])) {
@@ -323,13 +327,20 @@ impl ViewerApp {
                 }
             }
         }
+        self.refresh_error();
+        true
+    }
+
+    /// The error map of the current frames, computed once per pair (compare and error modes).
+    fn refresh_error(&mut self) {
+        if !self.settings.needs_exact() || self.error_at == Some(self.renders) {
+            return;
+        }
+        self.error_at = Some(self.renders);
         self.error = match (self.frame.as_ref(), self.exact_frame()) {
-            (Some(f), Some(x)) if self.settings.needs_exact() && f.image.len() == x.image.len() => {
-                Some(ErrorMap::new(&f.image, &x.image))
-            }
+            (Some(f), Some(x)) if f.image.len() == x.image.len() => Some(ErrorMap::new(&f.image, &x.image)),
             _ => None,
         };
-        true
     }
 
     /// The picture for the current frames and settings.

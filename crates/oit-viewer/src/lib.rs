@@ -17,10 +17,7 @@ pub use args::Options;
 
 /// The settings the command line asks for, with the method and parameters checked.
 pub fn settings(o: &Options) -> Result<Settings, String> {
-    let info = oit_core::methods().iter().find(|m| m.name == o.method).ok_or_else(|| {
-        let names: Vec<&str> = oit_core::methods().iter().map(|m| m.name).collect();
-        format!("unknown method '{}'; valid methods: {}", o.method, names.join(", "))
-    })?;
+    let info = oit_core::method::lookup(&o.method).map_err(|e| e.to_string())?;
     info.resolve_params(&o.params).map_err(|e| e.to_string())?;
     let mut s = Settings::new(&o.method);
     for (k, v) in &o.params {

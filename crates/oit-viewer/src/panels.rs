@@ -148,7 +148,7 @@ fn stats_section(ui: &mut egui::Ui, app: &ViewerApp) {
         for (k, v) in &st.extra {
             row(k, format!("{v}"));
         }
-        if let Some(e) = &app.error {
+        if let Some(e) = app.error.as_ref().filter(|_| app.settings.needs_exact()) {
             row("mean error", format!("{:.5}", e.mean));
             row("max error", format!("{:.5}", e.max));
         }

@@ -141,9 +141,18 @@ fn renders_only_when_something_changed() {
     h.state_mut().settings.background = [0.0, 0.0, 0.0];
     h.run();
     assert_eq!(h.state().renders, n + 1);
-    h.state_mut().camera.moved().rotate(40.0, 10.0);
+    // A mouse drag over the view orbits the camera, and the frame follows.
+    let from = h.state().view_rect.center();
+    let to = from + eframe::egui::vec2(60.0, 20.0);
+    h.hover_at(from);
+    h.drag_at(from);
     h.run();
-    assert_eq!(h.state().renders, n + 2);
+    h.hover_at(to);
+    h.run();
+    h.drop_at(to);
+    h.run();
+    assert!(!h.state().camera.is_home(), "the drag moved the camera");
+    assert!(h.state().renders > n + 1);
     h.key_press(Key::R); // reset view
     h.run();
     assert!(h.state().camera.is_home());
