@@ -97,9 +97,20 @@ def test_dragons_from_a_file(tmp_path):
         scenes.dragons(path=tmp_path / "missing.obj")
 
 
-def test_dragons_use_the_shared_mesh_when_present(shared_data):
+def test_dragons_use_the_shared_mesh_when_present(shared_data, monkeypatch):
+    monkeypatch.delenv("OIT_DATA", raising=False)
     built = scenes.dragons(max_triangles=500)
     assert built.meta["mesh"] == "dragon-100k.obj"
+
+
+def test_the_data_folder_follows_oit_data(tmp_path, monkeypatch):
+    monkeypatch.setenv("OIT_DATA", str(tmp_path))
+    assert scenes.shared_data_dir() == tmp_path
+    assert scenes.dragons(max_triangles=200).meta["mesh"] == "stand-in blob"  # no dragon there
+    trimesh.Trimesh(*geometry.uv_sphere(rings=8, segments=12)).export(tmp_path / scenes.DRAGON_FILE)
+    assert scenes.dragons(max_triangles=200).meta["mesh"] == scenes.DRAGON_FILE
+    monkeypatch.setenv("OIT_DATA", str(tmp_path / "absent"))
+    assert scenes.shared_data_dir() is None and scenes.dragons(max_triangles=200).meta["mesh"] == "stand-in blob"
 
 
 def test_stacks_give_every_pixel_its_layers(renderer):

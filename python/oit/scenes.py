@@ -8,7 +8,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator, Sequence, Union
+from typing import Any, Iterator, Optional, Sequence, Union
 
 import numpy as np
 
@@ -16,7 +16,7 @@ from . import geometry
 from ._api import Camera, Scene
 
 __all__ = ["BuiltScene", "MeshArrays", "from_meshes", "hair", "smoke", "foliage", "dragons", "glass", "stacks", "ALPHA_KINDS",
-           "DRAGON_ALPHAS", "DRAGON_PATH", "SCENES", "SHOWCASE"]
+           "DRAGON_ALPHAS", "DRAGON_FILE", "shared_data_dir", "default_dragon_path", "SCENES", "SHOWCASE"]
 
 
 @dataclass
@@ -228,13 +228,33 @@ def glass(detail: int = 32) -> BuiltScene:
 
 # The opacities of the hybrid paper's 22 dragons (Maule et al. 2013), front to back.
 DRAGON_ALPHAS = (0.05, 0.1, 0.05, 0.1, 0.2, 0.9, 0.2, 0.1, 0.05, 0.1, 0.05) * 2
-# ../shared/data beside the repository; absent in an installed package, where the stand-in is used.
-DRAGON_PATH = Path(__file__).resolve().parents[3] / "shared" / "data" / "dragon-100k.obj"
+DRAGON_FILE = "dragon-100k.obj"
+
+
+def shared_data_dir() -> Optional[Path]:
+    """The optional mesh folder: $OIT_DATA when set, else the first `shared/data` found beside
+    the working directory or the package (walking up from each), else None. An installed wheel
+    lives in site-packages, far from the checkout, so the working directory is searched too."""
+    env = os.environ.get("OIT_DATA")
+    if env:
+        return Path(env) if Path(env).is_dir() else None
+    for start in (Path.cwd(), Path(__file__).resolve().parent):
+        for folder in (start, *start.parents):
+            candidate = folder / "shared" / "data"
+            if candidate.is_dir():
+                return candidate
+    return None
+
+
+def default_dragon_path() -> Optional[Path]:
+    """shared_data_dir()/dragon-100k.obj when it exists, else None (the stand-in is used)."""
+    folder = shared_data_dir()
+    return folder / DRAGON_FILE if folder is not None and (folder / DRAGON_FILE).is_file() else None
 
 
 def _dragon_mesh(path: Union[str, os.PathLike, None], max_triangles: int) -> tuple[np.ndarray, np.ndarray, str]:
     """The dragon (or the stand-in blob) centered, longest side 1, decimated to max_triangles."""
-    if path is not None and (Path(path) != DRAGON_PATH or DRAGON_PATH.is_file()):
+    if path is not None:
         import trimesh
 
         if not Path(path).is_file():
@@ -250,13 +270,15 @@ def _dragon_mesh(path: Union[str, os.PathLike, None], max_triangles: int) -> tup
     return p, indices, source
 
 
-def dragons(path: Union[str, os.PathLike, None] = DRAGON_PATH, max_triangles: int = 8000) -> BuiltScene:
+def dragons(path: Union[str, os.PathLike, None] = "default", max_triangles: int = 8000) -> BuiltScene:
     """The hybrid paper's 22 aligned dragons with its opacities (DRAGON_ALPHAS), one after
     another along the view, each lit by a fixed light baked into its vertex colors. `path`:
-    the mesh (anything trimesh loads); the default ../shared/data/dragon-100k.obj is used when
-    present, and None or its absence gives a built-in non-convex stand-in. Each instance is
+    the mesh (anything trimesh loads); "default" uses dragon-100k.obj from shared_data_dir()
+    when present, and None or its absence gives a built-in non-convex stand-in. Each instance is
     decimated to at most `max_triangles` (22 full 100k-triangle dragons are slow on a software
     rasterizer). `meta["mesh"]` says which mesh was used."""
+    if isinstance(path, str) and path == "default":
+        path = default_dragon_path()
     p, idx, source = _dragon_mesh(path, max_triangles)
     light = np.array([0.4, 0.8, 0.45]) / np.linalg.norm([0.4, 0.8, 0.45])
     shade = 0.35 + 0.65 * np.abs(geometry.vertex_normals(p, idx) @ light)  # two-sided: back faces show
