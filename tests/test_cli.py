@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import struct
 import subprocess
 import sys
@@ -10,7 +11,8 @@ from pathlib import Path
 import pytest
 import trimesh
 
-from oit import cli
+import oit
+from oit import bench, cli
 
 
 def run_oit(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -129,11 +131,31 @@ def test_demo_result():
 
 
 def test_bench_quick_writes_its_tables(tmp_path):
+    # Three methods on the smallest scene: the command end to end, in a few seconds.
     out = tmp_path / "bench"
-    result = run_oit("bench", "--quick", "--out", str(out), cwd=tmp_path)
+    result = run_oit("bench", "--quick", "--scenes", "glass", "--methods", "unsorted", "abuffer", "hybrid",
+                     "--no-peers", "--no-plots", "--out", str(out), cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     table = (out / "results.md").read_text()
-    assert "| hair |" in table and "hybrid" in table and "abuffer" in table
-    rows = (out / "results.csv").read_text().splitlines()
-    assert rows[0].startswith("scene,size,method")
-    assert len(rows) > 5
+    assert table.startswith("Adapter: ")
+    assert [line.split(" | ")[2] for line in table.splitlines() if line.startswith("| glass |")] == ["abuffer", "unsorted", "hybrid"]
+    with open(out / "results.csv") as f:
+        rows = {r["method"]: r for r in csv.DictReader(f)}
+    assert list(rows) == ["abuffer", "unsorted", "hybrid"]
+    for r in rows.values():
+        assert r["status"] == "ok" and r["size"] == "64x64" and float(r["wall_ms"]) > 0
+        assert int(r["max_depth"]) >= 2  # the glass shells overlap
+    assert rows["hybrid"]["params"] == "k=8"
+    assert float(rows["abuffer"]["mean_err"]) == 0.0
+    # Glass is ordered worst for submission-order blending; hybrid's 8 slots hold its few layers.
+    assert float(rows["hybrid"]["mean_err"]) < 0.01 < float(rows["unsorted"]["mean_err"])
+
+
+def test_bench_quick_defaults_run_every_showcase_scene_and_method():
+    # What `bench --quick` would run, without running it (that takes half a minute).
+    args = cli.build_parser().parse_args(["bench", "--quick"])
+    assert args.scenes == list(oit.scenes.SHOWCASE) and args.methods is None and args.sizes is None
+    plan = bench.method_plan(args.methods, args.quick)
+    assert [method for method, _, _ in plan] == [m["name"] for m in oit.methods()]
+    assert all(is_default for *_, is_default in plan)
+    assert dict((m, p) for m, p, _ in plan)["hybrid"] == {"k": 8}

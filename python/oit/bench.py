@@ -170,17 +170,24 @@ def _build(name: str, size: int | None, quick: bool) -> scene_lib.BuiltScene:
     return builder(**kwargs)
 
 
+def method_plan(methods: list[str] | None = None, quick: bool = False) -> list[tuple[str, Params, bool]]:
+    """What the bench runs on each scene: (method, parameters, whether they are the method's
+    defaults: those rows go on the image sheet) for every method of oit.methods() or those
+    named, in that order."""
+    known = list_methods()
+    if methods is not None:
+        unknown = sorted(set(methods) - {m["name"] for m in known})
+        if unknown:
+            raise ValueError(f"unknown method(s) {', '.join(unknown)}; `python -m oit methods` lists them")
+    infos = [m for m in known if methods is None or m["name"] in methods]
+    return [(m["name"], p, p == sweep(m, quick=True)[0]) for m in infos for p in sweep(m, quick)]
+
+
 def run(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | None = None, repeat: int = 5,
         quick: bool = False, with_peers: bool = True, show_progress: bool = True) -> Result:
     """Measures every method of oit.methods() (or those named) on each scene at each size
     (default: the scene's own; --quick caps it at QUICK_SIZE)."""
-    infos = [m for m in list_methods() if methods is None or m["name"] in methods]
-    if methods is not None:
-        unknown = sorted(set(methods) - {m["name"] for m in list_methods()})
-        if unknown:
-            raise ValueError(f"unknown method(s) {', '.join(unknown)}; `python -m oit methods` lists them")
-    # (method, parameters, whether they are the defaults: those rows go on the image sheet)
-    plan = [(m["name"], p, p == sweep(m, quick=True)[0]) for m in infos for p in sweep(m, quick)]
+    plan = method_plan(methods, quick)
     peer_reason = peers.pygfx_missing() if with_peers else "peers not requested (--no-peers)"
     peer_modes = peers.PYGFX_MODES if peer_reason is None else ()
     result = Result(rows=[])
