@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import oit
+from oit import formulas
 from oit.scenes import stacks
 from scenes import IDENTITY, PERSPECTIVE, build_scene, random_meshes
 
@@ -62,11 +63,28 @@ def test_auto_uses_no_more_slots_than_the_depth_complexity(renderer):
     frame = renderer(8, 8).render(built.scene, built.camera, "auto", tolerance=0.05)
     assert frame.stats["auto_k"] == 5 and frame.stats["overflow_fragments"] == 0
     assert frame.stats["auto_attempts"] == 1
+    # hybrid's slots and accumulators plus the estimate pass's 12 bytes a pixel
+    assert frame.stats["memory_bytes"] == formulas.memory_bytes("hybrid", 8, 8, k=5) + 8 * 8 * 12
+
+
+def test_auto_predicts_k_on_hair_like_stacks(renderer):
+    # Random alphas, 40 layers: the prediction picks one k, fewer than the layers, and it holds.
+    built = stacks(layers=40, alphas="random", size=(16, 16), seed=3)
+    r = renderer(16, 16)
+    frame = r.render(built.scene, built.camera, "auto", tolerance=16 / 255)
+    exact = r.render(built.scene, built.camera, "abuffer")
+    assert measured(frame, exact).max() <= 16 / 255
+    assert frame.stats["auto_exact"] == 0 and frame.stats["auto_attempts"] == 1
+    assert frame.stats["auto_k"] == frame.stats["auto_predicted_k"] < 40
 
 
 def test_auto_falls_back_to_exact_for_a_tiny_tolerance(renderer):
     built = stacks(layers=60, alphas="random", size=(8, 8), seed=2)
-    frame = renderer(8, 8).render(built.scene, built.camera, "auto", tolerance=1e-4)
+    r = renderer(8, 8)
+    frame = r.render(built.scene, built.camera, "auto", tolerance=1e-4)
     assert frame.stats["auto_exact"] == 1
+    # Predicted before rendering: no hybrid is tried, and the exact image is the A-buffer's.
+    assert frame.stats["auto_attempts"] == 1 and frame.stats["auto_predicted_k"] == 0
+    assert np.array_equal(frame.image, r.render(built.scene, built.camera, "abuffer").image)
     # The exact composite's own bound: float32 rounding of 62 terms.
     assert frame.stats["error_bound_max"] == pytest.approx(62 * 2.4e-7, rel=1e-6)

@@ -30,6 +30,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("mlab.wgsl", include_str!("../../../shaders/mlab.wgsl")),
     ("bucket_peeling.wgsl", include_str!("../../../shaders/bucket_peeling.wgsl")),
     ("hybrid64.wgsl", include_str!("../../../shaders/hybrid64.wgsl")),
+    ("auto_estimate.wgsl", include_str!("../../../shaders/auto_estimate.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.

@@ -4,7 +4,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::targets::read_buffer;
 
-const MAX_PASSES: u32 = 32;
+const MAX_PASSES: u32 = 64;
 
 pub struct PassTimer {
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,

@@ -1,0 +1,31 @@
+// auto's estimate pass: per pixel, the optical depth of its transparent fragments and how far
+// their alphas are from hybrid's 8-bit keys, so that auto can predict hybrid's error bound for
+// every k before rendering (docs/methods.md, "auto"). Three fixed-point words a pixel: the
+// optical depth, its square (for the spread of the nearest fragments' share) and the
+// quantization error.
+//!include common/scene.wgsl
+//!include common/targets.wgsl
+
+@group(2) @binding(0) var<storage, read_write> sums: array<atomic<u32>>;
+
+// Optical depth -ln(1 - alpha) per fragment, capped (alpha = 1 gives the cap), at 2^-12 per
+// unit: 65,536 capped fragments fit in a word; its square at 2^-10 (16,384 capped fragments).
+// Alpha quantization at 2^-24 per unit, rounded up.
+const TAU_CAP: f32 = 16.0;
+const TAU_SCALE: f32 = 4096.0;
+const TAU2_SCALE: f32 = 1024.0;
+const QUANT_SCALE: f32 = 16777216.0;
+
+@fragment
+fn fs_estimate(in: VsOut) {
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
+        return;
+    }
+    let a = min(in.color.a, 1.0);
+    let px = pixel_index(in.clip);
+    let tau = select(min(-log(1.0 - a), TAU_CAP), TAU_CAP, a >= 1.0);
+    atomicAdd(&sums[3u * px], u32(round(tau * TAU_SCALE)));
+    atomicAdd(&sums[3u * px + 1u], u32(round(tau * tau * TAU2_SCALE)));
+    let q = round(a * 255.0) / 255.0;
+    atomicAdd(&sums[3u * px + 2u], u32(ceil(abs(a - q) * QUANT_SCALE)));
+}
