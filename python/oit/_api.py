@@ -302,8 +302,11 @@ class Renderer:
         return self._native.adapter_info
 
     def render(self, scene: Scene, camera: Camera, method: str = "abuffer",
-               background: Sequence[float] = (1.0, 1.0, 1.0), **params: Any) -> Frame:
-        """Renders `scene` with `method` (see `oit.methods()`); parameters go as keywords."""
+               background: Sequence[float] = (1.0, 1.0, 1.0), antialias: int = 1, **params: Any) -> Frame:
+        """Renders `scene` with `method` (see `oit.methods()`); parameters go as keywords.
+        `antialias` S in (1, 2, 4, 8, 16): S samples a pixel on the standard pattern, each a
+        frame of its own with the method's buffers reused, averaged (memory as at one sample,
+        time about S times; docs/methods.md, "Antialiasing")."""
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be an oit.Scene, got {type(scene).__name__}")
         if not isinstance(camera, Camera):
@@ -311,7 +314,8 @@ class Renderer:
         if not isinstance(method, str):
             raise TypeError(f"method must be a string, got {type(method).__name__}")
         bg = _background(background)
-        image, dc, stats, bound = self._native.render(scene._native, camera.view_proj, method, bg, params)
+        image, dc, stats, bound = self._native.render(scene._native, camera.view_proj, method, bg, params,
+                                                      _antialias(antialias))
         stats["adapter"] = self.adapter_info["name"]
         if bound is not None:
             stats["error_bound_max"] = float(bound.max()) if bound.size else 0.0
@@ -320,6 +324,16 @@ class Renderer:
         reason = ("exact method: the error is float32 compositing, at most about (n + 2) * 2**-23 for n layers"
                   if exact else f"no per-pixel bound is derived for '{method}' (docs/methods.md)")
         return Frame(image=image, stats=stats, depth_complexity=dc, error_bound_reason=reason)
+
+
+ANTIALIAS = (1, 2, 4, 8, 16)
+
+
+def _antialias(antialias: Any) -> int:
+    samples = _int(antialias, "antialias", f"an int, one of {ANTIALIAS} samples a pixel")
+    if samples not in ANTIALIAS:
+        raise ValueError(f"antialias must be one of {ANTIALIAS} samples a pixel (the standard patterns), got {samples}")
+    return samples
 
 
 def _background(background: Sequence[float]) -> tuple[float, float, float]:
@@ -339,10 +353,12 @@ def methods() -> list[dict]:
 
 
 def reference(scene: Scene, camera: Camera, width: int, height: int, background: Sequence[float] = (1.0, 1.0, 1.0),
-              return_mask: bool = False):
+              return_mask: bool = False, antialias: int = 1):
     """The CPU float64 reference image (h, w, 4). With return_mask=True, also a boolean
     (h, w) mask of ambiguous pixels: a pixel center on a triangle edge or on two nearly
-    equal depths, where a rasterizer may legitimately differ (docs/methods.md)."""
+    equal depths, where a rasterizer may legitimately differ (docs/methods.md). With
+    `antialias` S, the mean over the S standard sample positions of each pixel, as
+    Renderer.render(..., antialias=S) renders it (ambiguous where any sample is)."""
     if not isinstance(scene, Scene) or not isinstance(camera, Camera):
         raise TypeError("reference(scene, camera, width, height): scene must be an oit.Scene and camera an oit.Camera")
     w, h = _int(width, "width"), _int(height, "height")
@@ -356,7 +372,8 @@ def reference(scene: Scene, camera: Camera, width: int, height: int, background:
         raise MemoryError(f"reference at {w} x {h} needs {need / 2**30:.1f} GiB"
                           + (f" but {avail / 2**30:.1f} GiB are available" if avail is not None else "")
                           + ": use a smaller size (it costs 37 bytes a pixel)")
-    image, ambiguous, _ = _oit.reference(scene._native, camera.view_proj, w, h, _background(background))
+    samples = _antialias(antialias)
+    image, ambiguous, _ = _oit.reference(scene._native, camera.view_proj, w, h, _background(background), samples)
     return (image, ambiguous) if return_mask else image
 
 

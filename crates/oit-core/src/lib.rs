@@ -1,6 +1,7 @@
 //! oit-core: order-independent transparency methods on wgpu, with an exact A-buffer and a
 //! CPU float64 reference to measure them against. No Python, no windowing.
 
+pub mod antialias;
 pub mod context;
 pub mod error;
 pub mod gpu_types;
@@ -18,6 +19,6 @@ mod upload;
 pub use context::GpuContext;
 pub use error::{OitError, Result};
 pub use method::{methods, MethodInfo, ParamInfo, ParamKind, ParamValue, Params};
-pub use reference::{reference, ReferenceImage};
+pub use reference::{reference, reference_antialiased, ReferenceImage};
 pub use renderer::{shared_context, Frame, Renderer, Stats};
 pub use scene::{Camera, Mesh, Scene};

@@ -184,6 +184,30 @@ pub fn reference(scene: &Scene, camera: &Camera, width: u32, height: u32, backgr
     Ok(ReferenceImage { width, height, image, ambiguous, depth_complexity: complexity })
 }
 
+/// The reference of an `antialias`-sample frame: the mean of the references at the standard
+/// sample positions (`antialias::sample_offsets`), a pixel ambiguous where any of its samples
+/// is, its depth complexity the largest of its samples'.
+pub fn reference_antialiased(
+    scene: &Scene,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    background: [f64; 3],
+    antialias: u32,
+) -> Result<ReferenceImage> {
+    let offsets = crate::antialias::sample_offsets(antialias)?;
+    let mut out = reference(scene, &camera.jittered(offsets[0], width, height), width, height, background)?;
+    for offset in &offsets[1..] {
+        let r = reference(scene, &camera.jittered(*offset, width, height), width, height, background)?;
+        out.image.iter_mut().zip(&r.image).for_each(|(a, b)| *a += b);
+        out.ambiguous.iter_mut().zip(&r.ambiguous).for_each(|(a, b)| *a |= b);
+        out.depth_complexity.iter_mut().zip(&r.depth_complexity).for_each(|(a, b)| *a = (*a).max(*b));
+    }
+    let n = offsets.len() as f64;
+    out.image.iter_mut().for_each(|v| *v /= n);
+    Ok(out)
+}
+
 #[allow(clippy::too_many_arguments)]
 fn trace(bvh: &Bvh2, tris: &[Tri], o: DVec3, d: DVec3, center: DVec2, vp: &DMat4, hits: &mut Vec<Hit>, edge: &mut bool) {
     let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()), -1e-3, 1.0 + 1e-3);

@@ -5,10 +5,11 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
+use crate::antialias;
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
 use crate::gpu_types::FrameUniform;
-use crate::method::{self, FrameCtx, Limits, Method, ParamValue, Params};
+use crate::method::{self, FrameCtx, Limits, Method, MethodInfo, ParamValue, Params};
 use crate::pipeline;
 use crate::scene::{Camera, Scene};
 use crate::shader;
@@ -34,6 +35,8 @@ pub struct Stats {
     pub overflow_fragments: u64,
     pub wall_time_ms: f64,
     pub extra: Vec<(&'static str, f64)>,
+    /// Samples a pixel (1: no antialiasing).
+    pub antialias: u32,
 }
 
 pub struct Frame {
@@ -180,15 +183,84 @@ impl Renderer {
         params: &[(String, ParamValue)],
         background: [f32; 3],
     ) -> Result<Frame> {
+        self.render_antialiased(scene, camera, method_name, params, background, 1)
+    }
+
+    /// Renders `antialias` sample frames, each with the camera moved onto one position of the
+    /// standard pattern (`antialias::sample_offsets`), and averages them: every method gets
+    /// antialiasing with its own buffers reused from sample to sample (memory as at one
+    /// sample, time about `antialias` times). Stats: fragments and overflow are summed over
+    /// the samples, depth complexity is the largest per pixel, GPU time the sum, memory the
+    /// largest of the samples; the error bound is the mean of the samples' bounds (the
+    /// error of a mean is at most the mean of the errors).
+    pub fn render_antialiased(
+        &mut self,
+        scene: &Scene,
+        camera: &Camera,
+        method_name: &str,
+        params: &[(String, ParamValue)],
+        background: [f32; 3],
+        antialias: u32,
+    ) -> Result<Frame> {
         let start = Instant::now();
+        let offsets = antialias::sample_offsets(antialias)?;
         let info = method::lookup(method_name)?;
         let params = info.resolve_params(params)?;
         if background.iter().any(|c| !c.is_finite() || !(0.0..=1.0).contains(c)) {
             return Err(invalid!("background {background:?} must be three linear RGB values in [0, 1]"));
         }
         self.upload(scene)?;
+        if offsets.len() == 1 {
+            let mut frame = self.render_sample(camera, info, &params, background)?;
+            frame.stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
+            return Ok(frame);
+        }
+        let pixels = self.width as usize * self.height as usize;
+        let mut image = vec![0.0f64; pixels * 4];
+        let mut bound: Option<Vec<f64>> = None;
+        let mut depth_complexity = vec![0u32; pixels];
+        let mut stats = Stats::default();
+        for (i, offset) in offsets.iter().enumerate() {
+            let jittered = camera.jittered(*offset, self.width, self.height);
+            let f = self.render_sample(&jittered, info, &params, background)?;
+            image.iter_mut().zip(&f.image).for_each(|(a, &v)| *a += v as f64);
+            if let Some(b) = &f.error_bound {
+                let sum = bound.get_or_insert_with(|| vec![0.0; pixels]);
+                sum.iter_mut().zip(b).for_each(|(a, &v)| *a += v as f64);
+            }
+            depth_complexity.iter_mut().zip(&f.depth_complexity).for_each(|(a, &v)| *a = (*a).max(v));
+            let s = f.stats;
+            if i == 0 {
+                stats = Stats { fragments: 0, overflow_fragments: 0, memory_bytes: 0, gpu_time_ms: Some(0.0), ..s.clone() };
+            }
+            stats.fragments += s.fragments;
+            stats.overflow_fragments += s.overflow_fragments;
+            stats.max_depth_complexity = stats.max_depth_complexity.max(s.max_depth_complexity);
+            stats.memory_bytes = stats.memory_bytes.max(s.memory_bytes);
+            stats.gpu_time_ms = stats.gpu_time_ms.zip(s.gpu_time_ms).map(|(a, b)| a + b);
+            if i > 0 {
+                stats.pass_times_ms.extend(s.pass_times_ms);
+            }
+            stats.extra = s.extra;
+        }
+        let n = offsets.len() as f64;
+        stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
+        stats.antialias = antialias;
+        Ok(Frame {
+            width: self.width,
+            height: self.height,
+            image: image.iter().map(|&v| (v / n) as f32).collect(),
+            depth_complexity,
+            error_bound: bound.map(|b| b.iter().map(|&v| (v / n) as f32).collect()),
+            stats,
+        })
+    }
+
+    /// One frame with the pixel centers where `camera` puts them (the scene is uploaded).
+    fn render_sample(&mut self, camera: &Camera, info: &'static MethodInfo, params: &Params, background: [f32; 3]) -> Result<Frame> {
+        let start = Instant::now();
         let gpu = self.gpu.clone();
-        let (_, gpu_scene) = self.scene.as_ref().expect("uploaded above");
+        let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
         let uniform = FrameUniform {
             view_proj: camera.matrix_f32().to_cols_array_2d(),
             background: [background[0], background[1], background[2], 0.0],
@@ -214,7 +286,7 @@ impl Renderer {
             targets_layout: &self.shared.targets_layout,
             scene_layout: &self.shared.scene_layout,
             timer: &mut self.timer,
-            params: &params,
+            params,
             max_depth_complexity,
             fragments,
             frame_uniform: &self.shared.uniform,
@@ -227,7 +299,7 @@ impl Renderer {
         let error_bound = if report.error_bound { Some(read_rows(&gpu, &t.bound_texture, &t.bound_readback, 4)?) } else { None };
         let stats = Stats {
             method: info.name.to_string(),
-            params,
+            params: params.clone(),
             fragments,
             max_depth_complexity,
             memory_bytes: report.memory_bytes,
@@ -238,6 +310,7 @@ impl Renderer {
             overflow_fragments: report.overflow_fragments,
             wall_time_ms: start.elapsed().as_secs_f64() * 1e3,
             extra: report.extra,
+            antialias: 1,
         };
         Ok(Frame { width: self.width, height: self.height, image, depth_complexity, error_bound, stats })
     }

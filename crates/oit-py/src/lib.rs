@@ -150,13 +150,22 @@ fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, 
     d.set_item("target_bytes", s.target_bytes)?;
     d.set_item("scene_bytes", s.scene_bytes)?;
     d.set_item("gpu_time_ms", s.gpu_time_ms)?;
+    // A pass that ran more than once (antialiasing samples, auto's attempts) adds up.
+    let mut summed: Vec<(&str, f64)> = Vec::new();
+    for &(k, v) in &s.pass_times_ms {
+        match summed.iter_mut().find(|(name, _)| *name == k) {
+            Some((_, total)) => *total += v,
+            None => summed.push((k, v)),
+        }
+    }
     let passes = PyDict::new(py);
-    for (k, v) in &s.pass_times_ms {
-        passes.set_item(*k, v)?;
+    for (k, v) in summed {
+        passes.set_item(k, v)?;
     }
     d.set_item("pass_times_ms", passes)?;
     d.set_item("overflow_fragments", s.overflow_fragments)?;
     d.set_item("wall_time_ms", s.wall_time_ms)?;
+    d.set_item("antialias", s.antialias)?;
     for (k, v) in &s.extra {
         d.set_item(*k, v)?;
     }
@@ -209,6 +218,7 @@ impl Renderer {
         method: &str,
         background: (f32, f32, f32),
         params: Bound<'py, PyDict>,
+        antialias: u32,
     ) -> PyResult<Bound<'py, PyAny>> {
         let camera = oit_core::Camera::from_rows(matrix(&view_proj)?).map_err(Error::from)?;
         let mut plist = Vec::new();
@@ -221,7 +231,7 @@ impl Renderer {
         let frame = py
             .detach(|| {
                 let mut r = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-                r.render(inner_scene, &camera, method, &plist, bg)
+                r.render_antialiased(inner_scene, &camera, method, &plist, bg, antialias)
             })
             .map_err(Error::from)?;
         let (h, w) = (frame.height as usize, frame.width as usize);
@@ -288,6 +298,7 @@ fn reference<'py>(
     width: i64,
     height: i64,
     background: (f64, f64, f64),
+    antialias: u32,
 ) -> PyResult<Bound<'py, PyAny>> {
     if width <= 0 || height <= 0 || width > 1 << 16 || height > 1 << 16 {
         return Err(PyValueError::new_err(format!("width and height must be in [1, 65536], got {width} x {height}")));
@@ -296,7 +307,7 @@ fn reference<'py>(
     let inner_scene = &scene.inner;
     let bg = [background.0, background.1, background.2];
     let r = py
-        .detach(|| oit_core::reference(inner_scene, &camera, width as u32, height as u32, bg))
+        .detach(|| oit_core::reference_antialiased(inner_scene, &camera, width as u32, height as u32, bg, antialias))
         .map_err(Error::from)?;
     let (h, w) = (height as usize, width as usize);
     let image = r.image.into_pyarray(py).reshape([h, w, 4])?;

@@ -1,0 +1,97 @@
+"""Antialiasing (`antialias` S): the mean of S sample frames on the standard pattern, checked
+against the supersampled float64 reference, on partly covered pixels, for memory (as at one
+sample), error bounds and order independence."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import oit
+from scenes import IDENTITY, PERSPECTIVE, MeshData, build_scene, layer, random_meshes
+
+BG = (0.2, 0.3, 0.4)
+
+
+@pytest.mark.parametrize("samples", [2, 4, 8])
+def test_abuffer_matches_the_supersampled_reference(renderer, samples):
+    r = renderer(48, 40)
+    for seed in range(3):
+        scene = build_scene(random_meshes(seed, transparent=8, opaque=2, triangles=6, space="world", spread=1.0))
+        frame = r.render(scene, PERSPECTIVE, background=BG, antialias=samples)
+        ref, ambiguous = oit.reference(scene, PERSPECTIVE, 48, 40, background=BG, return_mask=True, antialias=samples)
+        assert frame.stats["antialias"] == samples
+        assert ambiguous.mean() < 0.25
+        assert np.abs(frame.image - ref)[~ambiguous].max() <= 2e-6
+        # Antialiasing did something: some pixels are neither any single sample's value.
+        one = r.render(scene, PERSPECTIVE, background=BG)
+        assert np.abs(frame.image - one.image).max() > 0.05
+
+
+@pytest.mark.parametrize("samples", [2, 4, 8, 16])
+def test_an_edge_through_pixel_centers_covers_half_of_each_pixel(renderer, samples):
+    # A quad whose right edge is the vertical line through the centers of column 2 of a
+    # 5-pixel-wide frame: half of every pattern's samples lie left of it (the 16-sample
+    # pattern has one on the line, which the top-left rule leaves out: a right edge).
+    positions = np.array([[-1.0, -1.0, 0.5], [0.0, -1.0, 0.5], [0.0, 1.0, 0.5], [-1.0, 1.0, 0.5]])
+    quad = MeshData(positions, np.array([[0, 1, 2], [0, 2, 3]]), np.tile([1.0, 0.0, 0.0, 0.6], (4, 1)).astype(np.float32), False)
+    frame = renderer(5, 4).render(build_scene([quad]), IDENTITY, background=BG, antialias=samples)
+    inside = 0.6 * np.array([1.0, 0.0, 0.0]) + 0.4 * np.array(BG)
+    half = 0.5 * inside + 0.5 * np.array(BG)
+    rgb = frame.image[..., :3]
+    assert np.abs(rgb[:, :2] - inside).max() <= 1e-6
+    assert np.abs(rgb[:, 2] - half).max() <= 1e-6
+    assert np.abs(rgb[:, 3:] - np.array(BG)).max() <= 1e-6
+    # The background coverage (alpha) is the mean of the samples' too.
+    assert np.abs(frame.image[:, 2, 3] - 0.5 * 0.6).max() <= 1e-6
+    ref = oit.reference(build_scene([quad]), IDENTITY, 5, 4, background=BG, antialias=samples)
+    assert np.abs(frame.image - ref).max() <= 1e-6
+
+
+def test_one_sample_is_the_plain_frame(renderer):
+    scene = build_scene(random_meshes(4))
+    r = renderer(32, 32)
+    a = r.render(scene, PERSPECTIVE, "hybrid")
+    b = r.render(scene, PERSPECTIVE, "hybrid", antialias=1)
+    assert np.array_equal(a.image, b.image) and a.stats["antialias"] == b.stats["antialias"] == 1
+
+
+@pytest.mark.parametrize("method", ["hybrid", "wboit", "unsorted"])
+def test_memory_is_that_of_one_sample(renderer, method):
+    scene = build_scene(random_meshes(5, transparent=6))
+    r = renderer(32, 24)
+    one = r.render(scene, PERSPECTIVE, method)
+    four = r.render(scene, PERSPECTIVE, method, antialias=4)
+    assert four.stats["memory_bytes"] == one.stats["memory_bytes"]
+    assert four.stats["target_bytes"] == one.stats["target_bytes"]
+    # Every sample frame's fragments are counted.
+    assert four.stats["fragments"] > 3 * one.stats["fragments"]
+
+
+def test_the_error_bound_holds_antialiased(renderer):
+    # The bound of a mean of samples is the mean of their bounds.
+    r = renderer(40, 32)
+    scene = build_scene(random_meshes(6, transparent=12, opaque=1, triangles=6, space="world", spread=0.8))
+    exact = r.render(scene, PERSPECTIVE, "abuffer", antialias=4)
+    frame = r.render(scene, PERSPECTIVE, "hybrid", k=2, antialias=4)
+    err = np.abs(frame.image[..., :3].astype(np.float64) - exact.image[..., :3])
+    assert (err <= frame.error_bound).all() and err.max() > 1e-3
+
+
+def test_antialiased_frames_do_not_depend_on_submission_order(renderer):
+    meshes = random_meshes(3, transparent=10, opaque=2, triangles=6, space="world", spread=0.9)
+    r = renderer(40, 32)
+    first = r.render(build_scene(meshes), PERSPECTIVE, antialias=4)
+    rng = np.random.default_rng(1)
+    shuffled = [meshes[i].shuffled(rng) for i in rng.permutation(len(meshes))]
+    assert np.array_equal(r.render(build_scene(shuffled), PERSPECTIVE, antialias=4).image, first.image)
+
+
+@pytest.mark.parametrize("bad, error", [(3, ValueError), (0, ValueError), (32, ValueError), (-4, ValueError),
+                                        ("4", TypeError), (True, TypeError), (4.0, TypeError)])
+def test_bad_sample_counts_are_refused(renderer, bad, error):
+    scene = build_scene([layer(0.5, (1, 0, 0, 0.5))])
+    with pytest.raises(error, match="antialias"):
+        renderer(8, 8).render(scene, IDENTITY, antialias=bad)
+    with pytest.raises(error, match="antialias"):
+        oit.reference(scene, IDENTITY, 8, 8, antialias=bad)
