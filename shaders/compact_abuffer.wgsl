@@ -47,29 +47,14 @@ fn fs_capture(in: VsOut) {
     push_node(pixel_index(in.clip), Node(in.clip.z, 0u, in.prim));
 }
 
-struct Cursor {
-    link: u32,
-    px: u32,
-}
-
-fn cursor_begin(px: u32) -> Cursor {
-    return Cursor(atomicLoad(&heads[px]), px);
-}
-
-fn cursor_more(c: Cursor) -> bool {
-    return c.link != NIL;
-}
-
-fn cursor_step(c: ptr<function, Cursor>) -> Frag {
-    let i = (*c).link;
-    let node = load_node(i - 1u);
-    (*c).link = node.next;
+// The node keeps only depth and triangle: its color is interpolated here, at the pixel center.
+fn node_frag(node: Node, link: u32, px: u32) -> Frag {
     let s = shading[node.prim];
-    let px = (*c).px;
     let ndc = vec2<f32>((f32(px % frame.size.x) + 0.5) * 2.0 / f32(frame.size.x) - 1.0,
                         1.0 - (f32(px / frame.size.x) + 0.5) * 2.0 / f32(frame.size.y));
     let b = barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
     let color = clamp(b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2], vec4<f32>(0.0), vec4<f32>(1.0));
-    return Frag(node.depth, color, i);
+    return Frag(node.depth, color, link);
 }
+//!include common/list_cursor.wgsl
 //!include common/sweep.wgsl

@@ -167,23 +167,11 @@ fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
     if count > 0u {
         atomicAdd(&overflow, count);
     }
-    var tail = vec3<f32>(0.0);
-    var t_tail = 1.0;
-    if TAIL != 0u && count > 0u {
-        let sum_a = read_fixed64(word(acc + TAIL_R + 6u), word(acc + TAIL_R + 7u));
-        if sum_a > 0.0 {
-            let sum_c = vec3<f32>(
-                read_fixed64(word(acc + TAIL_R), word(acc + TAIL_R + 1u)),
-                read_fixed64(word(acc + TAIL_R + 2u), word(acc + TAIL_R + 3u)),
-                read_fixed64(word(acc + TAIL_R + 4u), word(acc + TAIL_R + 5u)),
-            );
-            let n = f32(count);
-            let a_avg = min(sum_a / n, 1.0);                  // eq. 8
-            t_tail = select(pow(1.0 - a_avg, n), 0.0, a_avg >= 1.0); // eq. 9
-            tail = (sum_c / sum_a) * (1.0 - t_tail);          // eqs. 7 and 10: C_tail * alpha_tail
-        }
+    var tail = Tail(vec3<f32>(0.0), 1.0);
+    if TAIL != 0u {
+        tail = resolve_tail(acc + TAIL_R, count);
     }
-    let rgb = core + t_core * (tail + t_tail * base.rgb);    // eq. 11
+    let rgb = core + t_core * (tail.color + tail.trans * base.rgb); // eq. 11
     // Quantized core alphas: sum |d| T' plus the second-order D^2; whatever lies behind the
     // core (tail or, for ktab, nothing) is off by at most T_core; float32 and fixed-point
     // rounding of K + count terms.
@@ -192,5 +180,5 @@ fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
     if count > 0u {
         bound += t_core;
     }
-    return Final(vec4<f32>(rgb, 1.0 - t_core * t_tail * (1.0 - base.a)), bound);
+    return Final(vec4<f32>(rgb, 1.0 - t_core * tail.trans * (1.0 - base.a)), bound);
 }

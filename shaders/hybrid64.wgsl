@@ -100,29 +100,16 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
     }
     let acc = px * ACCUM_WORDS;
     let count = word(acc + TAIL_COUNT);
-    var tail = vec3<f32>(0.0);
-    var t_tail = 1.0;
     if count > 0u {
         atomicAdd(&overflow, count);
-        let sum_a = read_fixed64(word(acc + TAIL_R + 6u), word(acc + TAIL_R + 7u));
-        if sum_a > 0.0 {
-            let sum_c = vec3<f32>(
-                read_fixed64(word(acc + TAIL_R), word(acc + TAIL_R + 1u)),
-                read_fixed64(word(acc + TAIL_R + 2u), word(acc + TAIL_R + 3u)),
-                read_fixed64(word(acc + TAIL_R + 4u), word(acc + TAIL_R + 5u)),
-            );
-            let n = f32(count);
-            let a_avg = min(sum_a / n, 1.0);
-            t_tail = select(pow(1.0 - a_avg, n), 0.0, a_avg >= 1.0);
-            tail = (sum_c / sum_a) * (1.0 - t_tail);
-        }
     }
-    let rgb = core + t_core * (tail + t_tail * base.rgb);
+    let tail = resolve_tail(acc + TAIL_R, count);
+    let rgb = core + t_core * (tail.color + tail.trans * base.rgb); // eq. 11
     // Core colors quantized to 11/11/10 bits (visibilities sum to at most 1), core alphas as
     // above, at most T_core for what lies behind when there is a tail, and rounding.
     var bound = 1.0 / 2046.0 + alpha_bound + f32(K + count + 2u) * 2.4e-7;
     if count > 0u {
         bound += t_core;
     }
-    return Final(vec4<f32>(rgb, 1.0 - t_core * t_tail * (1.0 - base.a)), bound);
+    return Final(vec4<f32>(rgb, 1.0 - t_core * tail.trans * (1.0 - base.a)), bound);
 }

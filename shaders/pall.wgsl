@@ -69,22 +69,8 @@ fn fs_capture(in: VsOut) {
     store_node(i, node);
 }
 
-struct Cursor {
-    link: u32,
+fn node_frag(node: Node, link: u32, px: u32) -> Frag {
+    return Frag(node.depth, vec4<f32>(node.rg, node.ba), link);
 }
-
-fn cursor_begin(px: u32) -> Cursor {
-    return Cursor(atomicLoad(&heads[px]));
-}
-
-fn cursor_more(c: Cursor) -> bool {
-    return c.link != NIL;
-}
-
-fn cursor_step(c: ptr<function, Cursor>) -> Frag {
-    let i = (*c).link;
-    let node = load_node(i - 1u);
-    (*c).link = node.next;
-    return Frag(node.depth, vec4<f32>(node.rg, node.ba), i);
-}
+//!include common/list_cursor.wgsl
 //!include common/sweep.wgsl

@@ -95,3 +95,15 @@ def test_bad_sample_counts_are_refused(renderer, bad, error):
         renderer(8, 8).render(scene, IDENTITY, antialias=bad)
     with pytest.raises(error, match="antialias"):
         oit.reference(scene, IDENTITY, 8, 8, antialias=bad)
+
+
+EXACT = [m["name"] for m in oit.methods() if m["exact"]]
+
+
+@pytest.mark.parametrize("method", EXACT)
+def test_every_exact_method_antialiases_to_the_same_image(renderer, method):
+    r = renderer(32, 24)
+    scene = build_scene(random_meshes(8, transparent=6, opaque=1, triangles=5, space="world", spread=0.9))
+    exact = r.render(scene, PERSPECTIVE, "abuffer", background=BG, antialias=4)
+    frame = r.render(scene, PERSPECTIVE, method, background=BG, antialias=4)
+    assert np.abs(frame.image - exact.image).max() <= 2e-6

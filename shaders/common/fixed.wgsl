@@ -25,3 +25,32 @@ fn add_fixed64(i: u32, v: f32) {
 fn read_fixed64(lo: u32, hi: u32) -> f32 {
     return (f32(hi) * 4294967296.0 + f32(lo)) / TAIL_SCALE;
 }
+
+// The tail of hybrid transparency (Maule et al. 2013, eqs. 7-10) from its fixed-point sums:
+// words sums..sums+7 hold (lo, hi) pairs of sum C*alpha for r, g, b and of sum alpha, over
+// `count` fragments. Returns the tail's premultiplied color C_tail * alpha_tail and its
+// transmittance T_tail = (1 - alpha_avg)^count.
+struct Tail {
+    color: vec3<f32>,
+    trans: f32,
+}
+
+fn resolve_tail(sums: u32, count: u32) -> Tail {
+    var tail = Tail(vec3<f32>(0.0), 1.0);
+    if count == 0u {
+        return tail;
+    }
+    let sum_a = read_fixed64(atomicLoad(&accum[sums + 6u]), atomicLoad(&accum[sums + 7u]));
+    if sum_a > 0.0 {
+        let sum_c = vec3<f32>(
+            read_fixed64(atomicLoad(&accum[sums]), atomicLoad(&accum[sums + 1u])),
+            read_fixed64(atomicLoad(&accum[sums + 2u]), atomicLoad(&accum[sums + 3u])),
+            read_fixed64(atomicLoad(&accum[sums + 4u]), atomicLoad(&accum[sums + 5u])),
+        );
+        let n = f32(count);
+        let a_avg = min(sum_a / n, 1.0);                            // eq. 8
+        tail.trans = select(pow(1.0 - a_avg, n), 0.0, a_avg >= 1.0); // eq. 9
+        tail.color = (sum_c / sum_a) * (1.0 - tail.trans);           // eqs. 7 and 10
+    }
+    return tail;
+}

@@ -10,6 +10,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("common/nodes.wgsl", include_str!("../../../shaders/common/nodes.wgsl")),
     ("common/select.wgsl", include_str!("../../../shaders/common/select.wgsl")),
     ("common/sweep.wgsl", include_str!("../../../shaders/common/sweep.wgsl")),
+    ("common/list_cursor.wgsl", include_str!("../../../shaders/common/list_cursor.wgsl")),
     ("common/setup.wgsl", include_str!("../../../shaders/common/setup.wgsl")),
     ("common/submission.wgsl", include_str!("../../../shaders/common/submission.wgsl")),
     ("opaque.wgsl", include_str!("../../../shaders/opaque.wgsl")),
