@@ -175,3 +175,145 @@ def test_bench_puts_pygfx_rows_in_the_table():
         row = rows[f"pygfx-{mode}"]
         assert row["status"] == "ok" and row["wall_ms"] > 0 and row["mean_err"] >= 0, row
         assert row["adapter"].startswith("pygfx on ") and math.isnan(row["gpu_ms"])
+
+
+# ---- temporal stability
+
+def test_orbit_turns_about_the_scene_center():
+    built = scenes.glass(detail=8)
+    cameras = bench.orbit(built, frames=4, step_deg=2.0)
+    assert len(cameras) == 4 and np.array_equal(cameras[0].view_proj, built.camera.view_proj)
+
+    def ndc(camera, p):
+        clip = camera.view_proj @ np.append(p, 1.0)
+        return clip[:3] / clip[3]
+
+    # Glass is centered on the origin: points on the vertical axis through it stay put, a point
+    # off the axis moves, further each frame.
+    for p in ((0.0, 0.0, 0.0), (0.0, 0.4, 0.0)):
+        assert all(np.allclose(ndc(c, p), ndc(cameras[0], p), atol=1e-12) for c in cameras)
+    moved = [np.linalg.norm(ndc(c, (0.5, 0.0, 0.5)) - ndc(cameras[0], (0.5, 0.0, 0.5))) for c in cameras]
+    assert 0 < moved[1] < moved[2] < moved[3] < 0.2
+
+
+def test_frame_changes():
+    rng = np.random.default_rng(3)
+    exact = [rng.uniform(0, 1, (6, 6, 4)) for _ in range(4)]
+    covered = [np.ones((6, 6), bool) for _ in range(4)]
+    for c in covered:
+        c[0] = False  # the top row is never covered: what happens there does not count
+    offset = [e + 0.1 for e in exact]  # a constant error follows the motion exactly
+    eps = 0.01
+    noisy = [e + (eps if t % 2 else -eps) for t, e in enumerate(exact)]  # an error that flips every frame
+    for images in (offset, noisy):
+        for im in images:
+            im[0] = rng.uniform(0, 1, (6, 4))
+    ref = bench.frame_changes(exact, exact, covered)
+    steps = [np.sqrt(((exact[t + 1][1:, :, :3] - exact[t][1:, :, :3]) ** 2).sum(-1)) for t in range(3)]
+    assert ref["change"] == pytest.approx(np.mean(steps)) and ref["flicker"] == 0 == ref["max_flicker"]
+    still = bench.frame_changes(offset, exact, covered)
+    assert still["change"] == pytest.approx(ref["change"]) and still["flicker"] == pytest.approx(0, abs=1e-12)
+    flips = bench.frame_changes(noisy, exact, covered)
+    assert flips["flicker"] == pytest.approx(2 * eps * math.sqrt(3)) == flips["max_flicker"]
+
+
+TEMPORAL_TINY = dict(scenes=["glass"], methods=["hybrid", "unsorted", "stochastic"], sizes=[24], frames=3, quick=True,
+                     show_progress=False)
+
+
+def test_temporal_rows():
+    result = bench.temporal(**TEMPORAL_TINY, step_deg=1.0)
+    rows = by_method(result.rows)
+    assert list(rows) == ["abuffer", "unsorted", "hybrid", "stochastic"]  # abuffer, then as in oit.methods()
+    for r in rows.values():
+        assert set(r) >= {c for c, _ in bench.TEMPORAL_COLUMNS}
+        assert r["status"] == "ok" and r["size"] == "24x24" and r["frames"] == 3 and r["step_deg"] == 1.0
+        assert r["change"] > 0 and r["flicker"] <= r["max_flicker"]
+    assert rows["abuffer"]["change_ratio"] == 1 and rows["abuffer"]["flicker"] == 0 == rows["abuffer"]["flicker_ratio"]
+    assert rows["hybrid"]["mean_err"] < 0.01 < rows["unsorted"]["mean_err"]  # glass defeats submission order
+    for r in rows.values():
+        assert r["change_ratio"] == r["change"] / rows["abuffer"]["change"]
+
+
+def test_temporal_with_a_still_camera_sees_no_change():
+    # Every method repeats its frame bit for bit (stochastic is seeded), so nothing changes.
+    for r in bench.temporal(**TEMPORAL_TINY, step_deg=0.0).rows:
+        assert r["change"] == 0 and r["flicker"] == 0 and math.isnan(r["change_ratio"]), r["method"]
+
+
+def test_cli_temporal_writes_table_and_figure(tmp_path):
+    out = tmp_path / "bench"
+    code = cli.main(["bench", "--temporal", "--quick", "--scenes", "glass", "--sizes", "24", "--methods", "hybrid",
+                     "--frames", "3", "--out", str(out)])
+    assert code == 0
+    with open(out / "temporal.csv") as f:
+        assert [r["method"] for r in csv.DictReader(f)] == ["abuffer", "hybrid"]
+    assert (out / "temporal.md").read_text().startswith("Adapter: ")
+    assert not (out / "results.csv").exists()  # instead of the sweep, not beside it
+    if plots.matplotlib_missing() is None:
+        assert (out / "temporal.png").stat().st_size > 0
+
+
+# ---- auto against fixed k
+
+def test_smallest_k_scans_upward_and_stops_at_the_first():
+    errors = {1: 0.5, 2: 0.1, 3: 0.3, 4: 0.05}  # not monotone in k, as hybrid's need not be
+    asked = []
+    error = lambda k: asked.append(k) or errors[k]  # noqa: E731
+    assert bench.smallest_k(error, 0.2, max_k=4) == 2 and asked == [1, 2]
+    assert bench.smallest_k(error, 0.06, max_k=4) == 4
+    assert bench.smallest_k(error, 0.3, max_k=4) == 2
+    assert bench.smallest_k(error, 0.01, max_k=4) is None
+    assert bench.smallest_k(error, 0.06, max_k=3) is None
+
+
+AUTO_TINY = dict(scenes=["glass"], sizes=[24], tolerances=(1 / 255, 16 / 255), repeat=1, max_k=8, quick=True,
+                 show_progress=False)
+
+
+def test_auto_against_fixed_k(renderer):
+    result = bench.auto_vs_fixed(**AUTO_TINY)
+    assert [r["tolerance"] for r in result.rows] == list(AUTO_TINY["tolerances"])
+    built = scenes.glass()
+    r24 = renderer(24, 24)
+    exact = r24.render(built.scene, built.camera, "abuffer").image
+    measured = {k: bench.max_abs_error(r24.render(built.scene, built.camera, "hybrid", k=k).image, exact)
+                for k in range(1, AUTO_TINY["max_k"] + 1)}
+    for row in result.rows:
+        t = row["tolerance"]
+        assert set(row) >= {c for c, _ in bench.AUTO_COLUMNS} and row["status"] == "ok"
+        # auto's promise: every channel of every pixel within t of the exact image.
+        assert row["within_t"] is True and row["auto_max_abs"] <= t
+        assert row["auto_max_err"] <= row["auto_max_err_all"] and row["auto_mib"] > 0
+        assert row["auto_exact"] in (0, 1) and row["auto_attempts"] >= 1
+        # The fixed k is the first that meets t, by the same measure.
+        k = row["fixed_k"]
+        below = range(1, (AUTO_TINY["max_k"] + 1) if k == "none" else k)
+        assert all(measured[j] > t for j in below)
+        if k != "none":
+            assert row["fixed_max_abs"] == measured[k] <= t
+            assert row["mib_ratio"] == row["auto_mib"] / row["fixed_mib"]
+            assert row["gpu_ms_ratio"] == row["auto_gpu_ms"] / row["fixed_gpu_ms"]
+            assert row["fixed_mib"] * 2 ** 20 == formulas.memory_bytes("hybrid", 24, 24, k=k)
+        else:
+            assert math.isnan(row["mib_ratio"])
+    assert any(r["fixed_k"] != "none" for r in result.rows)
+
+
+def test_auto_over_its_tolerance_is_flagged(monkeypatch, tmp_path, capsys):
+    real = oit.Renderer.render
+
+    def render(self, scene, camera, method="abuffer", **kw):
+        frame = real(self, scene, camera, method, **kw)
+        if method == "auto":
+            frame.image[0, 0, :3] += 0.5  # a pixel far off: what a broken auto would return
+        return frame
+
+    monkeypatch.setattr(oit.Renderer, "render", render)
+    code = cli.main(["bench", "--auto", "--quick", "--scenes", "glass", "--sizes", "24", "--tolerances", "0.0627",
+                     "--max-k", "4", "--out", str(tmp_path)])
+    assert code == 1
+    assert "auto exceeded its tolerance on glass 24x24" in capsys.readouterr().err
+    with open(tmp_path / "auto.csv") as f:
+        (row,) = list(csv.DictReader(f))
+    assert row["within_t"] == "False" and float(row["auto_max_abs"]) > 0.0627

@@ -6,7 +6,12 @@ Methods and their parameter values come from `oit.methods()` (a few values acros
 declared range), so new methods join without changes here. A method that fails (an adapter
 limit, a memory budget) gives a row marked failed with the message. With pygfx installed the
 same scenes go through its alpha modes too (oit.peers). Writes results.csv, results.md, and
-with matplotlib the plots of oit.plots into --out."""
+with matplotlib the plots of oit.plots into --out.
+
+Two other experiments run instead of the sweep: `--temporal` (`temporal`: how much each
+approximate method's image changes between frames of a slow camera orbit, against the exact
+change) and `--auto` (`auto_vs_fixed`: auto at a tolerance against the cheapest fixed k that
+meets it, found by search)."""
 
 from __future__ import annotations
 
@@ -20,13 +25,13 @@ import statistics
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
 from . import formulas, peers
 from . import scenes as scene_lib
-from ._api import Renderer, methods as list_methods
+from ._api import Camera, Renderer, methods as list_methods
 from .imageio import linear_to_srgb
 
 # Values tried for integer parameters (k, nodes, samples, layers), clipped to the declared range.
@@ -195,19 +200,25 @@ def run(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | 
         result.notes.append(f"pygfx rows are missing: {peer_reason}")
     if flip_missing():
         result.notes.append(flip_missing())
-    jobs = [(s, z) for s in scenes for z in (sizes or [None])]
-    progress = Progress(len(jobs) * (2 + len(plan) + len(peer_modes)), show_progress)
-    renderers: dict[tuple[int, int], Renderer] = {}  # one per size: pipelines compile once
-    for scene_name, size in jobs:
-        built = _build(scene_name, size, quick)
-        w, h = (size, size) if size else built.size
-        if quick:
-            w, h = min(w, QUICK_SIZE), min(h, QUICK_SIZE)
-        if (w, h) not in renderers:
-            renderers[(w, h)] = Renderer(w, h)
-        renderer = renderers[(w, h)]
+    progress = Progress(len(scenes) * len(sizes or [None]) * (2 + len(plan) + len(peer_modes)), show_progress)
+    for scene_name, built, renderer in scene_jobs(scenes, sizes, quick):
         _run_scene(result, scene_name, built, renderer, plan, peer_modes, repeat, progress)
     return result
+
+
+def scene_jobs(scenes: list[str], sizes: list[int] | None, quick: bool) -> Iterator[tuple[str, scene_lib.BuiltScene, Renderer]]:
+    """(name, built scene, renderer) for each scene at each size (default: the scene's own;
+    --quick caps it at QUICK_SIZE), with one renderer per size: pipelines compile once."""
+    renderers: dict[tuple[int, int], Renderer] = {}
+    for scene_name in scenes:
+        for size in sizes or [None]:
+            built = _build(scene_name, size, quick)
+            w, h = (size, size) if size else built.size
+            if quick:
+                w, h = min(w, QUICK_SIZE), min(h, QUICK_SIZE)
+            if (w, h) not in renderers:
+                renderers[(w, h)] = Renderer(w, h)
+            yield scene_name, built, renderers[(w, h)]
 
 
 def _run_scene(result: Result, scene_name: str, built: scene_lib.BuiltScene, renderer: Renderer,
@@ -320,6 +331,209 @@ def figure7_table(size: int = 20) -> str:
     return "\n".join(lines)
 
 
+# ---- temporal stability: a slow camera orbit, each method's change between frames against abuffer's
+
+TEMPORAL_FRAMES = 8
+TEMPORAL_STEP_DEG = 0.25
+
+
+def orbit(built: scene_lib.BuiltScene, frames: int = TEMPORAL_FRAMES, step_deg: float = TEMPORAL_STEP_DEG) -> list[Camera]:
+    """Cameras of a slow orbit: the scene's camera turned `step_deg` a frame about the vertical
+    axis through the center of the geometry's bounding box (frame 0 is the scene's camera).
+    The scene is turned the other way instead of moving the eye: view_proj @ T(c) R(-a) T(-c)."""
+    points = np.concatenate([m.positions for m in built.meshes]).astype(np.float64)
+    center = (points.min(0) + points.max(0)) / 2
+    cameras = []
+    for i in range(frames):
+        a = -math.radians(step_deg * i)
+        turn = np.eye(4)
+        turn[0, 0], turn[0, 2], turn[2, 0], turn[2, 2] = math.cos(a), math.sin(a), -math.sin(a), math.cos(a)
+        to, back = np.eye(4), np.eye(4)
+        to[:3, 3], back[:3, 3] = center, -center
+        cameras.append(Camera(built.camera.view_proj @ to @ turn @ back))
+    return cameras
+
+
+def frame_changes(images: list[np.ndarray], exact: list[np.ndarray], covered: list[np.ndarray]) -> dict[str, float]:
+    """How a method's frames change against the exact frames', over the pixels covered in
+    either frame of each consecutive pair (all pairs pooled): `change`, the mean RGB distance
+    between consecutive frames; `flicker`, the mean RGB distance between the method's change
+    and the exact change, (m' - m) - (a' - a), which is the frame-to-frame change of its error:
+    the part that is not the true motion; `max_flicker`, its largest value."""
+    changes, flickers = [], []
+    for t in range(len(images) - 1):
+        mask = covered[t] | covered[t + 1]
+        dm = images[t + 1][..., :3].astype(np.float64) - images[t][..., :3]
+        da = exact[t + 1][..., :3].astype(np.float64) - exact[t][..., :3]
+        changes.append(np.sqrt((dm[mask] ** 2).sum(-1)))
+        flickers.append(np.sqrt(((dm - da)[mask] ** 2).sum(-1)))
+    change, flicker = np.concatenate(changes), np.concatenate(flickers)
+    if not change.size:
+        return {"change": math.nan, "flicker": math.nan, "max_flicker": math.nan}
+    return {"change": float(change.mean()), "flicker": float(flicker.mean()), "max_flicker": float(flicker.max())}
+
+
+def temporal(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | None = None,
+             frames: int = TEMPORAL_FRAMES, step_deg: float = TEMPORAL_STEP_DEG, quick: bool = False,
+             show_progress: bool = True) -> Result:
+    """The temporal-stability benchmark: each scene over a slow orbit (`orbit`), abuffer and
+    every approximate method (or those named) at its default parameters; one row per method
+    with frame_changes, `change_ratio` and `flicker_ratio` (over abuffer's change) and
+    `mean_err` (against abuffer, averaged over the frames)."""
+    if frames < 2:
+        raise ValueError(f"the temporal benchmark needs at least 2 frames, got {frames}")
+    approximate = [m["name"] for m in list_methods() if not m["exact"]]
+    plan = [(m, p) for m, p, _ in method_plan(methods or approximate, quick=True) if m != "abuffer"]
+    result = Result(rows=[])
+    progress = Progress(len(scenes) * len(sizes or [None]) * (1 + len(plan)), show_progress)
+    for scene_name, built, renderer in scene_jobs(scenes, sizes, quick):
+        size, adapter = f"{renderer.width}x{renderer.height}", renderer.adapter_info["name"]
+        cameras = orbit(built, frames, step_deg)
+        row = lambda method, params, **v: _temporal_row(scene_name, size, method, params, frames, step_deg, adapter, **v)  # noqa: E731
+        progress.show(f"{scene_name} {size} abuffer")
+        try:
+            exact_frames = [renderer.render(built.scene, c, "abuffer") for c in cameras]
+        except (RuntimeError, MemoryError) as e:
+            result.notes.append(f"{scene_name} {size}: no temporal rows, the exact A-buffer failed: {e}")
+            progress.step("abuffer")
+            continue
+        exact = [f.image for f in exact_frames]
+        covered = [f.depth_complexity > 0 for f in exact_frames]
+        reference = frame_changes(exact, exact, covered)
+        rows = [row("abuffer", {}, **reference, mean_err=0.0)]
+        progress.step("abuffer")
+        for method, params in plan:
+            progress.show(f"{scene_name} {size} {method}")
+            try:
+                images = [renderer.render(built.scene, c, method, **params).image for c in cameras]
+            except (RuntimeError, MemoryError, ValueError) as e:
+                rows.append(row(method, params, status="failed", message=str(e).splitlines()[0]))
+                progress.step(method)
+                continue
+            err = [image_errors(im, ex, cov, flip=False)["mean_err"] for im, ex, cov in zip(images, exact, covered)]
+            rows.append(row(method, params, **frame_changes(images, exact, covered), mean_err=float(np.mean(err))))
+            progress.step(method)
+        for r in rows:  # a still camera (step 0) leaves abuffer's change 0: no ratios
+            scale = reference["change"] if reference["change"] > 0 else math.nan
+            r["change_ratio"], r["flicker_ratio"] = r["change"] / scale, r["flicker"] / scale
+        result.rows += rows
+    return result
+
+
+def _temporal_row(scene: str, size: str, method: str, params: Params, frames: int, step_deg: float, adapter: str,
+                  **values: Any) -> dict:
+    row = {"scene": scene, "size": size, "method": method, "params": format_params(params), "status": "ok",
+           "frames": frames, "step_deg": step_deg, "change": math.nan, "change_ratio": math.nan, "flicker": math.nan,
+           "flicker_ratio": math.nan, "max_flicker": math.nan, "mean_err": math.nan, "adapter": adapter, "message": ""}
+    row.update(values)
+    return row
+
+
+TEMPORAL_COLUMNS = [
+    ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("params", "{}"), ("change", "{:.5f}"),
+    ("change_ratio", "{:.3f}"), ("flicker", "{:.5f}"), ("flicker_ratio", "{:.3f}"), ("max_flicker", "{:.4f}"),
+    ("mean_err", "{:.5f}"),
+]
+
+
+# ---- accuracy on demand: auto against the cheapest fixed k that meets the same tolerance
+
+AUTO_TOLERANCES = (1 / 255, 4 / 255, 16 / 255)
+AUTO_MAX_K = 32
+
+
+def max_abs_error(image: np.ndarray, exact: np.ndarray) -> float:
+    """Largest |image - exact| over every pixel and RGB channel: what auto's tolerance bounds
+    (its error bound holds for each channel, docs/methods.md)."""
+    return float(np.abs(image[..., :3].astype(np.float64) - exact[..., :3]).max())
+
+
+def smallest_k(error: Callable[[int], float], tolerance: float, max_k: int = AUTO_MAX_K) -> int | None:
+    """The smallest k in 1..max_k whose measured error is at most `tolerance`, scanning upward
+    and stopping at the first (hybrid's error is not monotone in k, so no bisection); None when
+    none is."""
+    return next((k for k in range(1, max_k + 1) if error(k) <= tolerance), None)
+
+
+def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances: tuple[float, ...] = AUTO_TOLERANCES,
+                  repeat: int = 5, max_k: int = AUTO_MAX_K, quick: bool = False, show_progress: bool = True) -> Result:
+    """For each scene and tolerance t: `auto` at t (GPU and wall time, median over `repeat`
+    after a warm-up; memory; what it chose; its measured error against abuffer) beside the
+    cheapest fixed-k hybrid that meets t as measured (smallest_k over 1..max_k, each k rendered
+    once, its errors shared by every t), timed the same way. `within_t` says whether auto's
+    largest per-channel error is at most t (it must be)."""
+    result = Result(rows=[])
+    progress = Progress(len(scenes) * len(sizes or [None]) * (1 + 2 * len(tolerances)), show_progress)
+    for scene_name, built, renderer in scene_jobs(scenes, sizes, quick):
+        size, adapter = f"{renderer.width}x{renderer.height}", renderer.adapter_info["name"]
+        render = lambda method, **p: renderer.render(built.scene, built.camera, method, **p)  # noqa: E731
+        progress.show(f"{scene_name} {size} abuffer")
+        try:
+            exact_frame = render("abuffer")
+        except (RuntimeError, MemoryError) as e:
+            result.notes.append(f"{scene_name} {size}: no auto rows, the exact A-buffer failed: {e}")
+            progress.step("abuffer")
+            continue
+        exact, covered = exact_frame.image, exact_frame.depth_complexity > 0
+        progress.step("abuffer")
+        fixed_errors: dict[int, float] = {}  # k -> measured max error, shared by every t
+
+        def fixed_error(k: int) -> float:
+            if k not in fixed_errors:
+                progress.show(f"{scene_name} {size} hybrid k={k} (search)")
+                fixed_errors[k] = max_abs_error(render("hybrid", k=k).image, exact)
+            return fixed_errors[k]
+
+        for t in tolerances:
+            row = {"scene": scene_name, "size": size, "tolerance": t, "status": "ok", **_AUTO_EMPTY, "adapter": adapter,
+                   "message": ""}
+            progress.show(f"{scene_name} {size} auto t={t:.4g}")
+            try:
+                frame, gpu, wall = timed(lambda: render("auto", tolerance=t), repeat)
+                row.update(_measured("auto", frame, gpu, wall, exact, covered))
+                row.update({key: frame.stats.get(key, math.nan) for key in AUTO_STATS})
+                row["within_t"] = row["auto_max_abs"] <= t
+                progress.step("auto")
+                k = smallest_k(fixed_error, t, max_k)
+                row["fixed_k"] = "none" if k is None else k
+                if k is not None:
+                    progress.show(f"{scene_name} {size} hybrid k={k} (timed)")
+                    row.update(_measured("fixed", *timed(lambda: render("hybrid", k=k), repeat), exact, covered))
+                    for what in ("gpu_ms", "wall_ms", "mib"):
+                        row[f"{what}_ratio"] = row[f"auto_{what}"] / row[f"fixed_{what}"]
+                progress.step("hybrid")
+            except (RuntimeError, MemoryError, ValueError) as e:
+                row.update(status="failed", message=str(e).splitlines()[0])
+            result.rows.append(row)
+    return result
+
+
+# Stats that auto reports beside the image (docs/methods.md, "Error bounds per pixel, and auto").
+AUTO_STATS = ("auto_k", "auto_predicted_k", "auto_exact", "auto_attempts", "error_bound_max")
+_AUTO_EMPTY = {**{f"{who}_{what}": math.nan for who in ("auto", "fixed") for what in
+                  ("gpu_ms", "wall_ms", "mib", "max_abs", "max_err", "max_err_all", "mean_err")},
+               **{key: math.nan for key in AUTO_STATS}, "within_t": None, "fixed_k": "",
+               "gpu_ms_ratio": math.nan, "wall_ms_ratio": math.nan, "mib_ratio": math.nan}
+
+
+def _measured(who: str, frame: Any, gpu: list[float], wall: list[float], exact: np.ndarray,
+              covered: np.ndarray) -> dict[str, float]:
+    e = image_errors(frame.image, exact, covered, flip=False)
+    all_pixels = float(np.sqrt(((frame.image[..., :3].astype(np.float64) - exact[..., :3]) ** 2).sum(-1)).max())
+    return {f"{who}_gpu_ms": statistics.median(gpu) if gpu else math.nan, f"{who}_wall_ms": statistics.median(wall),
+            f"{who}_mib": frame.stats["memory_bytes"] / 2 ** 20, f"{who}_max_abs": max_abs_error(frame.image, exact),
+            f"{who}_max_err": e["max_err"], f"{who}_max_err_all": all_pixels, f"{who}_mean_err": e["mean_err"]}
+
+
+AUTO_COLUMNS = [
+    ("scene", "{}"), ("size", "{}"), ("tolerance", "{:.5f}"), ("auto_k", "{:.0f}"), ("auto_exact", "{:.0f}"),
+    ("auto_attempts", "{:.0f}"), ("auto_gpu_ms", "{:.1f}"), ("auto_wall_ms", "{:.1f}"), ("auto_mib", "{:.2f}"),
+    ("auto_max_abs", "{:.5f}"), ("auto_max_err_all", "{:.5f}"), ("within_t", "{}"), ("fixed_k", "{}"),
+    ("fixed_gpu_ms", "{:.1f}"), ("fixed_wall_ms", "{:.1f}"), ("fixed_mib", "{:.2f}"), ("fixed_max_abs", "{:.5f}"),
+    ("gpu_ms_ratio", "{:.2f}"), ("wall_ms_ratio", "{:.2f}"), ("mib_ratio", "{:.2f}"),
+]
+
+
 # Markdown columns and formats; every row field goes to the CSV.
 COLUMNS = [
     ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("params", "{}"), ("gpu_ms", "{:.2f}"), ("x_floor", "{:.2f}"),
@@ -330,19 +544,19 @@ COLUMNS = [
 
 
 def _cell(value: Any, fmt: str) -> str:
-    if isinstance(value, float) and math.isnan(value):
+    if value is None or isinstance(value, float) and math.isnan(value):
         return ""
     return fmt.format(value)
 
 
-def markdown(rows: list[dict]) -> str:
+def markdown(rows: list[dict], columns: list[tuple[str, str]] = COLUMNS) -> str:
     """The rows as a Markdown table; failed rows carry their message in the last column."""
-    head = "| " + " | ".join(c for c, _ in COLUMNS) + " | note |"
-    sep = "|" + "---|" * (len(COLUMNS) + 1)
+    head = "| " + " | ".join(c for c, _ in columns) + " | note |"
+    sep = "|" + "---|" * (len(columns) + 1)
     lines = [head, sep]
     for r in rows:
         note = f"failed: {r['message']}" if r["status"] != "ok" else ""
-        lines.append("| " + " | ".join(_cell(r[c], f) for c, f in COLUMNS) + f" | {note} |")
+        lines.append("| " + " | ".join(_cell(r[c], f) for c, f in columns) + f" | {note} |")
     return "\n".join(lines)
 
 
@@ -357,40 +571,89 @@ def write_csv(path: str, rows: list[dict]) -> None:
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--scenes", nargs="+", default=list(scene_lib.SHOWCASE), choices=sorted(scene_lib.SCENES),
                     help="scenes to run (default: %(default)s)")
-    ap.add_argument("--methods", nargs="+", default=None, help="methods to run (default: every method of `oit methods`)")
+    ap.add_argument("--methods", nargs="+", default=None,
+                    help="methods to run (default: every method of `oit methods`; with --temporal every approximate one)")
     ap.add_argument("--sizes", type=int, nargs="+", default=None, help="square frame sizes (default: each scene's own)")
     ap.add_argument("--repeat", type=int, default=5, help="timed renders per row after one warm-up (median)")
-    ap.add_argument("--out", default="out/bench", help="directory for results.csv, results.md and the plots")
+    ap.add_argument("--out", default="out/bench", help="directory for the tables and the plots")
     ap.add_argument("--quick", action="store_true",
                     help=f"default parameters only, one timed render, frames of at most {QUICK_SIZE} pixels: a smoke test")
     ap.add_argument("--no-peers", action="store_true", help="skip pygfx even when it is installed")
     ap.add_argument("--no-plots", action="store_true", help="skip the matplotlib plots")
     ap.add_argument("--figure7", action="store_true", help="also run the hybrid paper's Figure 7 experiment (400 stacks)")
+    ap.add_argument("--temporal", action="store_true",
+                    help="instead of the method sweep: the change between frames of a slow camera orbit, each approximate "
+                         "method against abuffer (temporal.csv, temporal.md, temporal.png)")
+    ap.add_argument("--frames", type=int, default=TEMPORAL_FRAMES, help="--temporal: frames of the orbit (default: %(default)s)")
+    ap.add_argument("--step", type=float, default=TEMPORAL_STEP_DEG,
+                    help="--temporal: degrees the camera turns a frame (default: %(default)s)")
+    ap.add_argument("--auto", action="store_true",
+                    help="instead of the method sweep: auto against the cheapest fixed-k hybrid that meets each tolerance, "
+                         "found by search (auto.csv, auto.md)")
+    ap.add_argument("--tolerances", type=float, nargs="+", default=list(AUTO_TOLERANCES),
+                    help="--auto: tolerances (default: 1/255 4/255 16/255)")
+    ap.add_argument("--max-k", type=int, default=AUTO_MAX_K, help="--auto: the largest k searched (default: %(default)s)")
 
 
-def run_cli(a: argparse.Namespace) -> int:
-    result = run(a.scenes, a.methods, a.sizes, 1 if a.quick else max(1, a.repeat), a.quick, with_peers=not a.no_peers)
-    os.makedirs(a.out, exist_ok=True)
-    rows = result.rows
-    write_csv(os.path.join(a.out, "results.csv"), rows)
-    adapters = ", ".join(dict.fromkeys(r["adapter"] for r in rows if r["adapter"]))
+def write_tables(out: str, name: str, result: Result, columns: list[tuple[str, str]]) -> None:
+    """<out>/<name>.csv (every field) and <name>.md (the adapter, the notes, the table), and the
+    table on stdout."""
+    os.makedirs(out, exist_ok=True)
+    write_csv(os.path.join(out, f"{name}.csv"), result.rows)
+    adapters = ", ".join(dict.fromkeys(r["adapter"] for r in result.rows if r["adapter"]))
     notes = "".join(f"Note: {n}\n" for n in result.notes)
-    table = markdown(rows)
-    with open(os.path.join(a.out, "results.md"), "w") as f:
+    table = markdown(result.rows, columns)
+    with open(os.path.join(out, f"{name}.md"), "w") as f:
         f.write(f"Adapter: {adapters}\n\n{notes}\n{table}\n")
     print(f"adapter: {adapters}")
     for n in result.notes:
         print(f"note: {n}")
     print(table)
-    if not a.no_plots:
+
+
+def _plots_missing(a: argparse.Namespace) -> bool:
+    """True (and says why) when the plots are to be skipped."""
+    if a.no_plots:
+        return True
+    from . import plots
+
+    missing = plots.matplotlib_missing()
+    if missing:
+        print(f"note: no plots: {missing}")
+    return missing is not None
+
+
+def run_cli(a: argparse.Namespace) -> int:
+    repeat = 1 if a.quick else max(1, a.repeat)
+    if a.temporal or a.auto:
+        if a.temporal:
+            result = temporal(a.scenes, a.methods, a.sizes, a.frames, a.step, a.quick)
+            write_tables(a.out, "temporal", result, TEMPORAL_COLUMNS)
+            if not _plots_missing(a):
+                from . import plots
+
+                path = os.path.join(a.out, "temporal.png")
+                plots.temporal(result.rows, path)
+                print(f"wrote {path}")
+        if a.auto:
+            if a.methods is not None:
+                print("note: --auto compares auto with hybrid; --methods is ignored")
+            result = auto_vs_fixed(a.scenes, a.sizes, tuple(a.tolerances), repeat, a.max_k, a.quick)
+            write_tables(a.out, "auto", result, AUTO_COLUMNS)
+            over = [r for r in result.rows if r["within_t"] is False]
+            for r in over:
+                print(f"error: auto exceeded its tolerance on {r['scene']} {r['size']}: measured {r['auto_max_abs']:.6f} "
+                      f"> t = {r['tolerance']:.6f}", file=sys.stderr)
+            if over:
+                return 1
+        return 0
+    result = run(a.scenes, a.methods, a.sizes, repeat, a.quick, with_peers=not a.no_peers)
+    write_tables(a.out, "results", result, COLUMNS)
+    if not _plots_missing(a):
         from . import plots
 
-        missing = plots.matplotlib_missing()
-        if missing:
-            print(f"note: no plots: {missing}")
-        else:
-            for path in plots.write_all(result, a.out):
-                print(f"wrote {path}")
+        for path in plots.write_all(result, a.out):
+            print(f"wrote {path}")
     if a.figure7:
         fig7 = figure7_table()
         with open(os.path.join(a.out, "figure7.md"), "w") as f:

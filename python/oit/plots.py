@@ -147,3 +147,45 @@ def write_all(result: Any, out: str) -> list[str]:
             image_sheet(sheet, f"{scene} {size}: each method (default parameters) and its error", path)
             paths.append(path)
     return paths
+
+
+def temporal(rows: list[dict], path: str, columns: int = 3) -> None:
+    """The temporal-stability figure of bench.temporal: one panel per scene and size, a pair of
+    bars per method — its mean change between consecutive frames and its flicker (the change
+    of its error), both over abuffer's change — with abuffer's change (1) as a dashed line.
+    A method that follows the motion exactly has bars at 1 and 0."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    panels = list(dict.fromkeys((r["scene"], r["size"]) for r in rows))
+    methods = list(dict.fromkeys(r["method"] for r in rows))
+    cols = min(columns, len(panels))
+    lines = -(-len(panels) // cols)
+    fig, axes = plt.subplots(lines, cols, figsize=(4.2 * cols, lines * (0.9 + 0.22 * len(methods)) + 0.6),
+                             squeeze=False, sharey=True)
+    y = np.arange(len(methods))
+    for ax, (scene, size) in zip(axes.flat, panels):
+        mine = {r["method"]: r for r in rows if (r["scene"], r["size"]) == (scene, size) and r["status"] == "ok"}
+        get = lambda key: [mine[m][key] if m in mine else math.nan for m in methods]  # noqa: E731
+        ax.barh(y - 0.2, get("change_ratio"), height=0.4, color="tab:blue", label="mean change / abuffer's")
+        ax.barh(y + 0.2, get("flicker_ratio"), height=0.4, color="tab:red", label="flicker / abuffer's change")
+        ax.axvline(1.0, color="0.3", linestyle="--", linewidth=1)
+        ax.set_title(f"{scene} {size}", fontsize=9)
+        ax.set_xlabel("over abuffer's mean change between frames", fontsize=8)
+        ax.grid(True, axis="x", alpha=0.3)
+        ax.set_yticks(y, methods, fontsize=8)
+        ax.tick_params(axis="y", labelleft=True)
+    for ax in list(axes.flat)[len(panels):]:
+        ax.axis("off")
+    axes[0][0].invert_yaxis()
+    first = rows[0]
+    adapter = next((r["adapter"] for r in rows if r["adapter"]), "")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper right", fontsize=8, ncol=2)
+    fig.suptitle(f"Temporal stability: {first['frames']} frames, camera orbit {first['step_deg']:g}° a frame, "
+                 f"on {adapter}", fontsize=10, x=0.02, ha="left")
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
