@@ -19,7 +19,8 @@ rasterizer lavapipe with `apt-get install mesa-vulkan-drivers` (Debian/Ubuntu); 
 but not found, set VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
 
 /// Features every method may use when the adapter offers them; none is required by all.
-fn wanted_features() -> wgpu::Features {
+/// A device made elsewhere (the viewer's) should ask for those of them its adapter has.
+pub fn wanted_features() -> wgpu::Features {
     wgpu::Features::TIMESTAMP_QUERY
         | wgpu::Features::FLOAT32_BLENDABLE
         | wgpu::Features::SHADER_INT64
@@ -27,7 +28,8 @@ fn wanted_features() -> wgpu::Features {
         | wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS
 }
 
-fn adapter_rank(info: &wgpu::AdapterInfo) -> u32 {
+/// Adapter preference, lower first: hardware before software (lavapipe).
+pub fn adapter_rank(info: &wgpu::AdapterInfo) -> u32 {
     match info.device_type {
         wgpu::DeviceType::DiscreteGpu => 0,
         wgpu::DeviceType::IntegratedGpu => 1,

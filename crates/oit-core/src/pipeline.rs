@@ -108,6 +108,21 @@ pub fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
+/// Layout entry of an unfilterable float texture read by fragment shaders (accumulation
+/// targets a resolve pass loads).
+pub fn float_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 /// A geometry pass that only reads the opaque depth (bound as a texture at the same time).
 pub fn capture_pass<'e>(
     enc: &'e mut wgpu::CommandEncoder,
@@ -119,6 +134,33 @@ pub fn capture_pass<'e>(
         label: Some(label),
         color_attachments: &[],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: depth, depth_ops: None, stencil_ops: None }),
+        timestamp_writes: timestamps,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// A pass that draws over the opaque scene: the base color is copied to the output first, and
+/// the pass blends into it against `depth` (read-only with `depth_ops` None).
+pub fn over_base_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    targets: &'e crate::targets::Targets,
+    depth: &'e wgpu::TextureView,
+    depth_ops: Option<wgpu::Operations<f32>>,
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
+) -> wgpu::RenderPass<'e> {
+    let out = &targets.out_texture;
+    enc.copy_texture_to_texture(targets.base_texture.as_image_copy(), out.as_image_copy(), out.size());
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &targets.out,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: depth, depth_ops, stencil_ops: None }),
         timestamp_writes: timestamps,
         occlusion_query_set: None,
         multiview_mask: None,

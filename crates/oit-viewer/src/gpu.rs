@@ -4,25 +4,8 @@
 use std::sync::Arc;
 
 use eframe::egui_wgpu::{self, WgpuSetup, WgpuSetupCreateNew};
+use oit_core::context::{adapter_rank, wanted_features};
 use oit_core::GpuContext;
-
-/// The optional features oit-core asks for (mirrors `wanted_features` in
-/// crates/oit-core/src/context.rs, which is private there).
-pub const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
-    .union(wgpu::Features::FLOAT32_BLENDABLE)
-    .union(wgpu::Features::SHADER_INT64)
-    .union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
-
-/// Ranks adapters as oit-core does: hardware first, software (lavapipe) last.
-fn rank(info: &wgpu::AdapterInfo) -> u32 {
-    match info.device_type {
-        wgpu::DeviceType::DiscreteGpu => 0,
-        wgpu::DeviceType::IntegratedGpu => 1,
-        wgpu::DeviceType::VirtualGpu => 2,
-        wgpu::DeviceType::Other => 3,
-        wgpu::DeviceType::Cpu => 4,
-    }
-}
 
 /// eframe's wgpu setup: Vulkan (or WGPU_BACKEND), the adapter named by `adapter` or
 /// OIT_ADAPTER, else the best one (the software one first when `prefer_software`, for
@@ -41,7 +24,10 @@ pub fn setup(adapter: Option<String>, prefer_software: bool) -> WgpuSetup {
             })?,
             None => usable
                 .iter()
-                .min_by_key(|a| if prefer_software { 4 - rank(&a.get_info()) } else { rank(&a.get_info()) })
+                .min_by_key(|a| {
+                    let rank = adapter_rank(&a.get_info());
+                    if prefer_software { 4 - rank } else { rank }
+                })
                 .ok_or_else(|| {
                     "no GPU adapter found: install a Vulkan driver, or lavapipe with \
                      `apt-get install mesa-vulkan-drivers` (Debian/Ubuntu)"
@@ -52,7 +38,7 @@ pub fn setup(adapter: Option<String>, prefer_software: bool) -> WgpuSetup {
     }));
     s.device_descriptor = Arc::new(|adapter| wgpu::DeviceDescriptor {
         label: Some("oit-viewer"),
-        required_features: adapter.features() & WANTED_FEATURES,
+        required_features: adapter.features() & wanted_features(),
         required_limits: adapter.limits(),
         ..Default::default()
     });

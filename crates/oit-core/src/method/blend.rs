@@ -122,29 +122,8 @@ impl Method for Blend {
         }
         let t = cx.targets;
         let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_texture(
-            t.base_texture.as_image_copy(),
-            t.out_texture.as_image_copy(),
-            t.out_texture.size(),
-        );
         {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("blend"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &t.out,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &t.depth,
-                    depth_ops: None,
-                    stencil_ops: None,
-                }),
-                timestamp_writes: cx.timer.render_pass("blend"),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = pipeline::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.timer.render_pass("blend"));
             pass.set_pipeline(self.pipeline.as_ref().expect("built above"));
             pass.set_bind_group(0, &geo.group, &[]);
             for i in order {

@@ -52,26 +52,10 @@ impl Method for ScreenDoor {
         }
         let (_, depth_tex, depth_view) = self.depth.as_ref().expect("made above");
         let mut enc = d.create_command_encoder(&Default::default());
-        enc.copy_texture_to_texture(t.base_texture.as_image_copy(), t.out_texture.as_image_copy(), t.out_texture.size());
         enc.copy_texture_to_texture(t.depth_texture.as_image_copy(), depth_tex.as_image_copy(), depth_tex.size());
         {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("screen door"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &t.out,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: cx.timer.render_pass("dither"),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let depth_ops = Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store });
+            let mut pass = pipeline::over_base_pass(&mut enc, "screen door", t, depth_view, depth_ops, cx.timer.render_pass("dither"));
             pass.set_pipeline(self.pipeline.as_ref().expect("built above"));
             cx.scene.transparent.draw_all(&mut pass);
         }

@@ -2,7 +2,7 @@
 //! `samples` coverage samples per pixel kept in a storage buffer: a stochastic depth pass,
 //! an accumulation pass and a resolve (shaders/stochastic.wgsl). Deterministic for a seed.
 
-use super::weighted::{target, ACCUM_FORMAT, ADD, AUX_FORMAT, REVEAL};
+use super::weighted::{accumulation_targets, target, ACCUM_FORMAT, AUX_FORMAT, REVEAL};
 use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
 use crate::error::{OitError, Result};
 use crate::gpu_types::FrameUniform;
@@ -58,16 +58,6 @@ struct Stochastic {
 fn build(cx: &FrameCtx<'_>, samples: u32) -> Pipelines {
     let d = &cx.gpu.device;
     let module = shader::module(d, "stochastic.wgsl", &[Const::U32("SAMPLES", samples)]);
-    let tex = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    };
     // The accumulation targets are read only by the resolve, so they get their own group.
     let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("stochastic samples"),
@@ -75,14 +65,11 @@ fn build(cx: &FrameCtx<'_>, samples: u32) -> Pipelines {
     });
     let resolve_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("stochastic resolve"),
-        entries: &[tex(1), tex(2)],
+        entries: &[pipeline::float_texture_entry(1), pipeline::float_texture_entry(2)],
     });
     let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &layout]);
     let resolve_pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &resolve_layout]);
-    let targets = [
-        Some(wgpu::ColorTargetState { format: ACCUM_FORMAT, blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }), write_mask: wgpu::ColorWrites::ALL }),
-        Some(wgpu::ColorTargetState { format: AUX_FORMAT, blend: Some(wgpu::BlendState { color: REVEAL, alpha: REVEAL }), write_mask: wgpu::ColorWrites::ALL }),
-    ];
+    let targets = accumulation_targets(REVEAL);
     Pipelines {
         samples,
         depth: pipeline::geometry(d, "stochastic depth", &module, &pl, "fs_depth", &[], pipeline::depth_test_only()),

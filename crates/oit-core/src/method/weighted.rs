@@ -100,33 +100,11 @@ impl Weighted {
         let d = &cx.gpu.device;
         let eq = weight.trim_start_matches("eq").parse::<u32>().expect("choices are eqN");
         let module = shader::module(d, "weighted.wgsl", &[Const::U32("WEIGHT", eq)]);
-        let tex = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("weighted"),
-            entries: &[tex(0), tex(1)],
+            entries: &[pipeline::float_texture_entry(0), pipeline::float_texture_entry(1)],
         });
-        let aux_blend = if self.kind == Kind::Blended { REVEAL } else { ADD };
-        let targets = [
-            Some(wgpu::ColorTargetState {
-                format: ACCUM_FORMAT,
-                blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }),
-                write_mask: wgpu::ColorWrites::ALL,
-            }),
-            Some(wgpu::ColorTargetState {
-                format: AUX_FORMAT,
-                blend: Some(wgpu::BlendState { color: aux_blend, alpha: aux_blend }),
-                write_mask: wgpu::ColorWrites::ALL,
-            }),
-        ];
+        let targets = accumulation_targets(if self.kind == Kind::Blended { REVEAL } else { ADD });
         let (fs, resolve_fs) = match self.kind {
             Kind::Sum => ("fs_sum", "fs_resolve_wsum"),
             Kind::Average => ("fs_sum", "fs_resolve_wavg"),
@@ -150,6 +128,23 @@ impl Weighted {
         );
         Pipelines { weight: weight.to_string(), accumulate, resolve, layout }
     }
+}
+
+/// The two accumulation targets: premultiplied color summed in ACCUM_FORMAT, and the
+/// auxiliary target (ACCUM_FORMAT's companion) blended by `aux_blend`.
+pub(crate) fn accumulation_targets(aux_blend: wgpu::BlendComponent) -> [Option<wgpu::ColorTargetState>; 2] {
+    [
+        Some(wgpu::ColorTargetState {
+            format: ACCUM_FORMAT,
+            blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }),
+            write_mask: wgpu::ColorWrites::ALL,
+        }),
+        Some(wgpu::ColorTargetState {
+            format: AUX_FORMAT,
+            blend: Some(wgpu::BlendState { color: aux_blend, alpha: aux_blend }),
+            write_mask: wgpu::ColorWrites::ALL,
+        }),
+    ]
 }
 
 pub(crate) fn target(device: &wgpu::Device, size: (u32, u32), format: wgpu::TextureFormat) -> wgpu::TextureView {
