@@ -107,3 +107,20 @@ def test_every_exact_method_antialiases_to_the_same_image(renderer, method):
     exact = r.render(scene, PERSPECTIVE, "abuffer", background=BG, antialias=4)
     frame = r.render(scene, PERSPECTIVE, method, background=BG, antialias=4)
     assert np.abs(frame.image - exact.image).max() <= 2e-6
+
+
+def test_the_antialiasing_benchmark_reports_ratios_to_one_sample():
+    from oit import bench
+
+    result = bench.antialias(["glass"], ["abuffer", "hybrid"], sizes=[16], samples=(4,), repeat=1, quick=True,
+                             show_progress=False)
+    rows = {(r["method"], r["antialias"]): r for r in result.rows}
+    assert set(rows) == {("abuffer", 1), ("abuffer", 4), ("hybrid", 1), ("hybrid", 4)}
+    assert all(r["status"] == "ok" for r in rows.values())
+    for method in ("abuffer", "hybrid"):
+        assert rows[(method, 1)]["gpu_ms_x1"] == rows[(method, 1)]["mib_x1"] == 1.0
+    # abuffer is the exact answer at each sample count; hybrid's memory does not grow.
+    assert rows[("abuffer", 4)]["mean_err"] == 0.0 and rows[("abuffer", 4)]["mean_err_vs_finest"] == 0.0
+    assert rows[("abuffer", 1)]["mean_err_vs_finest"] > 0.0
+    assert rows[("hybrid", 4)]["mib_x1"] == 1.0
+    assert "| antialias |" in bench.markdown(result.rows, bench.AA_COLUMNS).splitlines()[0]

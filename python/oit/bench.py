@@ -8,10 +8,11 @@ limit, a memory budget) gives a row marked failed with the message. With pygfx i
 same scenes go through its alpha modes too (oit.peers). Writes results.csv, results.md, and
 with matplotlib the plots of oit.plots into --out.
 
-Two other experiments run instead of the sweep: `--temporal` (`temporal`: how much each
+Three other experiments run instead of the sweep: `--temporal` (`temporal`: how much each
 approximate method's image changes between frames of a slow camera orbit, against the exact
-change) and `--auto` (`auto_vs_fixed`: auto at a tolerance against the cheapest fixed k that
-meets it, found by search)."""
+change), `--auto` (`auto_vs_fixed`: auto at a tolerance against the cheapest fixed k that
+meets it, found by search) and `--antialias` (`antialias`: time and memory at S samples a
+pixel against one)."""
 
 from __future__ import annotations
 
@@ -534,6 +535,73 @@ AUTO_COLUMNS = [
 ]
 
 
+# ---- antialiasing: time and memory of S samples a pixel against one, error against the exact
+# antialiased image
+
+AA_METHODS = ("abuffer", "hybrid", "hybrid64", "wboit", "unsorted")
+AA_SAMPLES = (1, 4, 8)
+
+
+def antialias(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | None = None,
+              samples: tuple[int, ...] = AA_SAMPLES, repeat: int = 5, quick: bool = False,
+              show_progress: bool = True) -> Result:
+    """For each scene, method (default AA_METHODS) and sample count S: GPU and wall time (median
+    over `repeat` after a warm-up) and memory, as ratios to the same method at one sample;
+    the mean and largest error against abuffer at the same S (the method's own error), and the
+    mean error against abuffer at the largest S asked for (what is left of the aliasing)."""
+    methods = list(methods or AA_METHODS)
+    samples = tuple(sorted(set(samples) | {1}))
+    result = Result(rows=[])
+    progress = Progress(len(scenes) * len(sizes or [None]) * len(samples) * (1 + len(methods)), show_progress)
+    for scene_name, built, renderer in scene_jobs(scenes, sizes, quick):
+        size, adapter = f"{renderer.width}x{renderer.height}", renderer.adapter_info["name"]
+        exact: dict[int, Any] = {}
+        for s_count in samples:
+            progress.show(f"{scene_name} {size} abuffer x{s_count}")
+            try:
+                exact[s_count] = renderer.render(built.scene, built.camera, "abuffer", antialias=s_count)
+            except (RuntimeError, MemoryError) as e:
+                result.notes.append(f"{scene_name} {size}: no errors at {s_count} samples, abuffer failed: {e}")
+            progress.step("abuffer")
+        finest = exact.get(max(samples))
+        for method in methods:
+            one: dict[str, float] = {}
+            for s_count in samples:
+                row = {"scene": scene_name, "size": size, "method": method, "antialias": s_count, "status": "ok",
+                       "adapter": adapter, "message": "", **{c: math.nan for c, _ in AA_COLUMNS[4:]}}
+                progress.show(f"{scene_name} {size} {method} x{s_count}")
+                try:
+                    frame, gpu, wall = timed(
+                        lambda: renderer.render(built.scene, built.camera, method, antialias=s_count), repeat)
+                except (RuntimeError, MemoryError, ValueError) as e:
+                    row.update(status="failed", message=str(e).splitlines()[0])
+                    result.rows.append(row)
+                    progress.step(method)
+                    continue
+                row.update(gpu_ms=statistics.median(gpu) if gpu else math.nan, wall_ms=statistics.median(wall),
+                           mib=frame.stats["memory_bytes"] / 2 ** 20)
+                if s_count == 1:
+                    one = {k: row[k] for k in ("gpu_ms", "wall_ms", "mib")}
+                for k in ("gpu_ms", "wall_ms", "mib"):
+                    row[f"{k}_x1"] = row[k] / one[k] if one.get(k) else math.nan
+                if s_count in exact:
+                    diff = frame.image[..., :3].astype(np.float64) - exact[s_count].image[..., :3]
+                    row["mean_err"] = float(np.sqrt((diff ** 2).sum(-1)).mean())
+                    row["max_abs"] = float(np.abs(diff).max())
+                if finest is not None:
+                    row["mean_err_vs_finest"] = mean_rgb_distance(frame.image, finest.image)
+                result.rows.append(row)
+                progress.step(method)
+    return result
+
+
+AA_COLUMNS = [
+    ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("antialias", "{}"), ("gpu_ms", "{:.1f}"), ("gpu_ms_x1", "{:.2f}"),
+    ("wall_ms", "{:.1f}"), ("wall_ms_x1", "{:.2f}"), ("mib", "{:.2f}"), ("mib_x1", "{:.2f}"), ("mean_err", "{:.5f}"),
+    ("max_abs", "{:.5f}"), ("mean_err_vs_finest", "{:.5f}"),
+]
+
+
 # Markdown columns and formats; every row field goes to the CSV.
 COLUMNS = [
     ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("params", "{}"), ("gpu_ms", "{:.2f}"), ("x_floor", "{:.2f}"),
@@ -593,6 +661,11 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--tolerances", type=float, nargs="+", default=list(AUTO_TOLERANCES),
                     help="--auto: tolerances (default: 1/255 4/255 16/255)")
     ap.add_argument("--max-k", type=int, default=AUTO_MAX_K, help="--auto: the largest k searched (default: %(default)s)")
+    ap.add_argument("--antialias", action="store_true",
+                    help="run the antialiasing benchmark instead: time and memory of each method (default: "
+                         f"{', '.join(AA_METHODS)}) at --aa-samples samples a pixel against one (antialias.csv, .md)")
+    ap.add_argument("--aa-samples", type=int, nargs="+", default=list(AA_SAMPLES),
+                    help="--antialias: samples a pixel to measure (default: %(default)s; 1 is always added)")
 
 
 def write_tables(out: str, name: str, result: Result, columns: list[tuple[str, str]]) -> None:
@@ -625,7 +698,10 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
-    if a.temporal or a.auto:
+    if a.temporal or a.auto or a.antialias:
+        if a.antialias:
+            result = antialias(a.scenes, a.methods, a.sizes, tuple(a.aa_samples), repeat, a.quick)
+            write_tables(a.out, "antialias", result, AA_COLUMNS)
         if a.temporal:
             result = temporal(a.scenes, a.methods, a.sizes, a.frames, a.step, a.quick)
             write_tables(a.out, "temporal", result, TEMPORAL_COLUMNS)
