@@ -70,7 +70,7 @@ fn fs_capture(in: VsOut) {
 }
 
 fn node_frag(node: Node, link: u32, px: u32) -> Frag {
-    return Frag(node.depth, vec4<f32>(node.rg, node.ba), link);
+    return Frag(node.depth, vec4<f32>(node.rg, node.ba), link, ALL_SAMPLES);
 }
 //!include common/list_cursor.wgsl
 //!include common/sweep.wgsl

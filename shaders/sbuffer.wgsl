@@ -57,6 +57,6 @@ fn cursor_step(c: ptr<function, Cursor>) -> Frag {
     let i = (*c).at;
     let node = load_node(i);
     (*c).at = i + 1u;
-    return Frag(node.depth, vec4<f32>(node.rg, node.ba), i);
+    return Frag(node.depth, vec4<f32>(node.rg, node.ba), i, ALL_SAMPLES);
 }
 //!include common/sweep.wgsl

@@ -9,9 +9,12 @@
 //   fn cursor_step(c: ptr<function, Cursor>) -> Frag  (returns the fragment, advances)
 // and declares the `state` storage binding. docs/methods.md ("abuffer").
 
-// Per-pixel sweep state (STATE_WORDS words): accumulated color, transmittance, the last
-// composited fragment's key, flags.
-const STATE_WORDS: u32 = 12u;
+// Per-pixel sweep state (STATE_WORDS words): the last composited fragment's key (6 words),
+// flags, a spare word, then per sample of the pixel (PIXEL_SAMPLES, from the targets include:
+// 1, or the coverage-mask sample count) its accumulated color and transmittance.
+const STATE_WORDS: u32 = 8u + 4u * PIXEL_SAMPLES;
+const FLAGS: u32 = 6u;
+const SAMPLE_STATE: u32 = 8u;
 const STARTED: u32 = 1u;
 const DONE: u32 = 2u;
 
@@ -19,7 +22,11 @@ struct Frag {
     depth: f32,
     color: vec4<f32>,
     id: u32,
+    // The pixel's samples it covers (bit s: sample s); ALL_SAMPLES without coverage masks.
+    mask: u32,
 }
+
+const ALL_SAMPLES: u32 = (1u << PIXEL_SAMPLES) - 1u;
 
 // Strict total order: depth, then color, then node index. Fragments equal in depth and
 // color are interchangeable, so the composite does not depend on submission order.
@@ -39,21 +46,29 @@ fn cs_sweep(@builtin(global_invocation_id) gid: vec3<u32>) {
     if px == OUTSIDE {
         return;
     }
-    let s = px * STATE_WORDS;
-    let flags = state[s + 10u];
+    let at = px * STATE_WORDS;
+    let flags = state[at + FLAGS];
     if (flags & DONE) != 0u {
         return;
     }
     let started = (flags & STARTED) != 0u;
-    var accum = vec3<f32>(0.0);
-    var trans = 1.0;
+    var accum: array<vec3<f32>, PIXEL_SAMPLES>;
+    var trans: array<f32, PIXEL_SAMPLES>;
     var prev: Frag;
+    for (var s = 0u; s < PIXEL_SAMPLES; s++) {
+        let w = at + SAMPLE_STATE + 4u * s;
+        if started {
+            accum[s] = vec3<f32>(bitcast<f32>(state[w]), bitcast<f32>(state[w + 1u]), bitcast<f32>(state[w + 2u]));
+            trans[s] = bitcast<f32>(state[w + 3u]);
+        } else {
+            accum[s] = vec3<f32>(0.0);
+            trans[s] = 1.0;
+        }
+    }
     if started {
-        accum = vec3<f32>(bitcast<f32>(state[s]), bitcast<f32>(state[s + 1u]), bitcast<f32>(state[s + 2u]));
-        trans = bitcast<f32>(state[s + 3u]);
-        prev = Frag(bitcast<f32>(state[s + 4u]),
-                    vec4<f32>(bitcast<f32>(state[s + 5u]), bitcast<f32>(state[s + 6u]), bitcast<f32>(state[s + 7u]), bitcast<f32>(state[s + 8u])),
-                    state[s + 9u]);
+        prev = Frag(bitcast<f32>(state[at]),
+                    vec4<f32>(bitcast<f32>(state[at + 1u]), bitcast<f32>(state[at + 2u]), bitcast<f32>(state[at + 3u]), bitcast<f32>(state[at + 4u])),
+                    state[at + 5u], 0u);
     }
     var heap: array<Frag, BATCH>;
     var n = 0u;
@@ -66,38 +81,56 @@ fn cs_sweep(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     heap_sort(&heap, n);
     for (var b = 0u; b < n; b++) {
-        let c = heap[b].color;
-        accum += trans * c.a * c.rgb;
-        trans *= 1.0 - c.a;
+        let f = heap[b];
+        for (var s = 0u; s < PIXEL_SAMPLES; s++) {
+            if (f.mask & (1u << s)) != 0u {
+                accum[s] += trans[s] * f.color.a * f.color.rgb;
+                trans[s] *= 1.0 - f.color.a;
+            }
+        }
     }
     var out_flags = STARTED;
-    if n < BATCH || trans == 0.0 {
+    var opaque = true;
+    for (var s = 0u; s < PIXEL_SAMPLES; s++) {
+        let w = at + SAMPLE_STATE + 4u * s;
+        state[w] = bitcast<u32>(accum[s].r);
+        state[w + 1u] = bitcast<u32>(accum[s].g);
+        state[w + 2u] = bitcast<u32>(accum[s].b);
+        state[w + 3u] = bitcast<u32>(trans[s]);
+        opaque = opaque && trans[s] == 0.0;
+    }
+    if n < BATCH || opaque {
         out_flags |= DONE;
     }
-    state[s] = bitcast<u32>(accum.r);
-    state[s + 1u] = bitcast<u32>(accum.g);
-    state[s + 2u] = bitcast<u32>(accum.b);
-    state[s + 3u] = bitcast<u32>(trans);
     if n > 0u {
         let last = heap[n - 1u];
-        state[s + 4u] = bitcast<u32>(last.depth);
-        state[s + 5u] = bitcast<u32>(last.color.r);
-        state[s + 6u] = bitcast<u32>(last.color.g);
-        state[s + 7u] = bitcast<u32>(last.color.b);
-        state[s + 8u] = bitcast<u32>(last.color.a);
-        state[s + 9u] = last.id;
+        state[at] = bitcast<u32>(last.depth);
+        state[at + 1u] = bitcast<u32>(last.color.r);
+        state[at + 2u] = bitcast<u32>(last.color.g);
+        state[at + 3u] = bitcast<u32>(last.color.b);
+        state[at + 4u] = bitcast<u32>(last.color.a);
+        state[at + 5u] = last.id;
     }
-    state[s + 10u] = out_flags;
+    state[at + FLAGS] = out_flags;
 }
 
+// The pixel: the mean over its samples of the composite over that sample's opaque scene or
+// background (one sample without coverage masks).
 @fragment
 fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let base = base_at(pos);
-    let s = pixel_index(pos) * STATE_WORDS;
-    if (state[s + 10u] & STARTED) == 0u {
-        return base;
+    let at = pixel_index(pos) * STATE_WORDS;
+    let started = (state[at + FLAGS] & STARTED) != 0u;
+    var sum = vec4<f32>(0.0);
+    for (var s = 0u; s < PIXEL_SAMPLES; s++) {
+        let base = base_at_sample(pos, s);
+        if !started {
+            sum += base;
+            continue;
+        }
+        let w = at + SAMPLE_STATE + 4u * s;
+        let accum = vec3<f32>(bitcast<f32>(state[w]), bitcast<f32>(state[w + 1u]), bitcast<f32>(state[w + 2u]));
+        let trans = bitcast<f32>(state[w + 3u]);
+        sum += vec4<f32>(accum + trans * base.rgb, 1.0 - trans * (1.0 - base.a));
     }
-    let accum = vec3<f32>(bitcast<f32>(state[s]), bitcast<f32>(state[s + 1u]), bitcast<f32>(state[s + 2u]));
-    let trans = bitcast<f32>(state[s + 3u]);
-    return vec4<f32>(accum + trans * base.rgb, 1.0 - trans * (1.0 - base.a));
+    return sum / f32(PIXEL_SAMPLES);
 }

@@ -12,3 +12,10 @@ fn behind_opaque(pos: vec4<f32>) -> bool {
 fn base_at(pos: vec4<f32>) -> vec4<f32> {
     return textureLoad(base_color, vec2<i32>(pos.xy), 0);
 }
+
+// One sample a pixel (coverage-mask frames use common/targets_samples.wgsl instead).
+const PIXEL_SAMPLES: u32 = 1u;
+
+fn base_at_sample(pos: vec4<f32>, s: u32) -> vec4<f32> {
+    return base_at(pos);
+}
