@@ -302,11 +302,14 @@ class Renderer:
         return self._native.adapter_info
 
     def render(self, scene: Scene, camera: Camera, method: str = "abuffer",
-               background: Sequence[float] = (1.0, 1.0, 1.0), antialias: int = 1, **params: Any) -> Frame:
+               background: Sequence[float] = (1.0, 1.0, 1.0), antialias: int = 1, antialias_mode: str = "frames",
+               **params: Any) -> Frame:
         """Renders `scene` with `method` (see `oit.methods()`); parameters go as keywords.
-        `antialias` S in (1, 2, 4, 8, 16): S samples a pixel on the standard pattern, each a
-        frame of its own with the method's buffers reused, averaged (memory as at one sample,
-        time about S times; docs/methods.md, "Antialiasing")."""
+        `antialias` S in (1, 2, 4, 8, 16): S samples a pixel on the standard pattern. With
+        antialias_mode "frames" each sample is a frame of its own with the method's buffers
+        reused, averaged (any method; memory as at one sample, time about S times); with
+        "coverage" (abuffer, S = 4) the transparent geometry is rasterized once, multisampled,
+        and each stored fragment keeps its sample mask (docs/methods.md, "Antialiasing")."""
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be an oit.Scene, got {type(scene).__name__}")
         if not isinstance(camera, Camera):
@@ -314,8 +317,10 @@ class Renderer:
         if not isinstance(method, str):
             raise TypeError(f"method must be a string, got {type(method).__name__}")
         bg = _background(background)
+        if not isinstance(antialias_mode, str):
+            raise TypeError(f"antialias_mode must be 'frames' or 'coverage', got {antialias_mode!r}")
         image, dc, stats, bound = self._native.render(scene._native, camera.view_proj, method, bg, params,
-                                                      _antialias(antialias))
+                                                      _antialias(antialias), antialias_mode)
         stats["adapter"] = self.adapter_info["name"]
         if bound is not None:
             stats["error_bound_max"] = float(bound.max()) if bound.size else 0.0

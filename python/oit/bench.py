@@ -540,6 +540,9 @@ AUTO_COLUMNS = [
 
 AA_METHODS = ("abuffer", "hybrid", "hybrid64", "wboit", "unsorted")
 AA_SAMPLES = (1, 4, 8)
+# Methods and the sample count of antialias_mode="coverage" (oit_core::renderer).
+COVERAGE_METHODS = ("abuffer",)
+COVERAGE_SAMPLES = 4
 
 
 def antialias(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | None = None,
@@ -548,7 +551,8 @@ def antialias(scenes: list[str], methods: list[str] | None = None, sizes: list[i
     """For each scene, method (default AA_METHODS) and sample count S: GPU and wall time (median
     over `repeat` after a warm-up) and memory, as ratios to the same method at one sample;
     the mean and largest error against abuffer at the same S (the method's own error), and the
-    mean error against abuffer at the largest S asked for (what is left of the aliasing)."""
+    mean error against abuffer at the largest S asked for (what is left of the aliasing). The
+    COVERAGE_METHODS also get a row in antialias_mode "coverage" at COVERAGE_SAMPLES."""
     methods = list(methods or AA_METHODS)
     samples = tuple(sorted(set(samples) | {1}))
     result = Result(rows=[])
@@ -566,13 +570,16 @@ def antialias(scenes: list[str], methods: list[str] | None = None, sizes: list[i
         finest = exact.get(max(samples))
         for method in methods:
             one: dict[str, float] = {}
-            for s_count in samples:
-                row = {"scene": scene_name, "size": size, "method": method, "antialias": s_count, "status": "ok",
-                       "adapter": adapter, "message": "", **{c: math.nan for c, _ in AA_COLUMNS[4:]}}
-                progress.show(f"{scene_name} {size} {method} x{s_count}")
+            runs = [(s_count, "frames") for s_count in samples]
+            if method in COVERAGE_METHODS and COVERAGE_SAMPLES in samples:
+                runs.append((COVERAGE_SAMPLES, "coverage"))
+            for s_count, mode in runs:
+                row = {"scene": scene_name, "size": size, "method": method, "antialias": s_count, "mode": mode,
+                       "status": "ok", "adapter": adapter, "message": "", **{c: math.nan for c, _ in AA_COLUMNS[5:]}}
+                progress.show(f"{scene_name} {size} {method} x{s_count} {mode}")
                 try:
-                    frame, gpu, wall = timed(
-                        lambda: renderer.render(built.scene, built.camera, method, antialias=s_count), repeat)
+                    frame, gpu, wall = timed(lambda: renderer.render(built.scene, built.camera, method, antialias=s_count,
+                                                                     antialias_mode=mode), repeat)
                 except (RuntimeError, MemoryError, ValueError) as e:
                     row.update(status="failed", message=str(e).splitlines()[0])
                     result.rows.append(row)
@@ -596,7 +603,8 @@ def antialias(scenes: list[str], methods: list[str] | None = None, sizes: list[i
 
 
 AA_COLUMNS = [
-    ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("antialias", "{}"), ("gpu_ms", "{:.1f}"), ("gpu_ms_x1", "{:.2f}"),
+    ("scene", "{}"), ("size", "{}"), ("method", "{}"), ("antialias", "{}"), ("mode", "{}"), ("gpu_ms", "{:.1f}"),
+    ("gpu_ms_x1", "{:.2f}"),
     ("wall_ms", "{:.1f}"), ("wall_ms_x1", "{:.2f}"), ("mib", "{:.2f}"), ("mib_x1", "{:.2f}"), ("mean_err", "{:.5f}"),
     ("max_abs", "{:.5f}"), ("mean_err_vs_finest", "{:.5f}"),
 ]

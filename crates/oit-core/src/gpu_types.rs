@@ -23,6 +23,17 @@ pub struct PoolNode {
     pub rgba: [f32; 4],
 }
 
+/// Mirrors `Node` in `shaders/abuffer_coverage.wgsl`: a pool node with its sample mask.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CoverageNode {
+    pub depth: f32,
+    pub next: u32,
+    pub rgba: [f32; 4],
+    pub mask: u32,
+    pub pad: u32,
+}
+
 /// Mirrors `Node` in `shaders/adaptive.wgsl`: a pool node with its primitive index.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]

@@ -20,5 +20,5 @@ pub use context::GpuContext;
 pub use error::{OitError, Result};
 pub use method::{methods, MethodInfo, ParamInfo, ParamKind, ParamValue, Params};
 pub use reference::{reference, reference_antialiased, ReferenceImage};
-pub use renderer::{shared_context, Frame, Renderer, Stats};
+pub use renderer::{shared_context, AntialiasMode, Frame, Renderer, Stats, COVERAGE_METHODS, COVERAGE_SAMPLES};
 pub use scene::{Camera, Mesh, Scene};

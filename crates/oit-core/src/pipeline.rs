@@ -33,13 +33,40 @@ pub fn geometry(
     targets: &[Option<wgpu::ColorTargetState>],
     depth: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
+    geometry_samples(device, label, module, layout, fs, targets, depth, 1)
+}
+
+/// Depth state of a coverage-mask geometry pass: the multisampled attachment only gives the
+/// pass its sample count; the shader tests each sample against its own opaque depth.
+pub fn raster_only() -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        stencil: Default::default(),
+        bias: Default::default(),
+    })
+}
+
+/// [`geometry`] rasterized at `samples` samples a pixel (the shader reads the coverage mask).
+#[allow(clippy::too_many_arguments)]
+pub fn geometry_samples(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    fs: &str,
+    targets: &[Option<wgpu::ColorTargetState>],
+    depth: Option<wgpu::DepthStencilState>,
+    samples: u32,
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
         vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: depth,
-        multisample: Default::default(),
+        multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
         fragment: Some(wgpu::FragmentState { module, entry_point: Some(fs), compilation_options: Default::default(), targets }),
         multiview_mask: None,
         cache: None,

@@ -13,7 +13,7 @@ use crate::method::{self, FrameCtx, Limits, Method, MethodInfo, ParamValue, Para
 use crate::pipeline;
 use crate::scene::{Camera, Scene};
 use crate::shader;
-use crate::targets::{read_buffer, read_rows, targets_layout, Targets, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::targets::{read_buffer, read_rows, samples_layout, targets_layout, SampleTargets, Targets, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::timer::PassTimer;
 use crate::upload::{scene_layout, GpuScene};
 
@@ -37,7 +37,33 @@ pub struct Stats {
     pub extra: Vec<(&'static str, f64)>,
     /// Samples a pixel (1: no antialiasing).
     pub antialias: u32,
+    pub antialias_mode: AntialiasMode,
 }
+
+/// How a frame of several samples a pixel is made (docs/methods.md, "Antialiasing").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AntialiasMode {
+    /// One full frame per sample position, averaged: any method, memory of one sample.
+    #[default]
+    Frames,
+    /// One multisampled capture with a sample mask per stored fragment.
+    Coverage,
+}
+
+impl AntialiasMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            AntialiasMode::Frames => "frames",
+            AntialiasMode::Coverage => "coverage",
+        }
+    }
+}
+
+/// Methods that take coverage masks (`AntialiasMode::Coverage`).
+pub const COVERAGE_METHODS: &[&str] = &["abuffer"];
+/// Samples a pixel of a coverage-mask frame: WebGPU guarantees multisampling at 4 (lavapipe
+/// offers no other count).
+pub const COVERAGE_SAMPLES: u32 = 4;
 
 pub struct Frame {
     pub width: u32,
@@ -118,6 +144,8 @@ pub struct Renderer {
     methods: HashMap<&'static str, Box<dyn Method>>,
     timer: PassTimer,
     limits: Limits,
+    /// Made at the first coverage-mask frame.
+    coverage: Option<Coverage>,
 }
 
 /// One device per adapter choice, shared by every renderer in the process.
@@ -153,7 +181,7 @@ impl Renderer {
         gpu.take_error()?;
         let timer = PassTimer::new(&gpu);
         let limits = Limits { max_binding_bytes: gpu.max_binding_bytes() };
-        Ok(Self { gpu, width, height, shared, targets, scene: None, methods: HashMap::new(), timer, limits })
+        Ok(Self { gpu, width, height, shared, targets, scene: None, methods: HashMap::new(), timer, limits, coverage: None })
     }
 
     /// Sizes method buffers as if the adapter bound at most `bytes` per storage binding
@@ -183,7 +211,7 @@ impl Renderer {
         params: &[(String, ParamValue)],
         background: [f32; 3],
     ) -> Result<Frame> {
-        self.render_antialiased(scene, camera, method_name, params, background, 1)
+        self.render_antialiased(scene, camera, method_name, params, background, 1, AntialiasMode::Frames)
     }
 
     /// Renders `antialias` sample frames, each with the camera moved onto one position of the
@@ -193,6 +221,11 @@ impl Renderer {
     /// the samples, depth complexity is the largest per pixel, GPU time the sum, memory the
     /// largest of the samples; the error bound is the mean of the samples' bounds (the
     /// error of a mean is at most the mean of the errors).
+    ///
+    /// `AntialiasMode::Coverage` instead rasterizes the transparent geometry once,
+    /// multisampled, and stores one fragment per pixel with its sample mask (the methods of
+    /// COVERAGE_METHODS, at COVERAGE_SAMPLES samples); docs/methods.md, "Antialiasing".
+    #[allow(clippy::too_many_arguments)]
     pub fn render_antialiased(
         &mut self,
         scene: &Scene,
@@ -201,6 +234,7 @@ impl Renderer {
         params: &[(String, ParamValue)],
         background: [f32; 3],
         antialias: u32,
+        mode: AntialiasMode,
     ) -> Result<Frame> {
         let start = Instant::now();
         let offsets = antialias::sample_offsets(antialias)?;
@@ -209,10 +243,28 @@ impl Renderer {
         if background.iter().any(|c| !c.is_finite() || !(0.0..=1.0).contains(c)) {
             return Err(invalid!("background {background:?} must be three linear RGB values in [0, 1]"));
         }
+        let coverage = mode == AntialiasMode::Coverage && antialias > 1;
+        if coverage {
+            if !COVERAGE_METHODS.contains(&info.name) {
+                return Err(invalid!(
+                    "antialias_mode 'coverage' is implemented by {} only; '{}' antialiases with antialias_mode 'frames'",
+                    COVERAGE_METHODS.join(", "),
+                    info.name
+                ));
+            }
+            if antialias != COVERAGE_SAMPLES {
+                return Err(invalid!(
+                    "antialias_mode 'coverage' rasterizes at {COVERAGE_SAMPLES} samples a pixel (the count every adapter \
+                     multisamples at), got antialias={antialias}: use antialias={COVERAGE_SAMPLES}, or antialias_mode 'frames'"
+                ));
+            }
+        }
         self.upload(scene)?;
-        if offsets.len() == 1 {
-            let mut frame = self.render_sample(camera, info, &params, background)?;
+        if offsets.len() == 1 || coverage {
+            let mut frame = self.render_sample(camera, info, &params, background, coverage)?;
             frame.stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
+            frame.stats.antialias = antialias;
+            frame.stats.antialias_mode = if coverage { AntialiasMode::Coverage } else { mode };
             return Ok(frame);
         }
         let pixels = self.width as usize * self.height as usize;
@@ -222,7 +274,7 @@ impl Renderer {
         let mut stats = Stats::default();
         for (i, offset) in offsets.iter().enumerate() {
             let jittered = camera.jittered(*offset, self.width, self.height);
-            let f = self.render_sample(&jittered, info, &params, background)?;
+            let f = self.render_sample(&jittered, info, &params, background, false)?;
             image.iter_mut().zip(&f.image).for_each(|(a, &v)| *a += v as f64);
             if let Some(b) = &f.error_bound {
                 let sum = bound.get_or_insert_with(|| vec![0.0; pixels]);
@@ -246,6 +298,7 @@ impl Renderer {
         let n = offsets.len() as f64;
         stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
         stats.antialias = antialias;
+        stats.antialias_mode = AntialiasMode::Frames;
         Ok(Frame {
             width: self.width,
             height: self.height,
@@ -256,20 +309,18 @@ impl Renderer {
         })
     }
 
-    /// One frame with the pixel centers where `camera` puts them (the scene is uploaded).
-    fn render_sample(&mut self, camera: &Camera, info: &'static MethodInfo, params: &Params, background: [f32; 3]) -> Result<Frame> {
+    /// One frame with the pixel centers where `camera` puts them (the scene is uploaded); with
+    /// `coverage`, a coverage-mask frame at COVERAGE_SAMPLES samples a pixel.
+    fn render_sample(&mut self, camera: &Camera, info: &'static MethodInfo, params: &Params, background: [f32; 3], coverage: bool) -> Result<Frame> {
         let start = Instant::now();
         let gpu = self.gpu.clone();
+        if coverage && self.coverage.is_none() {
+            self.coverage = Some(Coverage::new(&gpu, self.width, self.height, &self.shared));
+            gpu.take_error()?;
+        }
+        let cov = if coverage { self.coverage.as_ref() } else { None };
         let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
-        let uniform = FrameUniform {
-            view_proj: camera.matrix_f32().to_cols_array_2d(),
-            background: [background[0], background[1], background[2], 0.0],
-            size: [self.width, self.height],
-            triangle_count: gpu_scene.transparent.triangles,
-            seed: 0,
-        };
-        gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
-        self.opaque_and_census(gpu_scene, background);
+        self.opaque_and_census(gpu_scene, camera, background, cov);
         let counts_raw = read_buffer(&gpu, &self.targets.counts_readback, self.width as u64 * self.height as u64 * 4)?;
         let depth_complexity: Vec<u32> = bytemuck::pod_collect_to_vec(&counts_raw);
         let max_depth_complexity = depth_complexity.iter().copied().max().unwrap_or(0);
@@ -283,7 +334,7 @@ impl Renderer {
             scene: gpu_scene,
             camera,
             targets: &self.targets,
-            targets_layout: &self.shared.targets_layout,
+            targets_layout: cov.map_or(&self.shared.targets_layout, |c| &c.layout),
             scene_layout: &self.shared.scene_layout,
             timer: &mut self.timer,
             params,
@@ -291,6 +342,7 @@ impl Renderer {
             fragments,
             frame_uniform: &self.shared.uniform,
             limits: self.limits,
+            coverage: cov.map(|c| &c.targets),
         };
         let report = method.render(&mut cx)?;
         let pass_times = self.timer.read(&gpu)?;
@@ -303,7 +355,7 @@ impl Renderer {
             fragments,
             max_depth_complexity,
             memory_bytes: report.memory_bytes,
-            target_bytes: self.targets.bytes(),
+            target_bytes: self.targets.bytes() + cov.map_or(0, |c| c.targets.bytes()),
             scene_bytes: gpu_scene.transparent.bytes + gpu_scene.opaque.bytes,
             gpu_time_ms: pass_times.as_ref().map(|p| p.iter().map(|(_, t)| t).sum()),
             pass_times_ms: pass_times.unwrap_or_default(),
@@ -311,6 +363,7 @@ impl Renderer {
             wall_time_ms: start.elapsed().as_secs_f64() * 1e3,
             extra: report.extra,
             antialias: 1,
+            antialias_mode: AntialiasMode::Frames,
         };
         Ok(Frame { width: self.width, height: self.height, image, depth_complexity, error_bound, stats })
     }
@@ -324,44 +377,95 @@ impl Renderer {
         Ok(())
     }
 
-    /// Opaque geometry into base color and depth, then the untimed fragment census.
-    fn opaque_and_census(&self, scene: &GpuScene, bg: [f32; 3]) {
+    /// Writes the frame uniform for `camera`.
+    fn set_camera(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3]) {
+        let uniform = FrameUniform {
+            view_proj: camera.matrix_f32().to_cols_array_2d(),
+            background: [bg[0], bg[1], bg[2], 0.0],
+            size: [self.width, self.height],
+            triangle_count: scene.transparent.triangles,
+            seed: 0,
+        };
+        self.gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
+    }
+
+    /// Opaque geometry into a base color and depth target (under the current uniform).
+    fn opaque_pass(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, color: &wgpu::TextureView, depth: &wgpu::TextureView, bg: [f32; 3]) {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("opaque"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: color,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 0.0 }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.shared.opaque);
+        scene.opaque.draw_all(&mut pass);
+    }
+
+    /// The opaque pass under `camera` (for a coverage-mask frame, one per sample position into
+    /// the sample targets), then the untimed fragment census, copied to its readback.
+    fn opaque_and_census(&self, scene: &GpuScene, camera: &Camera, bg: [f32; 3], coverage: Option<&Coverage>) {
         let t = &self.targets;
+        if let Some(c) = coverage {
+            let offsets = antialias::sample_offsets(c.targets.samples).expect("a supported sample count");
+            for (s, offset) in offsets.iter().enumerate() {
+                self.set_camera(&camera.jittered(*offset, self.width, self.height), scene, bg);
+                let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+                self.opaque_pass(&mut enc, scene, &c.targets.base_layers[s], &c.targets.depth_layers[s], bg);
+                self.gpu.queue.submit([enc.finish()]);
+            }
+        }
+        self.set_camera(camera, scene, bg);
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("opaque"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &t.base,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 0.0 }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &t.depth,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.shared.opaque);
-            scene.opaque.draw_all(&mut pass);
+        if coverage.is_none() {
+            self.opaque_pass(&mut enc, scene, &t.base, &t.depth, bg);
         }
         enc.clear_buffer(&t.counts, 0, None);
         {
-            let mut pass = pipeline::capture_pass(&mut enc, "census", &t.depth, None);
-            pass.set_pipeline(&self.shared.census);
-            pass.set_bind_group(1, &t.group, &[]);
+            let (census, group, depth) = match coverage {
+                Some(c) => (&c.census, &c.targets.group, &c.targets.raster_depth),
+                None => (&self.shared.census, &t.group, &t.depth),
+            };
+            let mut pass = pipeline::capture_pass(&mut enc, "census", depth, None);
+            pass.set_pipeline(census);
+            pass.set_bind_group(1, group, &[]);
             pass.set_bind_group(2, &t.counts_group, &[]);
             scene.transparent.draw_all(&mut pass);
         }
         enc.copy_buffer_to_buffer(&t.counts, 0, &t.counts_readback, 0, t.counts.size().min(t.counts_readback.size()));
         self.gpu.queue.submit([enc.finish()]);
     }
+}
 
+/// What a coverage-mask frame needs besides the frame targets: the per-sample targets, their
+/// layout, and the multisampled census.
+struct Coverage {
+    layout: wgpu::BindGroupLayout,
+    targets: SampleTargets,
+    census: wgpu::RenderPipeline,
+}
+
+impl Coverage {
+    fn new(gpu: &GpuContext, width: u32, height: u32, shared: &Shared) -> Self {
+        let d = &gpu.device;
+        let layout = samples_layout(d);
+        let targets = SampleTargets::new(gpu, width, height, COVERAGE_SAMPLES, &layout);
+        let module = shader::module(d, "census_samples.wgsl", &[]);
+        let pl = pipeline::layout(d, &[&shared.scene_layout, &layout, &shared.counts_layout]);
+        let census = pipeline::geometry_samples(d, "census", &module, &pl, "fs_census", &[], pipeline::raster_only(), COVERAGE_SAMPLES);
+        Self { layout, targets, census }
+    }
 }

@@ -32,6 +32,9 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("bucket_peeling.wgsl", include_str!("../../../shaders/bucket_peeling.wgsl")),
     ("hybrid64.wgsl", include_str!("../../../shaders/hybrid64.wgsl")),
     ("auto_estimate.wgsl", include_str!("../../../shaders/auto_estimate.wgsl")),
+    ("common/targets_samples.wgsl", include_str!("../../../shaders/common/targets_samples.wgsl")),
+    ("census_samples.wgsl", include_str!("../../../shaders/census_samples.wgsl")),
+    ("abuffer_coverage.wgsl", include_str!("../../../shaders/abuffer_coverage.wgsl")),
 ];
 
 /// A compile-time constant injected in front of a shader.

@@ -198,3 +198,99 @@ pub fn read_rows(gpu: &GpuContext, texture: &wgpu::Texture, readback: &wgpu::Buf
     }
     Ok(out)
 }
+
+/// Group 1 of a coverage-mask frame (shaders/common/targets_samples.wgsl): the opaque depth
+/// and base color of each sample position, as layers of 2D arrays.
+pub fn samples_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2Array, multisampled: false },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("sample targets"),
+        entries: &[tex(0, wgpu::TextureSampleType::Depth), tex(1, wgpu::TextureSampleType::Float { filterable: false })],
+    })
+}
+
+/// The targets of a coverage-mask frame at `samples` samples a pixel: per sample position the
+/// opaque base color and depth (one layer each, rendered with the camera moved onto it), and
+/// the multisampled depth attachment transparent geometry is rasterized against (never
+/// written: it only gives the pass its sample count).
+pub struct SampleTargets {
+    pub samples: u32,
+    pub base_layers: Vec<wgpu::TextureView>,
+    pub depth_layers: Vec<wgpu::TextureView>,
+    pub group: wgpu::BindGroup,
+    pub raster_depth: wgpu::TextureView,
+    pixels: u64,
+}
+
+impl SampleTargets {
+    pub fn new(gpu: &GpuContext, width: u32, height: u32, samples: u32, layout: &wgpu::BindGroupLayout) -> Self {
+        let d = &gpu.device;
+        use wgpu::TextureUsages as U;
+        let array = |label, format| {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: samples },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let base = array("sample base colors", COLOR_FORMAT);
+        let depth = array("sample opaque depths", DEPTH_FORMAT);
+        let layers = |t: &wgpu::Texture| -> Vec<wgpu::TextureView> {
+            (0..samples)
+                .map(|s| {
+                    t.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2),
+                        base_array_layer: s,
+                        array_layer_count: Some(1),
+                        ..Default::default()
+                    })
+                })
+                .collect()
+        };
+        let whole = |t: &wgpu::Texture| {
+            t.create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() })
+        };
+        let (base_all, depth_all) = (whole(&base), whole(&depth));
+        let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sample targets"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_all) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&base_all) },
+            ],
+        });
+        let raster = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("multisampled raster depth"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: samples,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: U::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        Self {
+            samples,
+            base_layers: layers(&base),
+            depth_layers: layers(&depth),
+            group,
+            raster_depth: raster.create_view(&Default::default()),
+            pixels: width as u64 * height as u64,
+        }
+    }
+
+    /// Bytes: base color and depth per sample, and the multisampled raster depth.
+    pub fn bytes(&self) -> u64 {
+        self.pixels * self.samples as u64 * (16 + 4 + 4)
+    }
+}

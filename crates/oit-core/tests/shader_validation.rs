@@ -1,7 +1,7 @@
 //! Every WGSL file parses and validates with naga (no GPU needed), and the structs shared
 //! with Rust have the sizes naga computes.
 
-use oit_core::gpu_types::{Alloc, CompactNode, FrameUniform, PallBlock, PoolNode, PrimNode, PrimShading};
+use oit_core::gpu_types::{CoverageNode, Alloc, CompactNode, FrameUniform, PallBlock, PoolNode, PrimNode, PrimShading};
 use oit_core::shader::{compose, entry_files, DEFAULT_CONSTS};
 
 fn validate(path: &str) -> naga::Module {
@@ -44,6 +44,8 @@ fn layout_sizes() {
     let m = validate("compact_abuffer.wgsl");
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<CompactNode>());
     assert_eq!(struct_size(&m, "PrimShading") as usize, std::mem::size_of::<PrimShading>());
+    let m = validate("abuffer_coverage.wgsl");
+    assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<CoverageNode>());
     let m = validate("pall.wgsl");
     assert_eq!(struct_size(&m, "Block") as usize, std::mem::size_of::<PallBlock>());
 }

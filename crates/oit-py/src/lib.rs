@@ -166,6 +166,7 @@ fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, 
     d.set_item("overflow_fragments", s.overflow_fragments)?;
     d.set_item("wall_time_ms", s.wall_time_ms)?;
     d.set_item("antialias", s.antialias)?;
+    d.set_item("antialias_mode", s.antialias_mode.name())?;
     for (k, v) in &s.extra {
         d.set_item(*k, v)?;
     }
@@ -219,7 +220,17 @@ impl Renderer {
         background: (f32, f32, f32),
         params: Bound<'py, PyDict>,
         antialias: u32,
+        antialias_mode: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let mode = match antialias_mode {
+            "frames" => oit_core::AntialiasMode::Frames,
+            "coverage" => oit_core::AntialiasMode::Coverage,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "antialias_mode must be 'frames' or 'coverage', got '{other}'"
+                )))
+            }
+        };
         let camera = oit_core::Camera::from_rows(matrix(&view_proj)?).map_err(Error::from)?;
         let mut plist = Vec::new();
         for (k, v) in params.iter() {
@@ -231,7 +242,7 @@ impl Renderer {
         let frame = py
             .detach(|| {
                 let mut r = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-                r.render_antialiased(inner_scene, &camera, method, &plist, bg, antialias)
+                r.render_antialiased(inner_scene, &camera, method, &plist, bg, antialias, mode)
             })
             .map_err(Error::from)?;
         let (h, w) = (frame.height as usize, frame.width as usize);

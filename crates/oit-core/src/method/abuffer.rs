@@ -5,7 +5,7 @@ use super::lists::{loop_limited, Aux, ListLayout, ListMethod, BATCH, LLVMPIPE_LO
 use super::{FrameCtx, Limits, Method, MethodInfo, MethodReport};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
-use crate::gpu_types::PoolNode;
+use crate::gpu_types::{CoverageNode, PoolNode};
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "abuffer",
@@ -17,21 +17,31 @@ pub const INFO: MethodInfo = MethodInfo {
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 
-struct ABuffer(ListMethod);
+struct ABuffer {
+    lists: ListMethod,
+    /// The coverage-mask variant (shaders/abuffer_coverage.wgsl), made at its first frame.
+    coverage: Option<ListMethod>,
+}
 
 impl ABuffer {
     fn new(gpu: &GpuContext, limits: &Limits) -> Self {
-        Self(ListMethod::new(gpu, limits, ListLayout {
+        let lists = ListMethod::new(gpu, limits, ListLayout {
             shader: "abuffer.wgsl",
             node_bytes: std::mem::size_of::<PoolNode>() as u64,
             state_words: STATE_WORDS,
             aux: Aux::None,
-        }))
+        });
+        Self { lists, coverage: None }
     }
 }
 
-/// Words of per-pixel sweep state (mirrors STATE_WORDS in shaders/common/sweep.wgsl).
-pub(crate) const STATE_WORDS: u64 = 12;
+/// Words of per-pixel sweep state at one sample a pixel (STATE_WORDS in
+/// shaders/common/sweep.wgsl: 8 + 4 per sample).
+pub(crate) const STATE_WORDS: u64 = state_words(1);
+
+pub(crate) const fn state_words(samples: u32) -> u64 {
+    8 + 4 * samples as u64
+}
 
 /// Loop iterations of one sweep over a list of n fragments, at worst: one per node and
 /// log2(BATCH) heap steps per node kept, then the batch's heap sort.
@@ -57,6 +67,19 @@ pub(crate) fn check_sweep_budget(cx: &FrameCtx<'_>) -> Result<()> {
 impl Method for ABuffer {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         check_sweep_budget(cx)?;
-        self.0.render(cx)
+        match cx.coverage {
+            Some(c) => {
+                let lists = self.coverage.get_or_insert_with(|| {
+                    ListMethod::new(cx.gpu, &cx.limits, ListLayout {
+                        shader: "abuffer_coverage.wgsl",
+                        node_bytes: std::mem::size_of::<CoverageNode>() as u64,
+                        state_words: state_words(c.samples),
+                        aux: Aux::None,
+                    })
+                });
+                lists.render(cx)
+            }
+            None => self.lists.render(cx),
+        }
     }
 }

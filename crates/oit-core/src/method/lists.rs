@@ -249,7 +249,10 @@ impl ListMethod {
         consts.extend(self.consts.iter().copied());
         let module = shader::module(d, self.shader, &consts);
         let layout = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &self.pool.layout]);
-        let capture = pipeline::geometry(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::depth_test_only());
+        let capture = match cx.coverage {
+            Some(c) => pipeline::geometry_samples(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::raster_only(), c.samples),
+            None => pipeline::geometry(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::depth_test_only()),
+        };
         let resolve = pipeline::fullscreen(d, "list resolve", &module, &layout, "fs_resolve");
         let compute = |entry: &str| pipeline::compute(d, &layout, &module, entry);
         let sweep = self.sweeps.then(|| compute("cs_sweep"));
@@ -265,11 +268,12 @@ impl ListMethod {
     fn count_and_scan(&self, cx: &mut FrameCtx<'_>, enc: &mut wgpu::CommandEncoder, count: &wgpu::RenderPipeline, scan: &Scan, pixels: u64) {
         let t = cx.targets;
         let group = self.pool.group.as_ref().expect("reserved");
+        let targets_group = cx.targets_group();
         enc.clear_buffer(&self.pool.aux, 0, None);
         {
             let mut pass = pipeline::capture_pass(enc, "list count", &t.depth, cx.timer.render_pass("count"));
             pass.set_pipeline(count);
-            pass.set_bind_group(1, &t.group, &[]);
+            pass.set_bind_group(1, targets_group, &[]);
             pass.set_bind_group(2, group, &[]);
             cx.scene.transparent.draw_all(&mut pass);
         }
@@ -300,6 +304,7 @@ impl ListMethod {
             self.scan = Some((pixels, Scan::new(cx.gpu, &self.pool.aux, pixels + 1)));
         }
         let mut regrown = 0.0;
+        let (targets_group, raster_depth) = (cx.targets_group(), cx.raster_depth());
         loop {
             cx.timer.reset();
             let p = self.pipelines.as_ref().expect("built above");
@@ -313,7 +318,7 @@ impl ListMethod {
                 });
                 pass.set_pipeline(allocate);
                 pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
-                pass.set_bind_group(1, &t.group, &[]);
+                pass.set_bind_group(1, targets_group, &[]);
                 pass.set_bind_group(2, group, &[]);
                 let groups = (triangles as u32).div_ceil(64);
                 pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
@@ -322,9 +327,9 @@ impl ListMethod {
                 self.count_and_scan(cx, &mut enc, count, scan, pixels);
             }
             {
-                let mut pass = pipeline::capture_pass(&mut enc, "list capture", &t.depth, cx.timer.render_pass("capture"));
+                let mut pass = pipeline::capture_pass(&mut enc, "list capture", raster_depth, cx.timer.render_pass("capture"));
                 pass.set_pipeline(&p.capture);
-                pass.set_bind_group(1, &t.group, &[]);
+                pass.set_bind_group(1, targets_group, &[]);
                 pass.set_bind_group(2, group, &[]);
                 cx.scene.transparent.draw_all(&mut pass);
             }
@@ -336,7 +341,7 @@ impl ListMethod {
                 });
                 pass.set_pipeline(sweep);
                 pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
-                pass.set_bind_group(1, &t.group, &[]);
+                pass.set_bind_group(1, targets_group, &[]);
                 pass.set_bind_group(2, group, &[]);
                 for _ in 0..sweeps {
                     pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
@@ -346,7 +351,7 @@ impl ListMethod {
                 let mut pass = pipeline::resolve_pass(&mut enc, "list resolve", &t.out, cx.timer.render_pass("resolve"));
                 pass.set_pipeline(&p.resolve);
                 pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
-                pass.set_bind_group(1, &t.group, &[]);
+                pass.set_bind_group(1, targets_group, &[]);
                 pass.set_bind_group(2, group, &[]);
                 pass.draw(0..3, 0..1);
             }

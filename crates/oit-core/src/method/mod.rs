@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 use crate::context::GpuContext;
 use crate::error::{invalid, Result};
 use crate::scene::Camera;
-use crate::targets::Targets;
+use crate::targets::{SampleTargets, Targets};
 use crate::timer::PassTimer;
 use crate::upload::GpuScene;
 
@@ -230,6 +230,22 @@ pub(crate) struct FrameCtx<'a> {
     pub frame_uniform: &'a wgpu::Buffer,
     /// Limits to size buffers by (the adapter's, or lower ones the caller asked for).
     pub limits: Limits,
+    /// A coverage-mask frame's per-sample targets (only methods that take coverage masks
+    /// see one); `targets_layout` is then their layout.
+    pub coverage: Option<&'a SampleTargets>,
+}
+
+impl<'a> FrameCtx<'a> {
+    /// Group 1 of storage-writing and resolve passes: the frame's targets, or the per-sample
+    /// ones of a coverage-mask frame.
+    pub fn targets_group(&self) -> &'a wgpu::BindGroup {
+        self.coverage.map_or(&self.targets.group, |c| &c.group)
+    }
+
+    /// The depth attachment geometry passes draw against (read-only).
+    pub fn raster_depth(&self) -> &'a wgpu::TextureView {
+        self.coverage.map_or(&self.targets.depth, |c| &c.raster_depth)
+    }
 }
 
 impl FrameCtx<'_> {
@@ -248,6 +264,7 @@ impl FrameCtx<'_> {
             fragments: self.fragments,
             frame_uniform: self.frame_uniform,
             limits: self.limits,
+            coverage: self.coverage,
         }
     }
 
