@@ -211,6 +211,8 @@ impl Renderer {
 
     /// Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict,
     /// error bound (h, w) float32 or None).
+    #[pyo3(signature = (scene, view_proj, method, background, params, antialias=1, antialias_mode="frames"))]
+    #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
         py: Python<'py>,
@@ -300,8 +302,10 @@ fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
     Ok(out)
 }
 
-/// CPU float64 reference: (image (h, w, 4) float64, ambiguous (h, w) bool, depth complexity).
+/// CPU float64 reference: (image (h, w, 4) float64, ambiguous (h, w) bool, depth complexity),
+/// the mean over the standard pattern's positions when `antialias` > 1.
 #[pyfunction]
+#[pyo3(signature = (scene, view_proj, width, height, background, antialias=1))]
 fn reference<'py>(
     py: Python<'py>,
     scene: PyRef<'py, Scene>,
