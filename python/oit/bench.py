@@ -505,6 +505,7 @@ def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances:
                 progress.step("hybrid")
             except (RuntimeError, MemoryError, ValueError) as e:
                 row.update(status="failed", message=str(e).splitlines()[0])
+            row["load_avg"] = os.getloadavg()[0] if hasattr(os, "getloadavg") else math.nan  # as _row keeps it
             result.rows.append(row)
     return result
 
@@ -529,7 +530,8 @@ def _measured(who: str, frame: Any, gpu: list[float], wall: list[float], exact: 
 AUTO_COLUMNS = [
     ("scene", "{}"), ("size", "{}"), ("tolerance", "{:.5f}"), ("auto_k", "{:.0f}"), ("auto_exact", "{:.0f}"),
     ("auto_attempts", "{:.0f}"), ("auto_gpu_ms", "{:.1f}"), ("auto_wall_ms", "{:.1f}"), ("auto_mib", "{:.2f}"),
-    ("auto_max_abs", "{:.5f}"), ("auto_max_err_all", "{:.5f}"), ("within_t", "{}"), ("fixed_k", "{}"),
+    ("auto_max_abs", "{:.5f}"), ("auto_max_err", "{:.5f}"), ("auto_max_err_all", "{:.5f}"), ("within_t", "{}"),
+    ("fixed_k", "{}"),
     ("fixed_gpu_ms", "{:.1f}"), ("fixed_wall_ms", "{:.1f}"), ("fixed_mib", "{:.2f}"), ("fixed_max_abs", "{:.5f}"),
     ("gpu_ms_ratio", "{:.2f}"), ("wall_ms_ratio", "{:.2f}"), ("mib_ratio", "{:.2f}"),
 ]

@@ -149,6 +149,9 @@ def write_all(result: Any, out: str) -> list[str]:
     return paths
 
 
+TEMPORAL_CLIP = 4.0  # bars of the temporal figure stop here, with their value written beside them
+
+
 def temporal(rows: list[dict], path: str, columns: int = 3) -> None:
     """The temporal-stability figure of bench.temporal: one panel per scene and size, a pair of
     bars per method — its mean change between consecutive frames and its flicker (the change
@@ -168,9 +171,14 @@ def temporal(rows: list[dict], path: str, columns: int = 3) -> None:
     y = np.arange(len(methods))
     for ax, (scene, size) in zip(axes.flat, panels):
         mine = {r["method"]: r for r in rows if (r["scene"], r["size"]) == (scene, size) and r["status"] == "ok"}
-        get = lambda key: [mine[m][key] if m in mine else math.nan for m in methods]  # noqa: E731
-        ax.barh(y - 0.2, get("change_ratio"), height=0.4, color="tab:blue", label="mean change / abuffer's")
-        ax.barh(y + 0.2, get("flicker_ratio"), height=0.4, color="tab:red", label="flicker / abuffer's change")
+        for dy, key, color, label in ((-0.2, "change_ratio", "tab:blue", "mean change / abuffer's"),
+                                      (0.2, "flicker_ratio", "tab:red", "flicker / abuffer's change")):
+            values = np.array([mine[m][key] if m in mine else math.nan for m in methods], dtype=float)
+            ax.barh(y + dy, np.minimum(values, TEMPORAL_CLIP), height=0.4, color=color, label=label)
+            for yy, v in zip(y + dy, values):
+                if v > TEMPORAL_CLIP:  # the unbounded sums (wsum, additive) would squash every other bar
+                    ax.text(TEMPORAL_CLIP, yy, f" {v:.1f}", va="center", fontsize=6, color=color)
+        ax.set_xlim(0, TEMPORAL_CLIP * 1.12)
         ax.axvline(1.0, color="0.3", linestyle="--", linewidth=1)
         ax.set_title(f"{scene} {size}", fontsize=9)
         ax.set_xlabel("over abuffer's mean change between frames", fontsize=8)
