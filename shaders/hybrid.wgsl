@@ -24,6 +24,18 @@ const ACCUM_WORDS: u32 = 16u;
 @group(2) @binding(1) var<storage, read_write> vis: array<f32>;
 @group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
 @group(2) @binding(3) var<storage, read_write> overflow: atomic<u32>;
+// With PER_PIXEL, pixel px owns slots offsets[px] .. offsets[px + 1] (a prefix sum of each
+// pixel's own k, chosen by auto); otherwise K slots a pixel and this binding is unused.
+@group(2) @binding(4) var<storage, read_write> offsets: array<u32>;
+
+// The first slot and the slot count of pixel px.
+fn slots(px: u32) -> vec2<u32> {
+    if PER_PIXEL != 0u {
+        let first = offsets[px];
+        return vec2<u32>(first, offsets[px + 1u] - first);
+    }
+    return vec2<u32>(px * K, K);
+}
 //!include common/fixed.wgsl
 
 // 24-bit depth over 8-bit alpha, inverted so that a cleared (zero) slot is empty and
@@ -44,16 +56,21 @@ fn fs_store(in: VsOut) {
         return;
     }
     let px = pixel_index(in.clip);
-    let base = px * K;
+    let sl = slots(px);
+    let base = sl.x;
     var v = pack_key(in.clip.z, in.color.a);
+    if sl.y == 0u {
+        atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
+        return;
+    }
     // Slots only ever grow (atomicMax), so a key not above a full table's last one now will
     // not be in the final table: record it as evicted without walking the table.
-    let last = atomicLoad(&ktab[base + K - 1u]);
+    let last = atomicLoad(&ktab[base + sl.y - 1u]);
     if last != 0u && v <= last {
         atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
         return;
     }
-    for (var i = 0u; i < K; i++) {
+    for (var i = 0u; i < sl.y; i++) {
         let old = atomicMax(&ktab[base + i], v);
         if old == 0u {
             return; // took an empty slot
@@ -67,16 +84,21 @@ fn fs_store(in: VsOut) {
 // the same key as the last slot was pushed out: that tied group is split across the table's
 // end, so all of it goes to the tail (no fragment counted twice or dropped).
 fn core_bound(px: u32) -> u32 {
-    let last = atomicLoad(&ktab[px * K + K - 1u]);
+    let sl = slots(px);
+    if sl.y == 0u {
+        return 0xffffffffu; // no slots: nothing is core
+    }
+    let last = atomicLoad(&ktab[sl.x + sl.y - 1u]);
     let evicted = atomicLoad(&accum[px * ACCUM_WORDS + EVICTED]);
     return select(last, last + 1u, evicted != 0u && evicted == last);
 }
 
 fn core_slots(px: u32) -> u32 {
     let bound = core_bound(px);
+    let sl = slots(px);
     var n = 0u;
-    while n < K {
-        let key = atomicLoad(&ktab[px * K + n]);
+    while n < sl.y {
+        let key = atomicLoad(&ktab[sl.x + n]);
         if key == 0u || key < bound {
             break;
         }
@@ -91,7 +113,7 @@ fn cs_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
     if px == OUTSIDE {
         return;
     }
-    let base = px * K;
+    let base = slots(px).x;
     let n = core_slots(px);
     var t = 1.0;
     for (var i = 0u; i < n; i++) {
@@ -107,19 +129,20 @@ fn fs_shade(in: VsOut) {
         return;
     }
     let px = pixel_index(in.clip);
-    let base = px * K;
+    let sl = slots(px);
+    let base = sl.x;
     let acc = px * ACCUM_WORDS;
     let key = pack_key(in.clip.z, in.color.a);
     if key >= core_bound(px) {
         // Core: the first slot holding this key (the table is sorted by descending key).
         var lo = 0u;
-        var hi = K;
+        var hi = sl.y;
         while lo < hi {
             let mid = (lo + hi) / 2u;
             if atomicLoad(&ktab[base + mid]) > key { lo = mid + 1u; } else { hi = mid; }
         }
         var m = 0u;
-        while lo + m < K && atomicLoad(&ktab[base + lo + m]) == key {
+        while lo + m < sl.y && atomicLoad(&ktab[base + lo + m]) == key {
             m++;
         }
         if m > 0u {
@@ -176,7 +199,7 @@ fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
     // core (tail or, for ktab, nothing) is off by at most T_core; float32 and fixed-point
     // rounding of K + count terms.
     let d = read_fixed32(word(acc + QUANT_D));
-    var bound = read_fixed32(word(acc + QUANT_W)) + d * d + f32(K + count + 2u) * 2.4e-7;
+    var bound = read_fixed32(word(acc + QUANT_W)) + d * d + f32(slots(pixel_index(pos)).y + count + 2u) * 2.4e-7;
     if count > 0u {
         bound += t_core;
     }

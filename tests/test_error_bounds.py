@@ -10,7 +10,7 @@ import pytest
 import oit
 from oit import formulas
 from oit.scenes import stacks
-from scenes import IDENTITY, PERSPECTIVE, build_scene, random_meshes
+from scenes import IDENTITY, PERSPECTIVE, build_scene, layer, random_meshes
 
 
 def measured(frame, exact):
@@ -62,9 +62,28 @@ def test_auto_uses_no_more_slots_than_the_depth_complexity(renderer):
     built = stacks(layers=5, alphas="constant", size=(8, 8), seed=1)
     frame = renderer(8, 8).render(built.scene, built.camera, "auto", tolerance=0.05)
     assert frame.stats["auto_k"] == 5 and frame.stats["overflow_fragments"] == 0
-    assert frame.stats["auto_attempts"] == 1
-    # hybrid's slots and accumulators plus the estimate pass's 12 bytes a pixel
-    assert frame.stats["memory_bytes"] == formulas.memory_bytes("hybrid", 8, 8, k=5) + 8 * 8 * 12
+    assert frame.stats["auto_attempts"] == 1 and frame.stats["auto_slots"] == 5 * 64
+    assert frame.stats["memory_bytes"] == formulas.memory_bytes("auto", 8, 8, slots=5 * 64)
+
+
+def test_auto_gives_each_pixel_its_own_slots(renderer):
+    # Three layers over the whole frame, seventeen more over its left half (alpha 0.3 each):
+    # the right half gets 3 slots (no tail), the left as many as its 20 layers need.
+    full = [layer(0.1 + 0.05 * i, (0.9, 0.2, 0.1, 0.3)) for i in range(3)]
+    half = []
+    for i in range(17):
+        q = layer(0.3 + 0.03 * i, (0.1, 0.3 + 0.02 * i, 0.8, 0.3))
+        q.positions[:, 0] = np.minimum(q.positions[:, 0], 0.0)  # x in [-1, 0]: the left half
+        half.append(q)
+    scene = build_scene(full + half)
+    r = renderer(8, 8)
+    frame = r.render(scene, IDENTITY, "auto", tolerance=0.02)
+    exact = r.render(scene, IDENTITY, "abuffer")
+    k_left = frame.stats["auto_k"]
+    assert frame.stats["auto_exact"] == 0 and 3 < k_left < 20
+    assert frame.stats["auto_slots"] == 32 * k_left + 32 * 3
+    assert measured(frame, exact).max() <= 0.02
+    assert frame.stats["memory_bytes"] == formulas.memory_bytes("auto", 8, 8, slots=frame.stats["auto_slots"])
 
 
 def test_auto_predicts_k_on_hair_like_stacks(renderer):

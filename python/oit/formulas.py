@@ -10,11 +10,17 @@ HYBRID_ACCUM_WORDS = 16
 
 
 def memory_bytes(method: str, width: int, height: int, **params) -> int | None:
-    """GPU bytes `method` allocates for a width x height frame, or None when unbounded."""
+    """GPU bytes `method` allocates for a width x height frame, or None when unbounded (auto:
+    when it rendered hybrid, pass its `slots` = stats["auto_slots"])."""
     pixels = width * height
     if method in ("hybrid", "ktab"):
         k = int(params.get("k", 8))
         return pixels * (2 * k + HYBRID_ACCUM_WORDS) * 4 + 4  # k-TAB, visibility, accumulators, counter
+    if method == "auto" and "slots" in params:
+        # hybrid with each pixel's own slots (2 words a slot), the accumulators, the slot
+        # offsets (pixels + 1 words) and the counter; the estimate pass's 3 words a pixel
+        slots = int(params["slots"])
+        return 2 * slots * 4 + pixels * HYBRID_ACCUM_WORDS * 4 + (pixels + 1) * 4 + 4 + pixels * 12
     if method == "hybrid64":
         return pixels * (8 * int(params.get("k", 8)) + 9 * 4) + 4  # 64-bit k-TAB, tail sums, counter
     if method in ("wavg", "wsum", "wboit"):

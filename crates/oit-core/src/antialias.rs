@@ -70,7 +70,10 @@ mod tests {
 
     #[test]
     fn a_jittered_center_sees_the_offset_point() {
-        let cam = Camera { view_proj: DMat4::perspective_rh(0.8, 1.5, 0.5, 10.0) };
+        // A right-handed perspective (w = -z), columns as glam stores them.
+        let cam = Camera {
+            view_proj: DMat4::from_cols_array(&[1.2, 0.0, 0.0, 0.0, 0.0, 1.8, 0.0, 0.0, 0.0, 0.0, -1.05, -1.0, 0.0, 0.0, -0.5, 0.0]),
+        };
         let (w, h) = (30, 20);
         let offset = [0.25, -0.375];
         let moved = cam.jittered(offset, w, h);

@@ -49,6 +49,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("NODES_PER_BINDING", 1 << 20),
     Const::U32("BATCH", 32),
     Const::U32("K", 8),
+    Const::U32("PER_PIXEL", 0),
     Const::U32("TAIL", 1),
     Const::U32("WEIGHT", 10),
     Const::U32("NODES", 8),

@@ -2,12 +2,14 @@
 //! whose per-pixel error bound (docs/methods.md, "hybrid") is at most t everywhere, or the
 //! exact A-buffer. It decides before rendering: an estimate pass gathers per pixel the
 //! optical depth of the fragments and their alpha-quantization error; with the census's
-//! fragment counts that predicts hybrid's bound for every k (`predicted_bound`). The smallest k
-//! predicted to meet t is rendered and its real bound read back; if it misses, k is doubled
-//! once (at most 32), and then the exact A-buffer is rendered. When no k ≤ 32 is predicted to
-//! meet t, the A-buffer is rendered directly.
+//! fragment counts that predicts hybrid's bound for every k (`predicted_bound`). Each pixel gets
+//! the smallest k predicted to meet t (its own slots: `Slots::PerPixel`, no more than its
+//! fragments) and the real bound is read back; where it misses, those pixels get twice the
+//! slots once, and then the exact A-buffer is rendered. When some pixel has no k ≤ 32
+//! predicted to meet t, the A-buffer is rendered directly.
 
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind, ParamValue, Params};
+use super::hybrid::{Hybrid, Slots};
+use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind, Params};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::pipeline;
@@ -19,7 +21,7 @@ pub const INFO: MethodInfo = MethodInfo {
     summary: "accuracy on demand: the cheapest hybrid (or the exact A-buffer) whose error bound is at most `tolerance`",
     exact: false,
     bounded_memory: false,
-    passes: &["census", "estimate", "hybrid with the smallest k predicted to meet the tolerance, then twice that k if it misses, else abuffer"],
+    passes: &["census", "estimate", "hybrid with each pixel's smallest k predicted to meet the tolerance (twice that where it misses), else abuffer"],
     params: &[ParamInfo {
         name: "tolerance",
         kind: ParamKind::Float { min: 0.0, max: 1.0, default: 1.0 / 255.0 },
@@ -45,14 +47,14 @@ struct Estimate {
 }
 
 struct Auto {
-    hybrid: Box<dyn Method>,
+    hybrid: Hybrid,
     exact: Box<dyn Method>,
     estimate: Option<Estimate>,
 }
 
 impl Auto {
     fn new(gpu: &GpuContext, limits: &super::Limits) -> Self {
-        let hybrid = super::lookup("hybrid").expect("registered").instantiate(gpu, limits);
+        let hybrid = Hybrid::new(true);
         let exact = super::lookup("abuffer").expect("registered").instantiate(gpu, limits);
         Self { hybrid, exact, estimate: None }
     }
@@ -152,19 +154,32 @@ pub fn predicted_bound(n: u32, s: Sums, k: u32) -> f64 {
     quant_term + tail + (k + n + 2) as f64 * ROUNDING
 }
 
-/// The smallest k ≤ min(32, deepest pixel) predicted to meet `tolerance` at every pixel.
-pub fn choose_k(counts: &[u32], sums: &[Sums], tolerance: f64) -> Option<u32> {
-    let deepest = counts.iter().copied().max().unwrap_or(0);
-    let top = deepest.clamp(1, MAX_K);
-    // Per pixel, the smallest k that meets t; the frame needs the largest of them.
-    let mut need = 1;
-    for (&n, &s) in counts.iter().zip(sums) {
-        if n == 0 || predicted_bound(n, s, need) <= tolerance {
-            continue;
-        }
-        need = (need + 1..=top).find(|&k| predicted_bound(n, s, k) <= tolerance)?;
-    }
-    Some(need)
+/// Each pixel's smallest k ≤ min(32, its fragments) predicted to meet `tolerance` (0 where it
+/// has no fragments); None when some pixel has no such k.
+pub fn choose_slots(counts: &[u32], sums: &[Sums], tolerance: f64) -> Option<Vec<u32>> {
+    counts
+        .iter()
+        .zip(sums)
+        .map(|(&n, &s)| if n == 0 { Some(0) } else { (1..=n.min(MAX_K)).find(|&k| predicted_bound(n, s, k) <= tolerance) })
+        .collect()
+}
+
+/// The slots of a second attempt: twice as many (at most min(32, n)) where the rendered bound
+/// missed `tolerance`; None when a missing pixel already has all it can get.
+fn widen(slots: &[u32], counts: &[u32], bound: &[f32], tolerance: f64) -> Option<Vec<u32>> {
+    slots
+        .iter()
+        .zip(counts)
+        .zip(bound)
+        .map(|((&k, &n), &b)| {
+            let cap = n.min(MAX_K);
+            match (b as f64 <= tolerance, k < cap) {
+                (true, _) => Some(k),
+                (false, true) => Some((2 * k).clamp(1, cap)),
+                (false, false) => None,
+            }
+        })
+        .collect()
 }
 
 impl Method for Auto {
@@ -174,31 +189,35 @@ impl Method for Auto {
         let pixels = t.width as u64 * t.height as u64;
         let counts: Vec<u32> = bytemuck::pod_collect_to_vec(&read_buffer(cx.gpu, &t.counts_readback, pixels * 4)?);
         let sums = self.measure(cx)?;
-        let predicted = choose_k(&counts, &sums, tolerance);
+        let predicted = choose_slots(&counts, &sums, tolerance);
+        let predicted_k = predicted.as_ref().map_or(0, |s| s.iter().copied().max().unwrap_or(0));
         let mut attempts = 0.0;
         // The hybrid buffers of a missed attempt stay allocated (reused by the next frame).
         let mut hybrid_bytes = 0;
-        let tries = predicted.map(|k| vec![k, (2 * k).min(MAX_K)]).unwrap_or_default();
-        for (i, &k) in tries.iter().enumerate() {
-            if i > 0 && k == tries[0] {
-                break; // already at 32 slots
-            }
+        let mut slots = predicted;
+        while let Some(current) = slots.take() {
             attempts += 1.0;
-            let params = Params([("k", ParamValue::Int(k as i64))].into_iter().collect());
-            let mut report = self.hybrid.render(&mut cx.with_params(&params))?;
+            let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current))?;
             let bound = read_rows(cx.gpu, &t.bound_texture, &t.bound_readback, 4)?;
             let worst = bound.iter().copied().fold(0.0f32, f32::max) as f64;
             hybrid_bytes = report.memory_bytes;
             if worst <= tolerance {
+                let covered = counts.iter().filter(|&&n| n > 0).count().max(1) as f64;
+                let total: u64 = current.iter().map(|&k| k as u64).sum();
                 report.memory_bytes += pixels * WORDS * 4;
                 report.extra.extend([
-                    ("auto_k", k as f64),
-                    ("auto_predicted_k", tries[0] as f64),
+                    ("auto_k", current.iter().copied().max().unwrap_or(0) as f64),
+                    ("auto_mean_k", total as f64 / covered),
+                    ("auto_slots", total as f64),
+                    ("auto_predicted_k", predicted_k as f64),
                     ("auto_exact", 0.0),
                     ("auto_attempts", attempts),
                     ("error_bound_max", worst),
                 ]);
                 return Ok(report);
+            }
+            if attempts < 2.0 {
+                slots = widen(&current, &counts, &bound, tolerance);
             }
         }
         let mut report = self.exact.render(&mut cx.with_params(&Params::default()))?;
@@ -226,7 +245,9 @@ impl Method for Auto {
         report.memory_bytes += pixels * WORDS * 4 + hybrid_bytes;
         report.extra.extend([
             ("auto_k", 0.0),
-            ("auto_predicted_k", predicted.map_or(0.0, |k| k as f64)),
+            ("auto_mean_k", 0.0),
+            ("auto_slots", 0.0),
+            ("auto_predicted_k", predicted_k as f64),
             ("auto_exact", 1.0),
             ("auto_attempts", attempts + 1.0),
             ("error_bound_max", rounding),
@@ -259,12 +280,19 @@ mod tests {
     }
 
     #[test]
-    fn the_smallest_k_that_meets_the_tolerance() {
+    fn each_pixel_gets_the_smallest_k_that_meets_the_tolerance() {
         let counts = [10, 0, 3];
         let sums = [alike(10, 0.5), Sums::default(), alike(3, 0.5)];
-        // 0.5^k <= 0.01 first at k = 7.
-        assert_eq!(choose_k(&counts, &sums, 0.01), Some(7));
+        // 0.5^k <= 0.01 first at k = 7; three fragments fit in three slots (no tail); none, none.
+        assert_eq!(choose_slots(&counts, &sums, 0.01), Some(vec![7, 0, 3]));
         // 100 fragments of optical depth 0.01 each: 32 slots leave e^-0.32, no k meets 0.01.
-        assert_eq!(choose_k(&[100], &[alike(100, 1.0 - (-0.01f64).exp())], 0.01), None);
+        assert_eq!(choose_slots(&[100, 1], &[alike(100, 1.0 - (-0.01f64).exp()), alike(1, 0.5)], 0.01), None);
+    }
+
+    #[test]
+    fn a_missed_pixel_gets_twice_the_slots_up_to_what_it_can_use() {
+        let (counts, slots) = ([40, 12, 40, 3], [8, 8, 32, 3]);
+        assert_eq!(widen(&slots, &counts, &[0.5, 0.5, 0.0, 0.0], 0.1), Some(vec![16, 12, 32, 3]));
+        assert_eq!(widen(&slots, &counts, &[0.0, 0.0, 0.5, 0.0], 0.1), None);
     }
 }

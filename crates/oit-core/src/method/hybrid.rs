@@ -48,6 +48,23 @@ pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
     pixels * (2 * k + ACCUM_WORDS) * 4 + 4
 }
 
+/// Bytes with each pixel's own slot count (`slots` in all): k-TAB and visibility (a word
+/// each per slot), the accumulators, the per-pixel offsets (pixels + 1 words) and the counter.
+pub fn memory_bytes_per_pixel(pixels: u64, slots: u64) -> u64 {
+    2 * slots * 4 + pixels * ACCUM_WORDS * 4 + (pixels + 1) * 4 + 4
+}
+
+/// How many k-TAB slots each pixel gets.
+pub(crate) enum Slots<'s> {
+    /// k for every pixel (the `k` parameter).
+    Uniform(u32),
+    /// Each pixel its own (row-major, one per pixel; auto's choice).
+    PerPixel(&'s [u32]),
+}
+
+/// Pipelines key for per-pixel slots (k itself is the key otherwise).
+const PER_PIXEL_KEY: u32 = 0;
+
 struct Pipelines {
     store: wgpu::RenderPipeline,
     visibility: wgpu::ComputePipeline,
@@ -56,8 +73,10 @@ struct Pipelines {
 }
 
 struct Buffers {
-    key: (u64, u32),
+    /// (pixels, slots in all, per-pixel)
+    key: (u64, u64, bool),
     ktab: wgpu::Buffer,
+    offsets: wgpu::Buffer,
     _vis: wgpu::Buffer,
     accum: wgpu::Buffer,
     overflow: wgpu::Buffer,
@@ -65,7 +84,7 @@ struct Buffers {
     group: wgpu::BindGroup,
 }
 
-struct Hybrid {
+pub(crate) struct Hybrid {
     tail: bool,
     layout: Option<wgpu::BindGroupLayout>,
     /// Pipelines by k (k is a shader constant): switching k, as auto does, rebuilds nothing.
@@ -74,14 +93,15 @@ struct Hybrid {
 }
 
 impl Hybrid {
-    fn new(tail: bool) -> Self {
+    pub(crate) fn new(tail: bool) -> Self {
         Self { tail, layout: None, pipelines: HashMap::new(), buffers: None }
     }
 
     fn build(&self, cx: &FrameCtx<'_>, layout: &wgpu::BindGroupLayout, k: u32) -> Pipelines {
         let d = &cx.gpu.device;
         let consts = [
-            Const::U32("K", k),
+            Const::U32("K", k.max(1)),
+            Const::U32("PER_PIXEL", (k == PER_PIXEL_KEY) as u32),
             Const::U32("TAIL", self.tail as u32),
             Const::F32("CORE_SCALE", CORE_SCALE),
             Const::F32("TAIL_SCALE", TAIL_SCALE),
@@ -95,19 +115,45 @@ impl Hybrid {
         Pipelines { store, visibility, shade, finish }
     }
 
-    fn reserve(&mut self, cx: &FrameCtx<'_>, pixels: u64, k: u32) -> Result<()> {
-        if self.buffers.as_ref().is_some_and(|b| b.key == (pixels, k)) {
+    fn reserve(&mut self, cx: &FrameCtx<'_>, pixels: u64, slots: &Slots<'_>) -> Result<()> {
+        let name = if self.tail { "hybrid" } else { "ktab" };
+        let (total, per_pixel) = match slots {
+            Slots::Uniform(k) => {
+                cx.check_per_pixel(&format!("{name} with k = {k}"), 4 * (*k as u64).max(ACCUM_WORDS))?;
+                (pixels * *k as u64, false)
+            }
+            Slots::PerPixel(s) => {
+                cx.check_per_pixel(&format!("{name}'s accumulators"), 4 * ACCUM_WORDS)?;
+                let total: u64 = s.iter().map(|&k| k as u64).sum();
+                if total * 4 > cx.limits.max_binding_bytes {
+                    return Err(crate::error::OitError::OutOfMemory(format!(
+                        "{name} with per-pixel slots needs {total} slots ({} bytes), past the {}-byte storage binding \
+                         limit: render a smaller frame or use a larger tolerance",
+                        total * 4,
+                        cx.limits.max_binding_bytes
+                    )));
+                }
+                (total, true)
+            }
+        };
+        let d = &cx.gpu.device;
+        if let (Slots::PerPixel(s), Some(b)) = (slots, &self.buffers) {
+            if b.key == (pixels, total, true) {
+                write_offsets(cx, &b.offsets, s);
+                return Ok(());
+            }
+        }
+        if self.buffers.as_ref().is_some_and(|b| b.key == (pixels, total, per_pixel)) {
             return Ok(());
         }
         self.buffers = None;
-        let d = &cx.gpu.device;
-        let name = if self.tail { "hybrid" } else { "ktab" };
-        cx.check_per_pixel(&format!("{name} with k = {k}"), 4 * (k as u64).max(ACCUM_WORDS))?;
-        let ktab_bytes = pixels * k as u64 * 4;
+        let ktab_bytes = total.max(1) * 4;
         let accum_bytes = pixels * ACCUM_WORDS * 4;
         let ktab = storage_buffer(d, "k-TAB", ktab_bytes, wgpu::BufferUsages::empty());
         let vis = storage_buffer(d, "core visibility", ktab_bytes, wgpu::BufferUsages::empty());
         let accum = storage_buffer(d, "hybrid accumulators", accum_bytes, wgpu::BufferUsages::empty());
+        let offsets_bytes = if per_pixel { (pixels + 1) * 4 } else { 4 };
+        let offsets = storage_buffer(d, "slot offsets", offsets_bytes, wgpu::BufferUsages::COPY_DST);
         let overflow = storage_buffer(d, "hybrid overflow", 4, wgpu::BufferUsages::COPY_SRC);
         let overflow_readback = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("overflow readback"),
@@ -123,20 +169,47 @@ impl Hybrid {
                 wgpu::BindGroupEntry { binding: 1, resource: vis.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: accum.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: overflow.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: offsets.as_entire_binding() },
             ],
         });
-        self.buffers = Some(Buffers { key: (pixels, k), ktab, _vis: vis, accum, overflow, overflow_readback, group });
+        if let Slots::PerPixel(s) = slots {
+            write_offsets(cx, &offsets, s);
+        }
+        self.buffers = Some(Buffers { key: (pixels, total, per_pixel), ktab, offsets, _vis: vis, accum, overflow, overflow_readback, group });
         Ok(())
     }
+}
+
+/// Each pixel's first slot (an exclusive prefix sum of its count) and the total at the end.
+fn write_offsets(cx: &FrameCtx<'_>, buffer: &wgpu::Buffer, slots: &[u32]) {
+    let mut offsets = Vec::with_capacity(slots.len() + 1);
+    let mut sum = 0u32;
+    for &k in slots {
+        offsets.push(sum);
+        sum += k;
+    }
+    offsets.push(sum);
+    cx.gpu.queue.write_buffer(buffer, 0, bytemuck::cast_slice(&offsets));
 }
 
 impl Method for Hybrid {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let k = cx.params.int("k") as u32;
+        self.render_slots(cx, Slots::Uniform(k))
+    }
+}
+
+impl Hybrid {
+    /// One frame with the k-TAB slots `slots` gives each pixel.
+    pub(crate) fn render_slots(&mut self, cx: &mut FrameCtx<'_>, slots: Slots<'_>) -> Result<MethodReport> {
+        let k = match slots {
+            Slots::Uniform(k) => k,
+            Slots::PerPixel(_) => PER_PIXEL_KEY,
+        };
         if self.layout.is_none() {
             self.layout = Some(cx.gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("hybrid"),
-                entries: &(0..4).map(pipeline::storage_entry).collect::<Vec<_>>(),
+                entries: &(0..5).map(pipeline::storage_entry).collect::<Vec<_>>(),
             }));
         }
         if !self.pipelines.contains_key(&k) {
@@ -145,7 +218,7 @@ impl Method for Hybrid {
         }
         let t = cx.targets;
         let pixels = t.width as u64 * t.height as u64;
-        self.reserve(cx, pixels, k)?;
+        self.reserve(cx, pixels, &slots)?;
         let p = &self.pipelines[&k];
         let b = self.buffers.as_ref().expect("reserved above");
         let geo = &cx.scene.transparent;
@@ -190,8 +263,12 @@ impl Method for Hybrid {
         cx.gpu.queue.submit([enc.finish()]);
         let raw = read_buffer(cx.gpu, &b.overflow_readback, 4)?;
         let overflow = u32::from_le_bytes(raw[..4].try_into().expect("4 bytes")) as u64;
+        let memory = match slots {
+            Slots::Uniform(k) => memory_bytes(pixels, k as u64),
+            Slots::PerPixel(_) => memory_bytes_per_pixel(pixels, b.key.1),
+        };
         Ok(MethodReport {
-            memory_bytes: memory_bytes(pixels, k as u64),
+            memory_bytes: memory,
             overflow_fragments: overflow,
             extra: vec![("tail_fragments", overflow as f64)],
             error_bound: true,
