@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use eframe::egui::{self, Color32, ColorImage, Rect, TextureHandle, TextureOptions};
-use oit_core::{Camera, Frame, GpuContext, Mesh, ParamValue, Renderer, Scene};
+use oit_core::{AntialiasMode, Camera, Frame, GpuContext, Mesh, ParamValue, Renderer, Scene};
 
 use crate::heatmap::{self, ErrorMap};
 use crate::orbit::ViewCamera;
@@ -50,6 +50,10 @@ pub struct Settings {
     pub error_scale: f32,
     /// Render at this fraction of the view's pixels (software adapters are slow).
     pub render_scale: f32,
+    /// Samples a pixel (oit_core::antialias::SAMPLE_COUNTS).
+    pub antialias: u32,
+    /// Coverage masks instead of sample frames (abuffer at 4 samples).
+    pub coverage: bool,
 }
 
 impl Settings {
@@ -72,6 +76,8 @@ impl Settings {
             split: 0.5,
             error_scale: 0.1,
             render_scale: 1.0,
+            antialias: 1,
+            coverage: false,
         }
     }
 
@@ -127,6 +133,8 @@ struct RenderKey {
     method: String,
     params: Vec<(String, ParamValue)>,
     background: [f32; 3],
+    antialias: u32,
+    mode: AntialiasMode,
     size: [u32; 2],
     camera: [[f64; 4]; 4],
     scene: u64,
@@ -271,11 +279,14 @@ impl ViewerApp {
             method: self.settings.method.clone(),
             params: self.settings.method_params(&self.settings.method),
             background: self.settings.background,
+            antialias: self.settings.antialias,
+            mode: if self.settings.coverage { AntialiasMode::Coverage } else { AntialiasMode::Frames },
             size,
             camera: rows,
             scene: self.scene_rev,
         };
-        let exact_key = RenderKey { method: EXACT.into(), params: vec![], ..key.clone() };
+        // The exact frame at the same samples, as sample frames (exact at every sample).
+        let exact_key = RenderKey { method: EXACT.into(), params: vec![], mode: AntialiasMode::Frames, ..key.clone() };
         let want_exact = self.settings.needs_exact() && self.settings.method != EXACT;
         let stale = self.key.as_ref() != Some(&key);
         let exact_stale = want_exact && self.exact_key.as_ref() != Some(&exact_key);
@@ -301,7 +312,8 @@ impl ViewerApp {
                 return false;
             }
         };
-        let mut run = |k: &RenderKey| renderer.render(&self.scene, &camera, &k.method, &k.params, k.background);
+        let mut run =
+            |k: &RenderKey| renderer.render_antialiased(&self.scene, &camera, &k.method, &k.params, k.background, k.antialias, k.mode);
         if stale {
             self.key = Some(key.clone());
             self.renders += 1;

@@ -106,6 +106,20 @@ fn view_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
         ui.color_edit_button_rgb(&mut s.background);
         ui.label("background");
     });
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_label("samples a pixel").selected_text(s.antialias.to_string()).show_ui(ui, |ui| {
+            for n in oit_core::antialias::SAMPLE_COUNTS {
+                ui.selectable_value(&mut s.antialias, n, n.to_string());
+            }
+        });
+    })
+    .response
+    .on_hover_text("antialiasing: one frame per sample position, averaged");
+    let coverage_ok = oit_core::COVERAGE_METHODS.contains(&s.method.as_str()) && s.antialias == oit_core::COVERAGE_SAMPLES;
+    s.coverage &= coverage_ok;
+    ui.add_enabled(coverage_ok, egui::Checkbox::new(&mut s.coverage, "coverage masks"))
+        .on_hover_text("abuffer at 4 samples: one multisampled capture, a sample mask per fragment")
+        .on_disabled_hover_text("abuffer at 4 samples only");
     ui.add(egui::Slider::new(&mut s.render_scale, 0.25..=1.0).text("render scale"))
         .on_hover_text("render at a fraction of the view's pixels: faster on software adapters");
     ui.horizontal(|ui| {

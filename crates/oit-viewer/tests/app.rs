@@ -177,3 +177,22 @@ fn the_frame_is_the_engines_frame() {
     assert!(diff < 1e-6, "max difference {diff}");
     assert_eq!(own.stats.fragments, f.stats.fragments);
 }
+
+/// The samples box and the coverage checkbox reach the engine: 4 samples with coverage masks
+/// on abuffer, then coverage unchecks itself when the method cannot take it.
+#[test]
+fn antialiasing_from_the_panel() {
+    let mut h = harness("abuffer");
+    h.state_mut().settings.antialias = 4;
+    h.run();
+    assert_eq!(h.state().frame.as_ref().unwrap().stats.antialias_mode, oit_core::AntialiasMode::Frames);
+    h.get_by_label("coverage masks").click();
+    h.run();
+    let stats = &h.state().frame.as_ref().unwrap().stats;
+    assert_eq!((stats.antialias, stats.antialias_mode), (4, oit_core::AntialiasMode::Coverage));
+    h.state_mut().settings.method = "hybrid".into();
+    h.run();
+    let stats = &h.state().frame.as_ref().unwrap().stats;
+    assert_eq!((stats.method.as_str(), stats.antialias, stats.antialias_mode), ("hybrid", 4, oit_core::AntialiasMode::Frames));
+    assert!(!h.state().settings.coverage);
+}
