@@ -5,10 +5,20 @@ use crate::targets::{BOUND_FORMAT, COLOR_FORMAT, DEPTH_FORMAT};
 
 /// Depth state of transparent geometry passes: test against the opaque depth, never write.
 pub fn depth_test_only() -> Option<wgpu::DepthStencilState> {
+    read_only_depth(wgpu::CompareFunction::Less)
+}
+
+/// Depth state of a coverage-mask geometry pass: the multisampled attachment only gives the
+/// pass its sample count; the shader tests each sample against its own opaque depth.
+pub fn raster_only() -> Option<wgpu::DepthStencilState> {
+    read_only_depth(wgpu::CompareFunction::Always)
+}
+
+fn read_only_depth(compare: wgpu::CompareFunction) -> Option<wgpu::DepthStencilState> {
     Some(wgpu::DepthStencilState {
         format: DEPTH_FORMAT,
         depth_write_enabled: Some(false),
-        depth_compare: Some(wgpu::CompareFunction::Less),
+        depth_compare: Some(compare),
         stencil: Default::default(),
         bias: Default::default(),
     })
@@ -34,18 +44,6 @@ pub fn geometry(
     depth: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
     geometry_samples(device, label, module, layout, fs, targets, depth, 1)
-}
-
-/// Depth state of a coverage-mask geometry pass: the multisampled attachment only gives the
-/// pass its sample count; the shader tests each sample against its own opaque depth.
-pub fn raster_only() -> Option<wgpu::DepthStencilState> {
-    Some(wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
-        depth_write_enabled: Some(false),
-        depth_compare: Some(wgpu::CompareFunction::Always),
-        stencil: Default::default(),
-        bias: Default::default(),
-    })
 }
 
 /// [`geometry`] rasterized at `samples` samples a pixel (the shader reads the coverage mask).
