@@ -5,6 +5,7 @@
 // quantization error.
 //!include common/scene.wgsl
 //!include common/targets.wgsl
+//!include common/alpha8.wgsl
 
 @group(2) @binding(0) var<storage, read_write> sums: array<atomic<u32>>;
 
@@ -26,6 +27,6 @@ fn fs_estimate(in: VsOut) {
     let tau = select(min(-log(1.0 - a), TAU_CAP), TAU_CAP, a >= 1.0);
     atomicAdd(&sums[3u * px], u32(round(tau * TAU_SCALE)));
     atomicAdd(&sums[3u * px + 1u], u32(round(tau * tau * TAU2_SCALE)));
-    let q = round(a * 255.0) / 255.0;
+    let q = f32(alpha_8bit(a)) / 255.0;
     atomicAdd(&sums[3u * px + 2u], u32(ceil(abs(a - q) * QUANT_SCALE)));
 }

@@ -37,13 +37,13 @@ fn slots(px: u32) -> vec2<u32> {
     return vec2<u32>(px * K, K);
 }
 //!include common/fixed.wgsl
+//!include common/alpha8.wgsl
 
 // 24-bit depth over 8-bit alpha, inverted so that a cleared (zero) slot is empty and
 // atomicMax keeps the nearest: a larger key is a nearer fragment (lower alpha first on ties).
 fn pack_key(z: f32, alpha: f32) -> u32 {
     let d = min(u32(z * 16777215.0), 0xfffffeu);
-    let a = u32(round(clamp(alpha, 0.0, 1.0) * 255.0));
-    return ~((d << 8u) | a);
+    return ~((d << 8u) | alpha_8bit(alpha));
 }
 
 fn key_alpha(key: u32) -> f32 {

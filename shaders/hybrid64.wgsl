@@ -19,10 +19,11 @@ const ACCUM_WORDS: u32 = 9u;
 @group(2) @binding(1) var<storage, read_write> accum: array<atomic<u32>>;
 @group(2) @binding(2) var<storage, read_write> overflow: atomic<u32>;
 //!include common/fixed.wgsl
+//!include common/alpha8.wgsl
 
 fn pack_word(z: f32, c: vec4<f32>) -> u64 {
     let d = min(u32(z * 16777215.0), 0xfffffeu);
-    let a = u32(round(clamp(c.a, 0.0, 1.0) * 255.0));
+    let a = alpha_8bit(c.a);
     let q = vec3<u32>(round(clamp(c.rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * vec3<f32>(2047.0, 2047.0, 1023.0)));
     let rgb = (q.r << 21u) | (q.g << 10u) | q.b;
     return ~((u64((d << 8u) | a) << 32u) | u64(rgb));
@@ -84,7 +85,7 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
     let px = pixel_index(pos);
     var core = vec3<f32>(0.0);
     var t_core = 1.0;
-    // Each core alpha is within 1/510 of the fragment's: sum (T' + drift so far) / 510.
+    // Each core alpha is within ALPHA_8BIT_ERROR of the fragment's: sum (T' + drift so far) * that.
     var alpha_bound = 0.0;
     var drift = 0.0;
     for (var i = 0u; i < K; i++) {
@@ -94,8 +95,8 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
         }
         let c = unpack_color(w);
         core += t_core * c.a * c.rgb;
-        alpha_bound += (t_core + drift) / 510.0;
-        drift += 1.0 / 510.0;
+        alpha_bound += (t_core + drift) * ALPHA_8BIT_ERROR;
+        drift += ALPHA_8BIT_ERROR;
         t_core *= 1.0 - c.a;
     }
     let acc = px * ACCUM_WORDS;

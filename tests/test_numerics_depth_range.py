@@ -13,6 +13,7 @@ import pytest
 import oit
 from numerics import BG, EXACT, NAMES, RANDOMIZED, full_screen_layers, params_for, tolerance
 from oit import _oit, models
+from oit.models import ALPHA_8BIT_ERROR
 from scenes import IDENTITY, MeshData, build_scene
 
 SIZE = 48
@@ -76,7 +77,7 @@ def test_hybrid_keys_separate_layers_at_wide_depth_ranges(renderer, case):
     for name in sorted({"hybrid", "ktab"} & set(NAMES)):
         f = r.render(scene, camera, name, background=tuple(BG), k=int(dc.max()))
         assert f.stats["overflow_fragments"] == 0
-        bound = (dc * (dc + 1) / 2 + dc) / 510 + tolerance(name, int(dc.max()))
+        bound = (dc * (dc + 1) / 2 + dc) * ALPHA_8BIT_ERROR + tolerance(name, int(dc.max()))
         assert (np.abs(f.image - exact.image).max(-1) <= bound).all(), name
 
 

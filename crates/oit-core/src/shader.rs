@@ -17,6 +17,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("census.wgsl", include_str!("../../../shaders/census.wgsl")),
     ("blend.wgsl", include_str!("../../../shaders/blend.wgsl")),
     ("common/fixed.wgsl", include_str!("../../../shaders/common/fixed.wgsl")),
+    ("common/alpha8.wgsl", include_str!("../../../shaders/common/alpha8.wgsl")),
     ("abuffer.wgsl", include_str!("../../../shaders/abuffer.wgsl")),
     ("hybrid.wgsl", include_str!("../../../shaders/hybrid.wgsl")),
     ("weighted.wgsl", include_str!("../../../shaders/weighted.wgsl")),

@@ -36,6 +36,8 @@ const MAX_K: u32 = 32;
 const TAU_SCALE: f64 = 4096.0;
 const TAU2_SCALE: f64 = 1024.0;
 const QUANT_SCALE: f64 = 16_777_216.0;
+/// Largest |alpha - q| of hybrid's 8-bit alpha (shaders/common/alpha8.wgsl).
+const ALPHA_8BIT_ERROR: f64 = (0.5 + 1.0 / 1024.0) / 255.0;
 /// Float32 and fixed-point rounding per term of hybrid's bound (hybrid.wgsl, fs_final).
 const ROUNDING: f64 = 2.4e-7;
 
@@ -140,9 +142,10 @@ pub fn predicted_bound(n: u32, s: Sums, k: u32) -> f64 {
     let nf = n as f64;
     let mean = s.tau / nf;
     let core = k.min(n);
-    // |δ| is at most 1/510; alphas off the 8-bit grid have it spread evenly below that, so
-    // twice the mean stands for the nearest fragments' (alphas on the grid give 0).
-    let d = (2.0 * s.quant / nf).min(1.0 / 510.0);
+    // |δ| is at most ALPHA_8BIT_ERROR (half a step of 1/255 and the rounding bias); alphas
+    // off the 8-bit grid have it spread evenly below that, so twice the mean stands for the
+    // nearest fragments' (alphas on the grid give 0).
+    let d = (2.0 * s.quant / nf).min(ALPHA_8BIT_ERROR);
     let quant_term: f64 = (0..core).map(|j| d * (-(j as f64) * mean).exp()).sum::<f64>() + (d * core as f64).min(s.quant).powi(2);
     let tail = if n > k {
         let kf = k as f64;
