@@ -4,8 +4,9 @@ on the built-in scenes, with the floor (one plain blended pass over the same geo
 
 Methods and their parameter values come from `oit.methods()` (a few values across each
 declared range), so new methods join without changes here. A method that fails (an adapter
-limit, a memory budget) gives a row marked failed with the message. With pygfx installed the
-same scenes go through its alpha modes too (oit.peers). Writes results.csv, results.md, and
+limit, a memory budget) gives a row marked failed with the message. With pygfx or VTK installed
+the same scenes go through their modes too (oit.peers): pygfx's alpha modes, VTK's depth
+peeling and plain blending. Writes results.csv, results.md, and
 with matplotlib the plots of oit.plots into --out.
 
 Three other experiments run instead of the sweep: `--temporal` (`temporal`: how much each
@@ -194,11 +195,14 @@ def run(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | 
     """Measures every method of oit.methods() (or those named) on each scene at each size
     (default: the scene's own; --quick caps it at QUICK_SIZE)."""
     plan = method_plan(methods, quick)
-    peer_reason = peers.pygfx_missing() if with_peers else "peers not requested (--no-peers)"
-    peer_modes = peers.PYGFX_MODES if peer_reason is None else ()
     result = Result(rows=[])
-    if peer_reason and with_peers:
-        result.notes.append(f"pygfx rows are missing: {peer_reason}")
+    peer_modes: list[tuple[str, str]] = []
+    for library, (modes, missing, _) in peers.PEERS.items() if with_peers else ():
+        reason = missing()
+        if reason:
+            result.notes.append(f"{library} rows are missing: {reason}")
+        else:
+            peer_modes += [(library, mode) for mode in modes]
     if flip_missing():
         result.notes.append(flip_missing())
     progress = Progress(len(scenes) * len(sizes or [None]) * (2 + len(plan) + len(peer_modes)), show_progress)
@@ -223,7 +227,7 @@ def scene_jobs(scenes: list[str], sizes: list[int] | None, quick: bool) -> Itera
 
 
 def _run_scene(result: Result, scene_name: str, built: scene_lib.BuiltScene, renderer: Renderer,
-               plan: list[tuple[str, Params, bool]], peer_modes: tuple[str, ...], repeat: int, progress: Progress) -> None:
+               plan: list[tuple[str, Params, bool]], peer_modes: list[tuple[str, str]], repeat: int, progress: Progress) -> None:
     w, h = renderer.width, renderer.height
     size = f"{w}x{h}"
     adapter = renderer.adapter_info["name"]
@@ -264,9 +268,10 @@ def _run_scene(result: Result, scene_name: str, built: scene_lib.BuiltScene, ren
                 sheet[method] = frame.image
         rows.append(row)
         progress.step(method)
-    for mode in peer_modes:
-        rows.append(_peer_row(scene_name, built, w, h, mode, repeat, exact, covered, sheet))
-        progress.step(f"pygfx {mode}")
+    for library, mode in peer_modes:
+        progress.show(f"{scene_name} {size} {library} {mode}")
+        rows.append(_peer_row(scene_name, built, w, h, library, mode, repeat, exact, covered, sheet))
+        progress.step(f"{library} {mode}")
     for row in rows:
         row["x_floor"] = row["gpu_ms"] / floor["gpu_ms"]
         row["wall_x_floor"] = row["wall_ms"] / floor["wall_ms"]
@@ -277,19 +282,21 @@ def _run_scene(result: Result, scene_name: str, built: scene_lib.BuiltScene, ren
     result.sheets[(scene_name, size)] = sheet
 
 
-def _peer_row(scene_name: str, built: scene_lib.BuiltScene, w: int, h: int, mode: str, repeat: int,
+def _peer_row(scene_name: str, built: scene_lib.BuiltScene, w: int, h: int, library: str, mode: str, repeat: int,
               exact: np.ndarray | None, covered: np.ndarray | None, sheet: dict[str, np.ndarray]) -> dict:
-    label = f"pygfx-{mode}"
+    """One row for `library`'s `mode` (peers.PEERS): the median wall time of `repeat` renders
+    after a warm-up, errors against the exact image; failed, with the message, when it raises."""
+    label = f"{library}-{mode}"
     try:
-        pg = peers.pygfx_renderer(w, h)
-        pg.render(built, mode)  # warm-up: shaders and pipelines
+        peer = peers.PEERS[library][2](w, h)
+        peer.render(built, mode)  # warm-up: shaders and pipelines
         wall, image = [], None
         for _ in range(repeat):
-            image, ms = pg.render(built, mode)
+            image, ms = peer.render(built, mode)
             wall.append(ms)
     except Exception as e:  # noqa: BLE001 - a third-party renderer fails in its own ways; the row says how
         return _row(scene_name, f"{w}x{h}", label, {}, status="failed", message=f"{type(e).__name__}: {e}".splitlines()[0])
-    row = _row(scene_name, f"{w}x{h}", label, {}, wall_ms=statistics.median(wall), adapter=pg.adapter)
+    row = _row(scene_name, f"{w}x{h}", label, {}, wall_ms=statistics.median(wall), adapter=peer.adapter)
     if exact is not None:
         row.update(image_errors(image, exact, covered))
         sheet[label] = image
@@ -657,7 +664,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--out", default="out/bench", help="directory for the tables and the plots")
     ap.add_argument("--quick", action="store_true",
                     help=f"default parameters only, one timed render, frames of at most {QUICK_SIZE} pixels: a smoke test")
-    ap.add_argument("--no-peers", action="store_true", help="skip pygfx even when it is installed")
+    ap.add_argument("--no-peers", action="store_true", help="skip the peers (pygfx, VTK) even when installed")
     ap.add_argument("--no-plots", action="store_true", help="skip the matplotlib plots")
     ap.add_argument("--figure7", action="store_true", help="also run the hybrid paper's Figure 7 experiment (400 stacks)")
     ap.add_argument("--temporal", action="store_true",

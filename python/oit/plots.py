@@ -69,7 +69,7 @@ def tradeoff(rows: list[dict], title: str, path: str) -> None:
             mine = [(x, y, r) for x, y, r in pts if r["method"] == m]
             if mine:
                 ax.scatter([p[0] for p in mine], [p[1] for p in mine], color=colors[m], label=m, s=30, zorder=3,
-                           marker="^" if m.startswith("pygfx") else "o")
+                           marker="^" if m.startswith(("pygfx-", "vtk-")) else "o")
             for x, y, r in mine:
                 # The first parameter's value (k, nodes, samples, layers) names the point.
                 text = "exact" if r["mean_err"] < EXACT_BELOW else r["params"].split(" ")[0].partition("=")[2]
