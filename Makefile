@@ -3,7 +3,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 export CARGO_TARGET_DIR ?= $(HOME)/.cache/oit/target
 
-.PHONY: setup demo test test-rust test-python bench viewer test-viewer
+.PHONY: setup demo test test-rust test-python test-bench bench viewer test-viewer
 
 setup:
 	bash scripts/setup.sh
@@ -11,7 +11,7 @@ setup:
 demo: setup
 	$(PY) -m oit demo -o out/demo.png
 
-test: setup test-rust test-viewer test-python
+test: setup test-rust test-viewer test-bench test-python
 
 test-rust:
 	cargo test --release -p oit-core
@@ -23,6 +23,14 @@ test-viewer:
 	@command -v xvfb-run >/dev/null || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null && \
 	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq xvfb xauth >/dev/null; } || \
 	  echo "make: no xvfb-run (apt-get install xvfb): the viewer's screenshot tests will be skipped"
+
+# The benchmark's smoke test: every method on every showcase scene, small and thinned (a
+# check that the whole bench runs, not a measurement); the tables go to out/bench-quick.
+test-bench:
+	@mkdir -p out
+	$(PY) -m oit bench --quick --no-plots --out out/bench-quick > out/bench-quick.log 2>&1 || \
+	  { tail -n 40 out/bench-quick.log; exit 1; }
+	@grep -c "^| " out/bench-quick/results.md | xargs -I{} echo "bench --quick: {} table lines in out/bench-quick/results.md"
 
 test-python:
 	$(PY) -m pytest -q
