@@ -106,7 +106,7 @@ impl GpuContext {
 
     /// Largest storage binding, in bytes.
     pub fn max_binding_bytes(&self) -> u64 {
-        (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size)
+        self.limits.max_storage_buffer_binding_size.min(self.limits.max_buffer_size)
     }
 
     /// Blocks until the queue is idle; a device fault or an error wgpu reported since the
