@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import oit
-from oit import bench, cli, formulas, geometry, peers, plots, scenes
+from oit import bench, cli, experiments, formulas, geometry, peers, plots, scenes
 from oit.imageio import linear_to_srgb
 
 TINY = dict(scenes=["glass"], methods=["abuffer", "unsorted", "sorted", "hybrid", "wboit"], sizes=[32], repeat=1,
@@ -181,7 +181,7 @@ def test_bench_puts_pygfx_rows_in_the_table():
 
 def test_orbit_turns_about_the_scene_center():
     built = scenes.glass(detail=8)
-    cameras = bench.orbit(built, frames=4, step_deg=2.0)
+    cameras = experiments.orbit(built, frames=4, step_deg=2.0)
     assert len(cameras) == 4 and np.array_equal(cameras[0].view_proj, built.camera.view_proj)
 
     def ndc(camera, p):
@@ -208,12 +208,12 @@ def test_frame_changes():
     for images in (offset, noisy):
         for im in images:
             im[0] = rng.uniform(0, 1, (6, 4))
-    ref = bench.frame_changes(exact, exact, covered)
+    ref = experiments.frame_changes(exact, exact, covered)
     steps = [np.sqrt(((exact[t + 1][1:, :, :3] - exact[t][1:, :, :3]) ** 2).sum(-1)) for t in range(3)]
     assert ref["change"] == pytest.approx(np.mean(steps)) and ref["flicker"] == 0 == ref["max_flicker"]
-    still = bench.frame_changes(offset, exact, covered)
+    still = experiments.frame_changes(offset, exact, covered)
     assert still["change"] == pytest.approx(ref["change"]) and still["flicker"] == pytest.approx(0, abs=1e-12)
-    flips = bench.frame_changes(noisy, exact, covered)
+    flips = experiments.frame_changes(noisy, exact, covered)
     assert flips["flicker"] == pytest.approx(2 * eps * math.sqrt(3)) == flips["max_flicker"]
 
 
@@ -222,11 +222,11 @@ TEMPORAL_TINY = dict(scenes=["glass"], methods=["hybrid", "unsorted", "stochasti
 
 
 def test_temporal_rows():
-    result = bench.temporal(**TEMPORAL_TINY, step_deg=1.0)
+    result = experiments.temporal(**TEMPORAL_TINY, step_deg=1.0)
     rows = by_method(result.rows)
     assert list(rows) == ["abuffer", "unsorted", "hybrid", "stochastic"]  # abuffer, then as in oit.methods()
     for r in rows.values():
-        assert set(r) >= {c for c, _ in bench.TEMPORAL_COLUMNS}
+        assert set(r) >= {c for c, _ in experiments.TEMPORAL_COLUMNS}
         assert r["status"] == "ok" and r["size"] == "24x24" and r["frames"] == 3 and r["step_deg"] == 1.0
         assert r["change"] > 0 and r["flicker"] <= r["max_flicker"]
     assert rows["abuffer"]["change_ratio"] == 1 and rows["abuffer"]["flicker"] == 0 == rows["abuffer"]["flicker_ratio"]
@@ -237,7 +237,7 @@ def test_temporal_rows():
 
 def test_temporal_with_a_still_camera_sees_no_change():
     # Every method repeats its frame bit for bit (stochastic is seeded), so nothing changes.
-    for r in bench.temporal(**TEMPORAL_TINY, step_deg=0.0).rows:
+    for r in experiments.temporal(**TEMPORAL_TINY, step_deg=0.0).rows:
         assert r["change"] == 0 and r["flicker"] == 0 and math.isnan(r["change_ratio"]), r["method"]
 
 
@@ -260,11 +260,11 @@ def test_smallest_k_scans_upward_and_stops_at_the_first():
     errors = {1: 0.5, 2: 0.1, 3: 0.3, 4: 0.05}  # not monotone in k, as hybrid's need not be
     asked = []
     error = lambda k: asked.append(k) or errors[k]  # noqa: E731
-    assert bench.smallest_k(error, 0.2, max_k=4) == 2 and asked == [1, 2]
-    assert bench.smallest_k(error, 0.06, max_k=4) == 4
-    assert bench.smallest_k(error, 0.3, max_k=4) == 2
-    assert bench.smallest_k(error, 0.01, max_k=4) is None
-    assert bench.smallest_k(error, 0.06, max_k=3) is None
+    assert experiments.smallest_k(error, 0.2, max_k=4) == 2 and asked == [1, 2]
+    assert experiments.smallest_k(error, 0.06, max_k=4) == 4
+    assert experiments.smallest_k(error, 0.3, max_k=4) == 2
+    assert experiments.smallest_k(error, 0.01, max_k=4) is None
+    assert experiments.smallest_k(error, 0.06, max_k=3) is None
 
 
 AUTO_TINY = dict(scenes=["glass"], sizes=[24], tolerances=(1 / 255, 16 / 255), repeat=1, max_k=8, quick=True,
@@ -272,16 +272,16 @@ AUTO_TINY = dict(scenes=["glass"], sizes=[24], tolerances=(1 / 255, 16 / 255), r
 
 
 def test_auto_against_fixed_k(renderer):
-    result = bench.auto_vs_fixed(**AUTO_TINY)
+    result = experiments.auto_vs_fixed(**AUTO_TINY)
     assert [r["tolerance"] for r in result.rows] == list(AUTO_TINY["tolerances"])
     built = scenes.glass()
     r24 = renderer(24, 24)
     exact = r24.render(built.scene, built.camera, "abuffer").image
-    measured = {k: bench.max_abs_error(r24.render(built.scene, built.camera, "hybrid", k=k).image, exact)
+    measured = {k: experiments.max_abs_error(r24.render(built.scene, built.camera, "hybrid", k=k).image, exact)
                 for k in range(1, AUTO_TINY["max_k"] + 1)}
     for row in result.rows:
         t = row["tolerance"]
-        assert set(row) >= {c for c, _ in bench.AUTO_COLUMNS} and row["status"] == "ok"
+        assert set(row) >= {c for c, _ in experiments.AUTO_COLUMNS} and row["status"] == "ok"
         # auto's promise: every channel of every pixel within t of the exact image.
         assert row["within_t"] is True and row["auto_max_abs"] <= t
         assert row["auto_max_err"] <= row["auto_max_err_all"] and row["auto_mib"] > 0

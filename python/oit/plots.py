@@ -153,7 +153,7 @@ TEMPORAL_CLIP = 4.0  # bars of the temporal figure stop here, with their value w
 
 
 def temporal(rows: list[dict], path: str, columns: int = 3) -> None:
-    """The temporal-stability figure of bench.temporal: one panel per scene and size, a pair of
+    """The temporal-stability figure of experiments.temporal: one panel per scene and size, a pair of
     bars per method — its mean change between consecutive frames and its flicker (the change
     of its error), both over abuffer's change — with abuffer's change (1) as a dashed line.
     A method that follows the motion exactly has bars at 1 and 0."""
