@@ -117,7 +117,8 @@ def test_bench_puts_vtk_rows_in_the_table():
     # Peeling is exact but for 8-bit rounding; blending in actor order is not.
     assert rows["vtk-depth_peeling"]["mean_err"] < 0.01 < rows["vtk-blend"]["mean_err"]
     without = bench.run(**tiny, with_peers=False)
-    assert not [r for r in without.rows if r["method"].startswith(("vtk-", "pygfx-"))] and not without.notes
+    assert not [r for r in without.rows if r["method"].startswith(("vtk-", "pygfx-"))]
+    assert not [n for n in without.notes if "vtk" in n or "pygfx" in n]
 
 
 @needs_vtk
@@ -135,3 +136,13 @@ def test_vtk_missing_says_so_when_no_context_opens(monkeypatch):
         peers.vtk_missing.cache_clear()
     assert reason is not None and "could not open an OpenGL context" in reason and "EGL" in reason
     assert peers.vtk_missing() is None
+
+
+def test_bench_notes_why_vtk_rows_are_missing(monkeypatch):
+    """Where VTK cannot render, the sweep runs without its rows and says why (needs no VTK)."""
+    for library, (modes, _, make) in list(peers.PEERS.items()):
+        monkeypatch.setitem(peers.PEERS, library, (modes, lambda lib=library: f"{lib} left out here", make))
+    result = bench.run(scenes=["glass"], methods=["unsorted"], sizes=[16], repeat=1, quick=True, show_progress=False)
+    assert [r["method"] for r in result.rows] == ["unsorted"]
+    assert "vtk rows are missing: vtk left out here" in result.notes
+    assert "pygfx rows are missing: pygfx left out here" in result.notes
