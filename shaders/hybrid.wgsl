@@ -18,7 +18,9 @@ const T_CORE: u32 = 12u;     // transmittance behind the core (f32 bits)
 const EVICTED: u32 = 13u;    // nearest key pushed out of the full k-TAB (0: none)
 const QUANT_W: u32 = 14u;    // sum over core fragments of |alpha - q| * T' (fixed point)
 const QUANT_D: u32 = 15u;    // sum over core fragments of |alpha - q| (fixed point)
-const ACCUM_WORDS: u32 = 16u;
+const TAIL_LO: u32 = 16u;    // smallest tail color channel (f32 bits, inverted: 0 = none)
+const TAIL_HI: u32 = 17u;    // largest tail color channel (f32 bits)
+const ACCUM_WORDS: u32 = 18u;
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
 @group(2) @binding(1) var<storage, read_write> vis: array<f32>;
@@ -161,6 +163,10 @@ fn fs_shade(in: VsOut) {
         }
     }
     atomicAdd(&accum[acc + TAIL_COUNT], 1u);
+    // The range of the tail's colors bounds what the estimate behind the core can be off by.
+    let c = clamp(in.color.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+    atomicMax(&accum[acc + TAIL_LO], ~bitcast<u32>(min(c.r, min(c.g, c.b))));
+    atomicMax(&accum[acc + TAIL_HI], bitcast<u32>(max(c.r, max(c.g, c.b))));
     if TAIL != 0u {
         let a = in.color.a;
         add_fixed64(acc + TAIL_R, in.color.r * a);
@@ -196,12 +202,15 @@ fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
     }
     let rgb = core + t_core * (tail.color + tail.trans * base.rgb); // eq. 11
     // Quantized core alphas: sum |d| T' plus the second-order D^2; whatever lies behind the
-    // core (tail or, for ktab, nothing) is off by at most T_core; float32 and fixed-point
-    // rounding of K + count terms.
+    // core (tail or, for ktab, nothing) and its estimate are both mixes of the tail colors and
+    // the base, so they differ by at most T_core times the range of those values; float32
+    // and fixed-point rounding of K + count terms.
     let d = read_fixed32(word(acc + QUANT_D));
     var bound = read_fixed32(word(acc + QUANT_W)) + d * d + f32(slots(pixel_index(pos)).y + count + 2u) * 2.4e-7;
     if count > 0u {
-        bound += t_core;
+        let lo = min(bitcast<f32>(~word(acc + TAIL_LO)), min(base.r, min(base.g, base.b)));
+        let hi = max(bitcast<f32>(word(acc + TAIL_HI)), max(base.r, max(base.g, base.b)));
+        bound += t_core * (hi - lo);
     }
     return Final(vec4<f32>(rgb, 1.0 - t_core * tail.trans * (1.0 - base.a)), bound);
 }

@@ -107,3 +107,19 @@ def test_auto_falls_back_to_exact_for_a_tiny_tolerance(renderer):
     assert np.array_equal(frame.image, r.render(built.scene, built.camera, "abuffer").image)
     # The exact composite's own bound: float32 rounding of 62 terms.
     assert frame.stats["error_bound_max"] == pytest.approx(62 * 2.4e-7, rel=1e-6)
+
+
+@pytest.mark.parametrize("method", ["hybrid", "ktab"])
+def test_the_tail_term_scales_with_the_range_of_the_colors_behind_the_core(renderer, method):
+    # Twenty layers of one gray over a background of the same gray: whatever the tail holds,
+    # the image behind the core is that gray, so only the 8-bit alpha terms remain in the bound.
+    gray = (0.5, 0.5, 0.5)
+    meshes = [layer(0.05 + 0.04 * i, (*gray, 0.1 + 0.02 * i)) for i in range(20)]
+    r = renderer(8, 8)
+    frame = r.render(build_scene(meshes), IDENTITY, method, k=2, background=gray)
+    exact = r.render(build_scene(meshes), IDENTITY, "abuffer", background=gray)
+    assert frame.stats["overflow_fragments"] == 18 * 64
+    assert frame.error_bound.max() < 0.02 and (measured(frame, exact) <= frame.error_bound).all()
+    # A white background widens the range to 0.5: T_core * 0.5 comes back.
+    bright = r.render(build_scene(meshes), IDENTITY, method, k=2, background=(1.0, 1.0, 1.0))
+    assert bright.error_bound.max() > 0.3

@@ -5,8 +5,9 @@ their node pool to the frame's fragments and have no formula in W and H alone.""
 from __future__ import annotations
 
 # Words per pixel of hybrid's accumulators: core RGB (3), tail sums as 64-bit pairs (8),
-# tail count, transmittance behind the core, nearest evicted key, two error-bound sums.
-HYBRID_ACCUM_WORDS = 16
+# tail count, transmittance behind the core, nearest evicted key, two error-bound sums, and
+# the tail colors' smallest and largest channel.
+HYBRID_ACCUM_WORDS = 18
 
 
 def memory_bytes(method: str, width: int, height: int, **params) -> int | None:
@@ -18,9 +19,9 @@ def memory_bytes(method: str, width: int, height: int, **params) -> int | None:
         return pixels * (2 * k + HYBRID_ACCUM_WORDS) * 4 + 4  # k-TAB, visibility, accumulators, counter
     if method == "auto" and "slots" in params:
         # hybrid with each pixel's own slots (2 words a slot), the accumulators, the slot
-        # offsets (pixels + 1 words) and the counter; the estimate pass's 3 words a pixel
+        # offsets (pixels + 1 words) and the counter; the estimate pass's 5 words a pixel
         slots = int(params["slots"])
-        return 2 * slots * 4 + pixels * HYBRID_ACCUM_WORDS * 4 + (pixels + 1) * 4 + 4 + pixels * 12
+        return 2 * slots * 4 + pixels * HYBRID_ACCUM_WORDS * 4 + (pixels + 1) * 4 + 4 + pixels * 20
     if method == "hybrid64":
         return pixels * (8 * int(params.get("k", 8)) + 9 * 4) + 4  # 64-bit k-TAB, tail sums, counter
     if method in ("wavg", "wsum", "wboit"):

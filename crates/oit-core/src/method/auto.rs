@@ -108,32 +108,39 @@ impl Auto {
         let raw = read_buffer(cx.gpu, readback, pixels * WORDS * 4)?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&raw);
         Ok(words
-            .chunks_exact(3)
-            .map(|w| Sums { tau: w[0] as f64 / TAU_SCALE, tau2: w[1] as f64 / TAU2_SCALE, quant: w[2] as f64 / QUANT_SCALE })
+            .chunks_exact(WORDS as usize)
+            .map(|w| Sums {
+                tau: w[0] as f64 / TAU_SCALE,
+                tau2: w[1] as f64 / TAU2_SCALE,
+                quant: w[2] as f64 / QUANT_SCALE,
+                range: if w[3] == 0 { 0.0 } else { (f32::from_bits(w[4]) - f32::from_bits(!w[3])).max(0.0) as f64 },
+            })
             .collect())
     }
 }
 
 /// Words per pixel of the estimate pass.
-const WORDS: u64 = 3;
+const WORDS: u64 = 5;
 /// How many standard deviations below its mean the nearest fragments' optical depth is taken.
 const SPREAD: f64 = 3.0;
 
 /// One pixel's estimate-pass sums over its transparent fragments: optical depth
-/// Σ −ln(1 − α), its square Σ ln²(1 − α), and Σ |α − q(α)| (q: hybrid's 8-bit alpha).
+/// Σ −ln(1 − α), its square Σ ln²(1 − α), Σ |α − q(α)| (q: hybrid's 8-bit alpha), and the
+/// range of the color channels of the fragments and the base behind them.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sums {
     pub tau: f64,
     pub tau2: f64,
     pub quant: f64,
+    pub range: f64,
 }
 
 /// Predicted hybrid bound at a pixel of `n` fragments for k slots. The nearest k are taken as
 /// a random draw from the pixel's fragments: their optical depth has mean k·μ and deviation
 /// σ·√(k(n − k)/(n − 1)) (sampling without replacement), and the prediction takes it SPREAD
 /// deviations thinner than its mean. It sums hybrid's terms: the quantization Σ|δ|·T' (|δ| at
-/// twice its mean, T' falling at the mean rate) and D², the rounding, and T_core where a tail
-/// exists. An estimate, not a bound — fragments sorted thin-first break it — which is why auto
+/// twice its mean, T' falling at the mean rate) and D², the rounding, and T_core times the
+/// range of the colors behind it where a tail exists. An estimate, not a bound — fragments sorted thin-first break it — which is why auto
 /// checks the rendered bound.
 pub fn predicted_bound(n: u32, s: Sums, k: u32) -> f64 {
     if n == 0 {
@@ -150,7 +157,7 @@ pub fn predicted_bound(n: u32, s: Sums, k: u32) -> f64 {
     let tail = if n > k {
         let kf = k as f64;
         let sd = (s.tau2 / nf - mean * mean).max(0.0).sqrt() * (kf * (nf - kf) / (nf - 1.0)).sqrt();
-        (-(kf * mean - SPREAD * sd).max(0.0)).exp()
+        (-(kf * mean - SPREAD * sd).max(0.0)).exp() * s.range
     } else {
         0.0
     };
@@ -265,7 +272,7 @@ mod tests {
 
     fn alike(n: u32, alpha: f64) -> Sums {
         let tau = -(1.0 - alpha).ln();
-        Sums { tau: n as f64 * tau, tau2: n as f64 * tau * tau, quant: 0.0 }
+        Sums { tau: n as f64 * tau, tau2: n as f64 * tau * tau, quant: 0.0, range: 1.0 }
     }
 
     #[test]

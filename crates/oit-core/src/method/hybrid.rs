@@ -37,7 +37,7 @@ pub const KTAB: MethodInfo = MethodInfo {
 };
 
 /// Words per pixel of the accumulators (mirrors ACCUM_WORDS in shaders/hybrid.wgsl).
-pub const ACCUM_WORDS: u64 = 16;
+pub const ACCUM_WORDS: u64 = 18;
 /// Fixed-point scales of core sums (values in [0, 1], total <= 1) and tail sums.
 pub const CORE_SCALE: f32 = 2147483648.0; // 2^31
 pub const TAIL_SCALE: f32 = 16777216.0; // 2^24
