@@ -168,22 +168,8 @@ fn fs_shade(in: VsOut) {
     atomicMax(&accum[acc + TAIL_LO], ~bitcast<u32>(min(c.r, min(c.g, c.b))));
     atomicMax(&accum[acc + TAIL_HI], bitcast<u32>(max(c.r, max(c.g, c.b))));
     if TAIL != 0u {
-        let a = in.color.a;
-        add_fixed64(acc + TAIL_R, in.color.r * a);
-        add_fixed64(acc + TAIL_R + 2u, in.color.g * a);
-        add_fixed64(acc + TAIL_R + 4u, in.color.b * a);
-        add_fixed64(acc + TAIL_R + 6u, a);
+        add_tail_sums(acc + TAIL_R, in.color.rgb, in.color.a);
     }
-}
-
-fn word(i: u32) -> u32 {
-    return atomicLoad(&accum[i]);
-}
-
-struct Final {
-    @location(0) color: vec4<f32>,
-    // Per-pixel bound of |this image - the exact composite|, per channel (docs/methods.md).
-    @location(1) bound: f32,
 }
 
 @fragment

@@ -37,13 +37,10 @@ fn unpack_color(word: u64) -> vec4<f32> {
     return vec4<f32>(c, f32(a) / 255.0);
 }
 
-fn add_tail(acc: u32, word: u64) {
-    let c = unpack_color(word);
+fn add_tail(acc: u32, packed: u64) {
+    let c = unpack_color(packed);
     atomicAdd(&accum[acc + TAIL_COUNT], 1u);
-    add_fixed64(acc + TAIL_R, c.r * c.a);
-    add_fixed64(acc + TAIL_R + 2u, c.g * c.a);
-    add_fixed64(acc + TAIL_R + 4u, c.b * c.a);
-    add_fixed64(acc + TAIL_R + 6u, c.a);
+    add_tail_sums(acc + TAIL_R, c.rgb, c.a);
 }
 
 @fragment
@@ -67,16 +64,6 @@ fn fs_insert(in: VsOut) {
     }
     // Quantized like every stored word, so the tail does not depend on arrival order.
     add_tail(px * ACCUM_WORDS, v);
-}
-
-fn word(i: u32) -> u32 {
-    return atomicLoad(&accum[i]);
-}
-
-struct Final {
-    @location(0) color: vec4<f32>,
-    // Per-pixel bound of |this image - the exact composite|, per channel (docs/methods.md).
-    @location(1) bound: f32,
 }
 
 @fragment

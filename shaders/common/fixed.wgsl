@@ -26,6 +26,19 @@ fn read_fixed64(lo: u32, hi: u32) -> f32 {
     return (f32(hi) * 4294967296.0 + f32(lo)) / TAIL_SCALE;
 }
 
+fn word(i: u32) -> u32 {
+    return atomicLoad(&accum[i]);
+}
+
+// Adds a fragment to the tail sums at words sums..sums+7 (eqs. 5-6): C*alpha for r, g, b and
+// alpha, each a 64-bit fixed-point pair.
+fn add_tail_sums(sums: u32, rgb: vec3<f32>, a: f32) {
+    add_fixed64(sums, rgb.r * a);
+    add_fixed64(sums + 2u, rgb.g * a);
+    add_fixed64(sums + 4u, rgb.b * a);
+    add_fixed64(sums + 6u, a);
+}
+
 // The tail of hybrid transparency (Maule et al. 2013, eqs. 7-10) from its fixed-point sums:
 // words sums..sums+7 hold (lo, hi) pairs of sum C*alpha for r, g, b and of sum alpha, over
 // `count` fragments. Returns the tail's premultiplied color C_tail * alpha_tail and its
@@ -40,12 +53,12 @@ fn resolve_tail(sums: u32, count: u32) -> Tail {
     if count == 0u {
         return tail;
     }
-    let sum_a = read_fixed64(atomicLoad(&accum[sums + 6u]), atomicLoad(&accum[sums + 7u]));
+    let sum_a = read_fixed64(word(sums + 6u), word(sums + 7u));
     if sum_a > 0.0 {
         let sum_c = vec3<f32>(
-            read_fixed64(atomicLoad(&accum[sums]), atomicLoad(&accum[sums + 1u])),
-            read_fixed64(atomicLoad(&accum[sums + 2u]), atomicLoad(&accum[sums + 3u])),
-            read_fixed64(atomicLoad(&accum[sums + 4u]), atomicLoad(&accum[sums + 5u])),
+            read_fixed64(word(sums), word(sums + 1u)),
+            read_fixed64(word(sums + 2u), word(sums + 3u)),
+            read_fixed64(word(sums + 4u), word(sums + 5u)),
         );
         let n = f32(count);
         let a_avg = min(sum_a / n, 1.0);                            // eq. 8
