@@ -48,21 +48,31 @@ pub fn texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu:
 }
 
 pub fn targets_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    opaque_layout(device, "targets", wgpu::TextureViewDimension::D2)
+}
+
+/// Group 1 of storage-writing and resolve passes: the opaque depth (binding 0) and base
+/// color (binding 1), as single textures or, for coverage-mask frames, arrays of layers.
+fn opaque_layout(device: &wgpu::Device, label: &str, view_dimension: wgpu::TextureViewDimension) -> wgpu::BindGroupLayout {
     let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
+        ty: wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false },
         count: None,
     };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("targets"),
+        label: Some(label),
+        entries: &[tex(0, wgpu::TextureSampleType::Depth), tex(1, wgpu::TextureSampleType::Float { filterable: false })],
+    })
+}
+
+fn opaque_group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, depth: &wgpu::TextureView, base: &wgpu::TextureView) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
         entries: &[
-            tex(0, wgpu::TextureSampleType::Depth),
-            tex(1, wgpu::TextureSampleType::Float { filterable: false }),
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(depth) },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(base) },
         ],
     })
 }
@@ -86,14 +96,7 @@ impl Targets {
         let base = base_texture.create_view(&Default::default());
         let depth = depth_texture.create_view(&Default::default());
         let out = out_texture.create_view(&Default::default());
-        let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("targets"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&base) },
-            ],
-        });
+        let group = opaque_group(d, "targets", layout, &depth, &base);
         let pixels = width as u64 * height as u64;
         let counts = storage_buffer(d, "census counts", pixels * 4, wgpu::BufferUsages::COPY_SRC);
         let counts_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -202,16 +205,7 @@ pub fn read_rows(gpu: &GpuContext, texture: &wgpu::Texture, readback: &wgpu::Buf
 /// Group 1 of a coverage-mask frame (shaders/common/targets_samples.wgsl): the opaque depth
 /// and base color of each sample position, as layers of 2D arrays.
 pub fn samples_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2Array, multisampled: false },
-        count: None,
-    };
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("sample targets"),
-        entries: &[tex(0, wgpu::TextureSampleType::Depth), tex(1, wgpu::TextureSampleType::Float { filterable: false })],
-    })
+    opaque_layout(device, "sample targets", wgpu::TextureViewDimension::D2Array)
 }
 
 /// The targets of a coverage-mask frame at `samples` samples a pixel: per sample position the
@@ -261,14 +255,7 @@ impl SampleTargets {
             t.create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() })
         };
         let (base_all, depth_all) = (whole(&base), whole(&depth));
-        let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sample targets"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_all) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&base_all) },
-            ],
-        });
+        let group = opaque_group(d, "sample targets", layout, &depth_all, &base_all);
         let raster = d.create_texture(&wgpu::TextureDescriptor {
             label: Some("multisampled raster depth"),
             size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
