@@ -338,6 +338,7 @@ impl Renderer {
             scene_layout: &self.shared.scene_layout,
             timer: &mut self.timer,
             params,
+            depth_complexity: &depth_complexity,
             max_depth_complexity,
             fragments,
             frame_uniform: &self.shared.uniform,

@@ -197,9 +197,9 @@ impl Method for Auto {
         let tolerance = cx.params.float("tolerance");
         let t = cx.targets;
         let pixels = t.width as u64 * t.height as u64;
-        let counts: Vec<u32> = bytemuck::pod_collect_to_vec(&read_buffer(cx.gpu, &t.counts_readback, pixels * 4)?);
+        let counts = cx.depth_complexity;
         let sums = self.measure(cx)?;
-        let predicted = choose_slots(&counts, &sums, tolerance);
+        let predicted = choose_slots(counts, &sums, tolerance);
         let predicted_k = predicted.as_ref().map_or(0, |s| s.iter().copied().max().unwrap_or(0));
         let mut attempts = 0.0;
         // The hybrid buffers of a missed attempt stay allocated (reused by the next frame).
@@ -227,7 +227,7 @@ impl Method for Auto {
                 return Ok(report);
             }
             if attempts < 2.0 {
-                slots = widen(&current, &counts, &bound, tolerance);
+                slots = widen(&current, counts, &bound, tolerance);
             }
         }
         let mut report = self.exact.render(&mut cx.with_params(&Params::default()))?;

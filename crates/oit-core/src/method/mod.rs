@@ -222,6 +222,8 @@ pub(crate) struct FrameCtx<'a> {
     pub scene_layout: &'a wgpu::BindGroupLayout,
     pub timer: &'a mut PassTimer,
     pub params: &'a Params,
+    /// Transparent fragments per pixel (row-major), from this frame's census.
+    pub depth_complexity: &'a [u32],
     /// Largest transparent fragment count of a pixel, from this frame's census.
     pub max_depth_complexity: u32,
     /// Transparent fragments of the frame, from the census.
@@ -260,6 +262,7 @@ impl FrameCtx<'_> {
             scene_layout: self.scene_layout,
             timer: &mut *self.timer,
             params,
+            depth_complexity: self.depth_complexity,
             max_depth_complexity: self.max_depth_complexity,
             fragments: self.fragments,
             frame_uniform: self.frame_uniform,
