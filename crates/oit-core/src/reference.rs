@@ -110,22 +110,31 @@ fn key_less(a: &Hit, b: &Hit) -> std::cmp::Ordering {
 }
 
 pub fn reference(scene: &Scene, camera: &Camera, width: u32, height: u32, background: [f64; 3]) -> Result<ReferenceImage> {
+    reference_antialiased(scene, camera, width, height, background, 1)
+}
+
+/// The reference of an `antialias`-sample frame: the mean of the references at the standard
+/// sample positions (`antialias::sample_offsets`), a pixel ambiguous where any of its samples
+/// is, its depth complexity the largest of its samples'. The triangles and their BVH are
+/// built once; only the screen positions follow the camera from sample to sample.
+pub fn reference_antialiased(
+    scene: &Scene,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    background: [f64; 3],
+    antialias: u32,
+) -> Result<ReferenceImage> {
     if width == 0 || height == 0 {
         return Err(invalid!("width and height must be positive, got {width} x {height}"));
     }
-    let vp = camera.view_proj;
-    let inv = vp.inverse();
-    let (wf, hf) = (width as f64, height as f64);
+    let offsets = crate::antialias::sample_offsets(antialias)?;
     let mut tris = Vec::new();
     for m in scene.meshes() {
         for ix in &m.indices {
             let v = ix.map(|i| DVec3::from(m.positions[i as usize].map(|x| x as f64)));
             let c = ix.map(|i| DVec4::from(m.colors[i as usize].map(|x| x as f64)));
-            let screen = match (to_pixels(&vp, v[0], wf, hf), to_pixels(&vp, v[1], wf, hf), to_pixels(&vp, v[2], wf, hf)) {
-                (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-                _ => None,
-            };
-            tris.push(Tri { v, c, opaque: m.opaque, screen });
+            tris.push(Tri { v, c, opaque: m.opaque, screen: None });
         }
     }
     // The BVH is f32: pad each box so that rounding cannot drop a triangle the f64 test hits,
@@ -146,7 +155,39 @@ pub fn reference(scene: &Scene, camera: &Camera, width: u32, height: u32, backgr
         })
         .collect();
     let bvh = if tris.is_empty() { None } else { Some(build_bvh2(&bounds, BvhBuildParams::fast_build(), &mut Default::default())) };
+    if offsets.len() == 1 {
+        return Ok(trace_frame(&mut tris, bvh.as_ref(), camera, width, height, background));
+    }
+    let mut out: Option<ReferenceImage> = None;
+    for offset in &offsets {
+        let r = trace_frame(&mut tris, bvh.as_ref(), &camera.jittered(*offset, width, height), width, height, background);
+        match &mut out {
+            None => out = Some(r),
+            Some(o) => {
+                o.image.iter_mut().zip(&r.image).for_each(|(a, b)| *a += b);
+                o.ambiguous.iter_mut().zip(&r.ambiguous).for_each(|(a, b)| *a |= b);
+                o.depth_complexity.iter_mut().zip(&r.depth_complexity).for_each(|(a, b)| *a = (*a).max(*b));
+            }
+        }
+    }
+    let mut out = out.expect("at least one sample");
+    let n = offsets.len() as f64;
+    out.image.iter_mut().for_each(|v| *v /= n);
+    Ok(out)
+}
 
+/// One reference frame of the pixel centers under `camera`, through the scene's BVH.
+fn trace_frame(tris: &mut [Tri], bvh: Option<&Bvh2>, camera: &Camera, width: u32, height: u32, background: [f64; 3]) -> ReferenceImage {
+    let vp = camera.view_proj;
+    let inv = vp.inverse();
+    let (wf, hf) = (width as f64, height as f64);
+    for t in tris.iter_mut() {
+        t.screen = match (to_pixels(&vp, t.v[0], wf, hf), to_pixels(&vp, t.v[1], wf, hf), to_pixels(&vp, t.v[2], wf, hf)) {
+            (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+            _ => None,
+        };
+    }
+    let tris = &*tris;
     let pixels = width as usize * height as usize;
     let mut image = vec![0.0f64; pixels * 4];
     let mut ambiguous = vec![false; pixels];
@@ -159,7 +200,7 @@ pub fn reference(scene: &Scene, camera: &Camera, width: u32, height: u32, backgr
             .zip(ambiguous.chunks_mut(rows_per * width as usize))
             .zip(complexity.chunks_mut(rows_per * width as usize));
         for (i, ((img, amb), cx)) in chunks.enumerate() {
-            let (tris, bvh, inv) = (&tris, bvh.as_ref(), &inv);
+            let inv = &inv;
             s.spawn(move || {
                 let row0 = i * rows_per;
                 for (k, px) in amb.iter_mut().enumerate() {
@@ -181,31 +222,7 @@ pub fn reference(scene: &Scene, camera: &Camera, width: u32, height: u32, backgr
             });
         }
     });
-    Ok(ReferenceImage { width, height, image, ambiguous, depth_complexity: complexity })
-}
-
-/// The reference of an `antialias`-sample frame: the mean of the references at the standard
-/// sample positions (`antialias::sample_offsets`), a pixel ambiguous where any of its samples
-/// is, its depth complexity the largest of its samples'.
-pub fn reference_antialiased(
-    scene: &Scene,
-    camera: &Camera,
-    width: u32,
-    height: u32,
-    background: [f64; 3],
-    antialias: u32,
-) -> Result<ReferenceImage> {
-    let offsets = crate::antialias::sample_offsets(antialias)?;
-    let mut out = reference(scene, &camera.jittered(offsets[0], width, height), width, height, background)?;
-    for offset in &offsets[1..] {
-        let r = reference(scene, &camera.jittered(*offset, width, height), width, height, background)?;
-        out.image.iter_mut().zip(&r.image).for_each(|(a, b)| *a += b);
-        out.ambiguous.iter_mut().zip(&r.ambiguous).for_each(|(a, b)| *a |= b);
-        out.depth_complexity.iter_mut().zip(&r.depth_complexity).for_each(|(a, b)| *a = (*a).max(*b));
-    }
-    let n = offsets.len() as f64;
-    out.image.iter_mut().for_each(|v| *v /= n);
-    Ok(out)
+    ReferenceImage { width, height, image, ambiguous, depth_complexity: complexity }
 }
 
 #[allow(clippy::too_many_arguments)]
