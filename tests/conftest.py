@@ -14,10 +14,10 @@ from typing import Callable, Dict, List, Optional, Tuple
 import pytest
 
 import oit
+from oit.scenes import shared_data_dir
 from scenes import IDENTITY, PERSPECTIVE
 
 REPO = Path(__file__).resolve().parent.parent
-SHARED_DATA = REPO.parent / "shared" / "data"
 
 
 # ---- the installed package should be the one in python/oit
@@ -77,7 +77,10 @@ def perspective_camera() -> oit.Camera:
 
 @pytest.fixture
 def shared_data() -> Path:
-    """../shared/data (meshes such as suzanne.obj); the test is skipped when it is absent."""
-    if not SHARED_DATA.is_dir():
-        pytest.skip(f"optional mesh data not found at {SHARED_DATA} (tests that need it are skipped)")
-    return SHARED_DATA
+    """The optional mesh folder (meshes such as suzanne.obj), found as the library finds it
+    (oit.scenes.shared_data_dir); the test is skipped when it is absent."""
+    found = shared_data_dir()
+    if found is None:
+        pytest.skip("optional mesh data not found ($OIT_DATA, or a shared/data folder above the working directory): "
+                    "tests that need it are skipped")
+    return found
