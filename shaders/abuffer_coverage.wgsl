@@ -35,7 +35,12 @@ fn fs_capture(in: VsOut, @builtin(sample_mask) coverage: u32) {
 }
 
 fn node_frag(node: Node, link: u32, px: u32) -> Frag {
-    return Frag(node.depth, vec4<f32>(node.rg, node.ba), link, node.mask);
+    return Frag(node.depth, vec4<f32>(node.rg, node.ba), link);
+}
+
+// The node's sample mask, read back by its link when the fragment is composited.
+fn frag_mask(f: Frag) -> u32 {
+    return load_node(f.id - 1u).mask;
 }
 //!include common/list_cursor.wgsl
 //!include common/sweep.wgsl

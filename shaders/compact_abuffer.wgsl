@@ -54,7 +54,11 @@ fn node_frag(node: Node, link: u32, px: u32) -> Frag {
                         1.0 - (f32(px / frame.size.x) + 0.5) * 2.0 / f32(frame.size.y));
     let b = barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
     let color = clamp(b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2], vec4<f32>(0.0), vec4<f32>(1.0));
-    return Frag(node.depth, color, link, ALL_SAMPLES);
+    return Frag(node.depth, color, link);
+}
+
+fn frag_mask(f: Frag) -> u32 {
+    return 1u;
 }
 //!include common/list_cursor.wgsl
 //!include common/sweep.wgsl

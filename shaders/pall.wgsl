@@ -70,7 +70,11 @@ fn fs_capture(in: VsOut) {
 }
 
 fn node_frag(node: Node, link: u32, px: u32) -> Frag {
-    return Frag(node.depth, vec4<f32>(node.rg, node.ba), link, ALL_SAMPLES);
+    return Frag(node.depth, vec4<f32>(node.rg, node.ba), link);
+}
+
+fn frag_mask(f: Frag) -> u32 {
+    return 1u;
 }
 //!include common/list_cursor.wgsl
 //!include common/sweep.wgsl

@@ -57,6 +57,10 @@ fn cursor_step(c: ptr<function, Cursor>) -> Frag {
     let i = (*c).at;
     let node = load_node(i);
     (*c).at = i + 1u;
-    return Frag(node.depth, vec4<f32>(node.rg, node.ba), i, ALL_SAMPLES);
+    return Frag(node.depth, vec4<f32>(node.rg, node.ba), i);
+}
+
+fn frag_mask(f: Frag) -> u32 {
+    return 1u;
 }
 //!include common/sweep.wgsl
