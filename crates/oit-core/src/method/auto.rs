@@ -201,12 +201,12 @@ impl Method for Auto {
         let sums = self.measure(cx)?;
         let predicted = choose_slots(counts, &sums, tolerance);
         let predicted_k = predicted.as_ref().map_or(0, |s| s.iter().copied().max().unwrap_or(0));
-        let mut attempts = 0.0;
+        let mut attempts = 0u32;
         // The hybrid buffers of a missed attempt stay allocated (reused by the next frame).
         let mut hybrid_bytes = 0;
         let mut slots = predicted;
         while let Some(current) = slots.take() {
-            attempts += 1.0;
+            attempts += 1;
             let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current))?;
             let bound = read_rows(cx.gpu, &t.bound_texture, &t.bound_readback, 4)?;
             let worst = bound.iter().copied().fold(0.0f32, f32::max) as f64;
@@ -221,12 +221,12 @@ impl Method for Auto {
                     ("auto_slots", total as f64),
                     ("auto_predicted_k", predicted_k as f64),
                     ("auto_exact", 0.0),
-                    ("auto_attempts", attempts),
+                    ("auto_attempts", attempts as f64),
                     ("error_bound_max", worst),
                 ]);
                 return Ok(report);
             }
-            if attempts < 2.0 {
+            if attempts < 2 {
                 slots = widen(&current, counts, &bound, tolerance);
             }
         }
@@ -259,7 +259,7 @@ impl Method for Auto {
             ("auto_slots", 0.0),
             ("auto_predicted_k", predicted_k as f64),
             ("auto_exact", 1.0),
-            ("auto_attempts", attempts + 1.0),
+            ("auto_attempts", (attempts + 1) as f64),
             ("error_bound_max", rounding),
         ]);
         Ok(report)
