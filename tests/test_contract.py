@@ -8,7 +8,7 @@ import pytest
 
 import oit
 from oit import geometry
-from scenes import IDENTITY, MeshData, build_scene, layer, random_meshes
+from scenes import IDENTITY, MeshData, build_scene, layer
 
 METHODS = ["abuffer", "unsorted", "sorted"]
 STAT_KEYS = {"fragments", "max_depth_complexity", "memory_bytes", "gpu_time_ms", "overflow_fragments"}

@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import oit
 from oit import formulas
 from oit.scenes import stacks
 from scenes import IDENTITY, PERSPECTIVE, build_scene, layer, random_meshes
