@@ -18,8 +18,22 @@ const P2: [[i8; 2]; 2] = [[4, 4], [-4, -4]];
 const P4: [[i8; 2]; 4] = [[-2, -6], [6, -2], [-6, 2], [2, 6]];
 const P8: [[i8; 2]; 8] = [[1, -3], [-1, 3], [5, 1], [-3, -5], [-5, 5], [-7, -1], [3, 7], [7, -7]];
 const P16: [[i8; 2]; 16] = [
-    [1, 1], [-1, -3], [-3, 2], [4, -1], [-5, -2], [2, 5], [5, 3], [3, -5],
-    [-2, 6], [0, -7], [-4, -6], [-6, 4], [-8, 0], [7, -4], [6, 7], [-7, -8],
+    [1, 1],
+    [-1, -3],
+    [-3, 2],
+    [4, -1],
+    [-5, -2],
+    [2, 5],
+    [5, 3],
+    [3, -5],
+    [-2, 6],
+    [0, -7],
+    [-4, -6],
+    [-6, 4],
+    [-8, 0],
+    [7, -4],
+    [6, 7],
+    [-7, -8],
 ];
 
 /// The sample positions of an S-sample pixel, as offsets from its center in pixels (y down).
@@ -30,11 +44,7 @@ pub fn sample_offsets(samples: u32) -> Result<Vec<[f64; 2]>> {
         4 => &P4,
         8 => &P8,
         16 => &P16,
-        _ => {
-            return Err(invalid!(
-                "antialias must be one of {SAMPLE_COUNTS:?} samples a pixel (the standard patterns), got {samples}"
-            ))
-        }
+        _ => return Err(invalid!("antialias must be one of {SAMPLE_COUNTS:?} samples a pixel (the standard patterns), got {samples}")),
     };
     Ok(pattern.iter().map(|p| [p[0] as f64 / 16.0, p[1] as f64 / 16.0]).collect())
 }

@@ -54,19 +54,13 @@ impl GpuContext {
         let adapter = match &wanted {
             Some(w) => {
                 let lw = w.to_lowercase();
-                adapters
-                    .into_iter()
-                    .find(|a| a.get_info().name.to_lowercase().contains(&lw))
-                    .ok_or_else(|| {
-                        if names.is_empty() {
-                            OitError::NoAdapter(NO_ADAPTER_HELP.to_string())
-                        } else {
-                            OitError::NoAdapter(format!(
-                                "no adapter name contains '{w}'; available: {}",
-                                names.join(", ")
-                            ))
-                        }
-                    })?
+                adapters.into_iter().find(|a| a.get_info().name.to_lowercase().contains(&lw)).ok_or_else(|| {
+                    if names.is_empty() {
+                        OitError::NoAdapter(NO_ADAPTER_HELP.to_string())
+                    } else {
+                        OitError::NoAdapter(format!("no adapter name contains '{w}'; available: {}", names.join(", ")))
+                    }
+                })?
             }
             None => adapters
                 .into_iter()

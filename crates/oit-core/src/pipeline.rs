@@ -26,11 +26,7 @@ fn read_only_depth(compare: wgpu::CompareFunction) -> Option<wgpu::DepthStencilS
 
 pub fn layout(device: &wgpu::Device, groups: &[&wgpu::BindGroupLayout]) -> wgpu::PipelineLayout {
     let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
-    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: None,
-        bind_group_layouts: &groups,
-        immediate_size: 0,
-    })
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: &groups, immediate_size: 0 })
 }
 
 /// A pipeline drawing scene triangles with `vs_main` and the fragment entry `fs`.
@@ -72,12 +68,24 @@ pub fn geometry_samples(
 }
 
 /// A full-screen pass writing one RGBA32F target with the fragment entry `fs`.
-pub fn fullscreen(device: &wgpu::Device, label: &str, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, fs: &str) -> wgpu::RenderPipeline {
+pub fn fullscreen(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    fs: &str,
+) -> wgpu::RenderPipeline {
     fullscreen_targets(device, label, module, layout, fs, &[Some(COLOR_FORMAT.into())])
 }
 
 /// A full-screen pass writing the RGBA32F output and the R32F error bound.
-pub fn fullscreen_with_bound(device: &wgpu::Device, label: &str, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, fs: &str) -> wgpu::RenderPipeline {
+pub fn fullscreen_with_bound(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    fs: &str,
+) -> wgpu::RenderPipeline {
     fullscreen_targets(device, label, module, layout, fs, &[Some(COLOR_FORMAT.into()), Some(BOUND_FORMAT.into())])
 }
 
@@ -96,12 +104,7 @@ fn fullscreen_targets(
         primitive: Default::default(),
         depth_stencil: None,
         multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(fs),
-            compilation_options: Default::default(),
-            targets,
-        }),
+        fragment: Some(wgpu::FragmentState { module, entry_point: Some(fs), compilation_options: Default::default(), targets }),
         multiview_mask: None,
         cache: None,
     })

@@ -148,9 +148,7 @@ pub fn reference_antialiased(
         .map(|t| {
             let lo = t.v[0].min(t.v[1]).min(t.v[2]);
             let hi = t.v[0].max(t.v[1]).max(t.v[2]);
-            let pad = ((hi - lo).max_element().max(lo.abs().max_element()).max(hi.abs().max_element()) * 1e-5)
-                .max(scene_pad)
-                + 1e-30;
+            let pad = ((hi - lo).max_element().max(lo.abs().max_element()).max(hi.abs().max_element()) * 1e-5).max(scene_pad) + 1e-30;
             Bounds(Aabb::new((lo - pad).as_vec3().into(), (hi + pad).as_vec3().into()))
         })
         .collect();

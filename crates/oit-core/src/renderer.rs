@@ -93,10 +93,8 @@ impl Shared {
         let d = &gpu.device;
         let scene_layout = scene_layout(d);
         let targets_layout = targets_layout(d);
-        let counts_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("census"),
-            entries: &[pipeline::storage_entry(0)],
-        });
+        let counts_layout =
+            d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("census"), entries: &[pipeline::storage_entry(0)] });
         let opaque_module = shader::module(d, "opaque.wgsl", &[]);
         let opaque = pipeline::geometry(
             d,
@@ -311,7 +309,14 @@ impl Renderer {
 
     /// One frame with the pixel centers where `camera` puts them (the scene is uploaded); with
     /// `coverage`, a coverage-mask frame at COVERAGE_SAMPLES samples a pixel.
-    fn render_sample(&mut self, camera: &Camera, info: &'static MethodInfo, params: &Params, background: [f32; 3], coverage: bool) -> Result<Frame> {
+    fn render_sample(
+        &mut self,
+        camera: &Camera,
+        info: &'static MethodInfo,
+        params: &Params,
+        background: [f32; 3],
+        coverage: bool,
+    ) -> Result<Frame> {
         let start = Instant::now();
         let gpu = self.gpu.clone();
         if coverage && self.coverage.is_none() {
@@ -391,7 +396,14 @@ impl Renderer {
     }
 
     /// Opaque geometry into a base color and depth target (under the current uniform).
-    fn opaque_pass(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, color: &wgpu::TextureView, depth: &wgpu::TextureView, bg: [f32; 3]) {
+    fn opaque_pass(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        color: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+        bg: [f32; 3],
+    ) {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("opaque"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {

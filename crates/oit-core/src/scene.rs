@@ -33,10 +33,7 @@ impl Mesh {
             ));
         }
         if let Some(i) = colors.iter().position(|c| c.iter().any(|x| !(0.0..=1.0).contains(x))) {
-            return Err(invalid!(
-                "colors[{i}] = {:?} is outside [0, 1] (or NaN): colors are straight linear RGBA in [0, 1]",
-                colors[i]
-            ));
+            return Err(invalid!("colors[{i}] = {:?} is outside [0, 1] (or NaN): colors are straight linear RGBA in [0, 1]", colors[i]));
         }
         if let Some(t) = indices.iter().position(|t| t.iter().any(|&v| v as usize >= n)) {
             return Err(invalid!(
@@ -131,9 +128,7 @@ impl Camera {
         let view_proj = DMat4::from_cols_array_2d(&m).transpose();
         let det = view_proj.determinant();
         if !det.is_finite() || det.abs() < 1e-300 {
-            return Err(invalid!(
-                "camera matrix is singular (determinant {det:e}): build it with Camera.look_at or Camera.orthographic"
-            ));
+            return Err(invalid!("camera matrix is singular (determinant {det:e}): build it with Camera.look_at or Camera.orthographic"));
         }
         Ok(Self { view_proj })
     }

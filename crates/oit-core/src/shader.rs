@@ -65,11 +65,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
 ];
 
 fn source(path: &str) -> &'static str {
-    SOURCES
-        .iter()
-        .find(|(p, _)| *p == path)
-        .map(|(_, s)| *s)
-        .unwrap_or_else(|| panic!("shader '{path}' is not in shader::SOURCES"))
+    SOURCES.iter().find(|(p, _)| *p == path).map(|(_, s)| *s).unwrap_or_else(|| panic!("shader '{path}' is not in shader::SOURCES"))
 }
 
 fn expand(path: &str, out: &mut String, seen: &mut Vec<String>) {

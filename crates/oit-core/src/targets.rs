@@ -34,7 +34,14 @@ pub struct Targets {
     pub counts_readback: wgpu::Buffer,
 }
 
-pub fn texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages) -> wgpu::Texture {
+pub fn texture(
+    device: &wgpu::Device,
+    label: &str,
+    w: u32,
+    h: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
@@ -66,7 +73,13 @@ fn opaque_layout(device: &wgpu::Device, label: &str, view_dimension: wgpu::Textu
     })
 }
 
-fn opaque_group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, depth: &wgpu::TextureView, base: &wgpu::TextureView) -> wgpu::BindGroup {
+fn opaque_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    depth: &wgpu::TextureView,
+    base: &wgpu::TextureView,
+) -> wgpu::BindGroup {
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
         layout,
@@ -83,14 +96,8 @@ impl Targets {
         use wgpu::TextureUsages as U;
         let base_texture = texture(d, "base", width, height, COLOR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
         let depth_texture = texture(d, "depth", width, height, DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
-        let out_texture = texture(
-            d,
-            "out",
-            width,
-            height,
-            COLOR_FORMAT,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST,
-        );
+        let out_texture =
+            texture(d, "out", width, height, COLOR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST);
         let bound_texture = texture(d, "error bound", width, height, BOUND_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
         let bound = bound_texture.create_view(&Default::default());
         let base = base_texture.create_view(&Default::default());
@@ -180,7 +187,12 @@ pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> crate:
 }
 
 /// Reads a float texture back into a row-major Vec (row padding removed).
-pub fn read_rows(gpu: &GpuContext, texture: &wgpu::Texture, readback: &wgpu::Buffer, bytes_per_pixel: u32) -> crate::error::Result<Vec<f32>> {
+pub fn read_rows(
+    gpu: &GpuContext,
+    texture: &wgpu::Texture,
+    readback: &wgpu::Buffer,
+    bytes_per_pixel: u32,
+) -> crate::error::Result<Vec<f32>> {
     let size = texture.size();
     let row = padded_row(size.width, bytes_per_pixel);
     let mut enc = gpu.device.create_command_encoder(&Default::default());

@@ -1,7 +1,7 @@
 //! Every WGSL file parses and validates with naga (no GPU needed), and the structs shared
 //! with Rust have the sizes naga computes.
 
-use oit_core::gpu_types::{CoverageNode, Alloc, CompactNode, FrameUniform, PallBlock, PoolNode, PrimNode, PrimShading};
+use oit_core::gpu_types::{Alloc, CompactNode, CoverageNode, FrameUniform, PallBlock, PoolNode, PrimNode, PrimShading};
 use oit_core::shader::{compose, entry_files, DEFAULT_CONSTS};
 
 fn validate(path: &str) -> naga::Module {
@@ -25,11 +25,7 @@ fn every_shader_validates() {
 fn struct_size(module: &naga::Module, name: &str) -> u32 {
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).unwrap();
-    let (handle, _) = module
-        .types
-        .iter()
-        .find(|(_, t)| t.name.as_deref() == Some(name))
-        .unwrap_or_else(|| panic!("no struct {name}"));
+    let (handle, _) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("no struct {name}"));
     layouter[handle].size
 }
 

@@ -227,11 +227,7 @@ impl Renderer {
         let mode = match antialias_mode {
             "frames" => oit_core::AntialiasMode::Frames,
             "coverage" => oit_core::AntialiasMode::Coverage,
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "antialias_mode must be 'frames' or 'coverage', got '{other}'"
-                )))
-            }
+            other => return Err(PyValueError::new_err(format!("antialias_mode must be 'frames' or 'coverage', got '{other}'"))),
         };
         let camera = oit_core::Camera::from_rows(matrix(&view_proj)?).map_err(Error::from)?;
         let mut plist = Vec::new();

@@ -360,9 +360,7 @@ impl ViewerApp {
         let f = self.frame.as_ref()?;
         let s = &self.settings;
         let picture = |fr: &Frame| match s.view {
-            ViewMode::Complexity => {
-                heatmap::complexity_image(fr.width, fr.height, &fr.depth_complexity, fr.stats.max_depth_complexity)
-            }
+            ViewMode::Complexity => heatmap::complexity_image(fr.width, fr.height, &fr.depth_complexity, fr.stats.max_depth_complexity),
             _ => heatmap::color_image(fr.width, fr.height, &fr.image),
         };
         if s.view == ViewMode::Error {

@@ -68,7 +68,8 @@ impl Default for Options {
 
 /// 'k=v' with v an int, else a float, else the string (as `python -m oit render --param`).
 pub fn parse_param(text: &str) -> Result<(String, ParamValue), String> {
-    let (k, v) = text.split_once('=').filter(|(k, _)| !k.is_empty()).ok_or_else(|| format!("parameters are written name=value, got '{text}'"))?;
+    let (k, v) =
+        text.split_once('=').filter(|(k, _)| !k.is_empty()).ok_or_else(|| format!("parameters are written name=value, got '{text}'"))?;
     let value = v
         .parse::<i64>()
         .map(ParamValue::Int)
@@ -101,7 +102,9 @@ pub fn parse(args: impl IntoIterator<Item = String>) -> Result<Option<Options>, 
             "-m" | "--method" => o.method = it.next().ok_or("--method needs a name")?,
             "--param" => o.params.push(parse_param(&it.next().ok_or("--param needs NAME=VALUE")?)?),
             "--alpha" => o.alpha = Some(unit("--alpha", it.next())?),
-            "--background" => o.background = [unit("--background", it.next())?, unit("--background", it.next())?, unit("--background", it.next())?],
+            "--background" => {
+                o.background = [unit("--background", it.next())?, unit("--background", it.next())?, unit("--background", it.next())?]
+            }
             "--compare" => {
                 o.compare = match it.next().as_deref() {
                     Some("off") => Compare::Off,
@@ -150,9 +153,10 @@ mod tests {
 
     #[test]
     fn options_and_errors() {
-        let o = args("a.obj b.ply --method abuffer --param k=4 --param weight=eq10 --alpha 0.3 --compare split --screenshot x.png --frames 2")
-            .unwrap()
-            .unwrap();
+        let o =
+            args("a.obj b.ply --method abuffer --param k=4 --param weight=eq10 --alpha 0.3 --compare split --screenshot x.png --frames 2")
+                .unwrap()
+                .unwrap();
         assert_eq!(o.files.len(), 2);
         assert_eq!(o.params, vec![("k".into(), ParamValue::Int(4)), ("weight".into(), ParamValue::Str("eq10".into()))]);
         assert_eq!((o.alpha, o.compare, o.frames), (Some(0.3), Compare::Split, 2));

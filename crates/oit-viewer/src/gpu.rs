@@ -15,18 +15,22 @@ pub fn setup(adapter: Option<String>, prefer_software: bool) -> WgpuSetup {
     s.instance_descriptor.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
     let wanted = adapter.or_else(|| std::env::var("OIT_ADAPTER").ok()).filter(|s| !s.is_empty());
     s.native_adapter_selector = Some(Arc::new(move |adapters, surface| {
-        let usable: Vec<&wgpu::Adapter> =
-            adapters.iter().filter(|a| surface.is_none_or(|s| a.is_surface_supported(s))).collect();
+        let usable: Vec<&wgpu::Adapter> = adapters.iter().filter(|a| surface.is_none_or(|s| a.is_surface_supported(s))).collect();
         let names: Vec<String> = usable.iter().map(|a| a.get_info().name).collect();
         let chosen = match &wanted {
-            Some(w) => usable.iter().find(|a| a.get_info().name.to_lowercase().contains(&w.to_lowercase())).ok_or_else(|| {
-                format!("no adapter name contains '{w}'; available: {}", names.join(", "))
-            })?,
+            Some(w) => usable
+                .iter()
+                .find(|a| a.get_info().name.to_lowercase().contains(&w.to_lowercase()))
+                .ok_or_else(|| format!("no adapter name contains '{w}'; available: {}", names.join(", ")))?,
             None => usable
                 .iter()
                 .min_by_key(|a| {
                     let rank = adapter_rank(&a.get_info());
-                    if prefer_software { 4 - rank } else { rank }
+                    if prefer_software {
+                        4 - rank
+                    } else {
+                        rank
+                    }
                 })
                 .ok_or_else(|| {
                     "no GPU adapter found: install a Vulkan driver, or lavapipe with \

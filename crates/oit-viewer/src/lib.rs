@@ -33,9 +33,7 @@ pub fn settings(o: &Options) -> Result<Settings, String> {
 pub fn builtin_scene(name: &str, alpha: Option<f32>) -> Result<scenefile::SceneData, String> {
     let python = std::env::var("OIT_PYTHON").unwrap_or_else(|_| "python3".into());
     let path = std::env::temp_dir().join(format!("oit-viewer-{}-{name}.oitscene", std::process::id()));
-    let help = format!(
-        "run `python -m oit view --scene {name}` with the Python that has oit installed, or point OIT_PYTHON at it"
-    );
+    let help = format!("run `python -m oit view --scene {name}` with the Python that has oit installed, or point OIT_PYTHON at it");
     let status = std::process::Command::new(&python)
         .args(["-m", "oit", "view", "--scene", name, "--export"])
         .arg(&path)

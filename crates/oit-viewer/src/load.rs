@@ -92,7 +92,10 @@ fn obj(path: &Path) -> Result<Vec<NamedMesh>, String> {
         let indices: Vec<[u32; 3]> = m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
         let material = m.material_id.and_then(|id| materials.get(id));
         let colors = if m.vertex_color.len() == m.positions.len() && !m.vertex_color.is_empty() {
-            m.vertex_color.chunks_exact(3).map(|c| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), DEFAULT_ALPHA]).collect()
+            m.vertex_color
+                .chunks_exact(3)
+                .map(|c| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), DEFAULT_ALPHA])
+                .collect()
         } else {
             let rgb = material.and_then(|mt| mt.diffuse).map(|d| d.map(srgb_to_linear)).unwrap_or(DEFAULT_RGB);
             let a = material.and_then(|mt| mt.dissolve).filter(|&d| d < 1.0).unwrap_or(DEFAULT_ALPHA);
@@ -202,7 +205,11 @@ fn base64(text: &str) -> Result<Vec<u8>, String> {
         b'/' | b'_' => Some(63),
         _ => None,
     };
-    let digits: Vec<u8> = text.bytes().filter(|&c| c != b'=' && !c.is_ascii_whitespace()).map(value).collect::<Option<_>>()
+    let digits: Vec<u8> = text
+        .bytes()
+        .filter(|&c| c != b'=' && !c.is_ascii_whitespace())
+        .map(value)
+        .collect::<Option<_>>()
         .ok_or("a data URI is not valid base64")?;
     let mut out = Vec::with_capacity(digits.len() * 3 / 4);
     for chunk in digits.chunks(4) {

@@ -27,7 +27,11 @@ fn main() {
     };
     let settings = oit_viewer::settings(&o).unwrap_or_else(|e: String| fail(&e, 2));
     let mut data = load::load_all(&o.files, o.alpha).unwrap_or_else(|e: String| -> oit_viewer::scenefile::SceneData {
-        if o.files.is_empty() { Default::default() } else { fail(&e, 2) }
+        if o.files.is_empty() {
+            Default::default()
+        } else {
+            fail(&e, 2)
+        }
     });
     if let Some(name) = &o.scene {
         let mut builtin = oit_viewer::builtin_scene(name, o.alpha).unwrap_or_else(|e: String| fail(&e, 1));

@@ -109,11 +109,7 @@ impl Orbit {
         let aspect = right_edge.length() / up_edge.length();
         let true_up = up_edge.normalize();
         // Prefer world +Y as the turntable axis when it gives the same view (no roll).
-        let up = if forward.cross(DVec3::Y).normalize().abs_diff_eq(forward.cross(true_up).normalize(), 1e-9) {
-            DVec3::Y
-        } else {
-            true_up
-        };
+        let up = if forward.cross(DVec3::Y).normalize().abs_diff_eq(forward.cross(true_up).normalize(), 1e-9) { DVec3::Y } else { true_up };
         let t = (center - eye).dot(forward);
         let t = if t > near { t } else { (near + far) / 2.0 };
         let orbit = Self::look_at(eye, eye + forward * t, up, fov_y, near, far)?;

@@ -153,8 +153,8 @@ mod tests {
     use super::*;
 
     fn triangle(opaque: bool) -> NamedMesh {
-        let mesh = Mesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]], vec![[0.5, 0.25, 1.0, 0.4]], opaque)
-            .unwrap();
+        let mesh =
+            Mesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]], vec![[0.5, 0.25, 1.0, 0.4]], opaque).unwrap();
         NamedMesh { name: "tri".into(), mesh }
     }
 

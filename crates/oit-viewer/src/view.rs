@@ -102,7 +102,9 @@ fn overlay(painter: &egui::Painter, rect: Rect, app: &ViewerApp) {
         _ => {}
     }
     let legend = match (s.view, app.frame.as_ref()) {
-        (ViewMode::Complexity, Some(f)) => Some(("fragments / pixel".to_string(), "0".to_string(), f.stats.max_depth_complexity.to_string())),
+        (ViewMode::Complexity, Some(f)) => {
+            Some(("fragments / pixel".to_string(), "0".to_string(), f.stats.max_depth_complexity.to_string()))
+        }
         (ViewMode::Error, Some(_)) => Some(("max |Δ| of linear RGB".to_string(), "0".to_string(), format!("≥ {}", s.error_scale))),
         _ => None,
     };

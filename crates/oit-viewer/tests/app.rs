@@ -54,7 +54,8 @@ fn harness(method: &str) -> Harness<'static, ViewerApp> {
 /// default per-pixel threshold, with a few pixels spare for antialiased text edges. Times
 /// ("... ms") change from run to run and are masked.
 fn check(h: &mut Harness<'_, ViewerApp>, name: &str) {
-    let timings: Vec<_> = h.query_all_by(|n| [n.label(), n.value()].into_iter().flatten().any(|l| l.ends_with(" ms"))).map(|n| n.rect()).collect();
+    let timings: Vec<_> =
+        h.query_all_by(|n| [n.label(), n.value()].into_iter().flatten().any(|l| l.ends_with(" ms"))).map(|n| n.rect()).collect();
     assert!(!timings.is_empty(), "the stats show times");
     // A fixed width: the text's own width changes with the number.
     timings.into_iter().for_each(|r| h.mask(eframe::egui::Rect::from_min_size(r.min, [120.0, r.height()].into())));

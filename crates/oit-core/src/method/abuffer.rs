@@ -25,12 +25,16 @@ struct ABuffer {
 
 impl ABuffer {
     fn new(gpu: &GpuContext, limits: &Limits) -> Self {
-        let lists = ListMethod::new(gpu, limits, ListLayout {
-            shader: "abuffer.wgsl",
-            node_bytes: std::mem::size_of::<PoolNode>() as u64,
-            state_words: STATE_WORDS,
-            aux: Aux::None,
-        });
+        let lists = ListMethod::new(
+            gpu,
+            limits,
+            ListLayout {
+                shader: "abuffer.wgsl",
+                node_bytes: std::mem::size_of::<PoolNode>() as u64,
+                state_words: STATE_WORDS,
+                aux: Aux::None,
+            },
+        );
         Self { lists, coverage: None }
     }
 }
@@ -70,12 +74,16 @@ impl Method for ABuffer {
         match cx.coverage {
             Some(c) => {
                 let lists = self.coverage.get_or_insert_with(|| {
-                    ListMethod::new(cx.gpu, &cx.limits, ListLayout {
-                        shader: "abuffer_coverage.wgsl",
-                        node_bytes: std::mem::size_of::<CoverageNode>() as u64,
-                        state_words: state_words(c.samples),
-                        aux: Aux::None,
-                    })
+                    ListMethod::new(
+                        cx.gpu,
+                        &cx.limits,
+                        ListLayout {
+                            shader: "abuffer_coverage.wgsl",
+                            node_bytes: std::mem::size_of::<CoverageNode>() as u64,
+                            state_words: state_words(c.samples),
+                            aux: Aux::None,
+                        },
+                    )
                 });
                 lists.render(cx)
             }

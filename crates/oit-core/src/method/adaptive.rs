@@ -21,12 +21,11 @@ pub const INFO: MethodInfo = MethodInfo {
         doc: "steps of the per-pixel visibility function",
     }],
     create: |gpu, limits| {
-        Box::new(Adaptive(ListMethod::new(gpu, limits, ListLayout {
-            shader: "adaptive.wgsl",
-            node_bytes: std::mem::size_of::<PrimNode>() as u64,
-            state_words: 0,
-            aux: Aux::None,
-        })))
+        Box::new(Adaptive(ListMethod::new(
+            gpu,
+            limits,
+            ListLayout { shader: "adaptive.wgsl", node_bytes: std::mem::size_of::<PrimNode>() as u64, state_words: 0, aux: Aux::None },
+        )))
     },
 };
 

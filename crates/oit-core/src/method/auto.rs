@@ -21,7 +21,11 @@ pub const INFO: MethodInfo = MethodInfo {
     summary: "accuracy on demand: the cheapest hybrid (or the exact A-buffer) whose error bound is at most `tolerance`",
     exact: false,
     bounded_memory: false,
-    passes: &["census", "estimate", "hybrid with each pixel's smallest k predicted to meet the tolerance (twice that where it misses), else abuffer"],
+    passes: &[
+        "census",
+        "estimate",
+        "hybrid with each pixel's smallest k predicted to meet the tolerance (twice that where it misses), else abuffer",
+    ],
     params: &[ParamInfo {
         name: "tolerance",
         kind: ParamKind::Float { min: 0.0, max: 1.0, default: 1.0 / 255.0 },

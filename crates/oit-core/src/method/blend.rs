@@ -74,7 +74,11 @@ impl Kind {
     }
 
     fn entry(self) -> &'static str {
-        if self == Kind::Filter { "fs_filter" } else { "fs_blend" }
+        if self == Kind::Filter {
+            "fs_filter"
+        } else {
+            "fs_blend"
+        }
     }
 }
 
@@ -116,7 +120,11 @@ impl Method for Blend {
             // Far to near: larger NDC depth first; meshes behind the eye (w <= 0) go first.
             let key = |i: usize| {
                 let c = vp * geo.meshes[i].centroid.extend(1.0);
-                if c.w > 0.0 { c.z / c.w } else { f32::INFINITY }
+                if c.w > 0.0 {
+                    c.z / c.w
+                } else {
+                    f32::INFINITY
+                }
             };
             order.sort_by(|&a, &b| key(b).total_cmp(&key(a)));
         }

@@ -14,11 +14,7 @@ pub const INFO: MethodInfo = MethodInfo {
     exact: false,
     bounded_memory: true,
     passes: &["depth bounds (geometry)", "bucket keys (geometry)", "bucket colors (geometry)", "resolve (full screen)"],
-    params: &[ParamInfo {
-        name: "buckets",
-        kind: ParamKind::Int { min: 1, max: 32, default: 32 },
-        doc: "buckets (layers) per pixel",
-    }],
+    params: &[ParamInfo { name: "buckets", kind: ParamKind::Int { min: 1, max: 32, default: 32 }, doc: "buckets (layers) per pixel" }],
     create: |_, _| Box::new(Buckets { pipelines: None, buffers: None }),
 };
 

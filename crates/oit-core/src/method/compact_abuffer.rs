@@ -17,12 +17,16 @@ pub const INFO: MethodInfo = MethodInfo {
     passes: &["triangle setup (compute)", "capture (geometry)", "sweeps (compute)", "resolve (full screen)"],
     params: &[],
     create: |gpu, limits| {
-        Box::new(Compact(ListMethod::new(gpu, limits, ListLayout {
-            shader: "compact_abuffer.wgsl",
-            node_bytes: std::mem::size_of::<CompactNode>() as u64,
-            state_words: STATE_WORDS,
-            aux: Aux::PerTriangle(std::mem::size_of::<PrimShading>() as u64),
-        })))
+        Box::new(Compact(ListMethod::new(
+            gpu,
+            limits,
+            ListLayout {
+                shader: "compact_abuffer.wgsl",
+                node_bytes: std::mem::size_of::<CompactNode>() as u64,
+                state_words: STATE_WORDS,
+                aux: Aux::PerTriangle(std::mem::size_of::<PrimShading>() as u64),
+            },
+        )))
     },
 };
 

@@ -175,7 +175,8 @@ impl Hybrid {
         if let Slots::PerPixel(s) = slots {
             write_offsets(cx, &offsets, s);
         }
-        self.buffers = Some(Buffers { key: (pixels, total, per_pixel), ktab, offsets, _vis: vis, accum, overflow, overflow_readback, group });
+        self.buffers =
+            Some(Buffers { key: (pixels, total, per_pixel), ktab, offsets, _vis: vis, accum, overflow, overflow_readback, group });
         Ok(())
     }
 }

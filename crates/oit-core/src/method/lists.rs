@@ -148,13 +148,13 @@ impl NodePool {
                 wgpu::BindGroupEntry { binding: 0, resource: self.heads.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: self.alloc.as_entire_binding() },
             ];
-            entries.extend(self.pools.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry {
-                binding: 2 + i as u32,
-                resource: b.as_entire_binding(),
-            }));
+            entries.extend(
+                self.pools.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: 2 + i as u32, resource: b.as_entire_binding() }),
+            );
             entries.push(wgpu::BindGroupEntry { binding: 2 + POOL_BINDINGS as u32, resource: self.state.as_entire_binding() });
             entries.push(wgpu::BindGroupEntry { binding: 3 + POOL_BINDINGS as u32, resource: self.aux.as_entire_binding() });
-            self.group = Some(d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("node pool"), layout: &self.layout, entries: &entries }));
+            self.group =
+                Some(d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("node pool"), layout: &self.layout, entries: &entries }));
         }
         Ok(())
     }
@@ -250,7 +250,9 @@ impl ListMethod {
         let module = shader::module(d, self.shader, &consts);
         let layout = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &self.pool.layout]);
         let capture = match cx.coverage {
-            Some(c) => pipeline::geometry_samples(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::raster_only(), c.samples),
+            Some(c) => {
+                pipeline::geometry_samples(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::raster_only(), c.samples)
+            }
             None => pipeline::geometry(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::depth_test_only()),
         };
         let resolve = pipeline::fullscreen(d, "list resolve", &module, &layout, "fs_resolve");
@@ -265,7 +267,14 @@ impl ListMethod {
     /// S-buffer preparation: per-pixel counts into binding 7, their exclusive prefix sum in
     /// place (entry W * H becomes the total), the starts copied to the fill cursors (heads)
     /// and the total to the allocator's count, so that the capacity check works as for lists.
-    fn count_and_scan(&self, cx: &mut FrameCtx<'_>, enc: &mut wgpu::CommandEncoder, count: &wgpu::RenderPipeline, scan: &Scan, pixels: u64) {
+    fn count_and_scan(
+        &self,
+        cx: &mut FrameCtx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        count: &wgpu::RenderPipeline,
+        scan: &Scan,
+        pixels: u64,
+    ) {
         let t = cx.targets;
         let group = self.pool.group.as_ref().expect("reserved");
         let targets_group = cx.targets_group();
@@ -294,7 +303,10 @@ impl ListMethod {
         }
         let t = cx.targets;
         let pixels = t.width as u64 * t.height as u64;
-        cx.check_per_pixel(&format!("{} (its per-pixel heads and sweep state)", self.shader.trim_end_matches(".wgsl")), 4 * self.pool.state_words.max(1))?;
+        cx.check_per_pixel(
+            &format!("{} (its per-pixel heads and sweep state)", self.shader.trim_end_matches(".wgsl")),
+            4 * self.pool.state_words.max(1),
+        )?;
         let initial = if self.pool.capacity == 0 { pixels.min(self.pool.max_nodes()) } else { self.pool.capacity };
         // A list of n fragments takes floor(n / BATCH) + 1 sweeps (the last one finds it empty).
         let sweeps = cx.max_depth_complexity / BATCH + 1;

@@ -15,18 +15,13 @@ pub const INFO: MethodInfo = MethodInfo {
     exact: false,
     bounded_memory: false,
     passes: &["capture (geometry)", "replay in submission order and composite (full screen)"],
-    params: &[ParamInfo {
-        name: "layers",
-        kind: ParamKind::Int { min: 1, max: 32, default: 4 },
-        doc: "blended layers kept per pixel",
-    }],
+    params: &[ParamInfo { name: "layers", kind: ParamKind::Int { min: 1, max: 32, default: 4 }, doc: "blended layers kept per pixel" }],
     create: |gpu, limits| {
-        Box::new(Mlab(ListMethod::new(gpu, limits, ListLayout {
-            shader: "mlab.wgsl",
-            node_bytes: std::mem::size_of::<PrimNode>() as u64,
-            state_words: 0,
-            aux: Aux::None,
-        })))
+        Box::new(Mlab(ListMethod::new(
+            gpu,
+            limits,
+            ListLayout { shader: "mlab.wgsl", node_bytes: std::mem::size_of::<PrimNode>() as u64, state_words: 0, aux: Aux::None },
+        )))
     },
 };
 

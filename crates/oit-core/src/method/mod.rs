@@ -2,20 +2,20 @@
 //! Adding a method: one file here, its WGSL, one line in `REGISTRY`, and its tests.
 
 mod abuffer;
-mod auto;
 mod adaptive;
-mod mlab;
+mod auto;
 mod blend;
 mod bucket_peeling;
 mod compact_abuffer;
+pub mod hybrid;
+mod hybrid64;
+pub(crate) mod lists;
+mod mlab;
 mod pall;
 pub mod peel;
 mod sbuffer;
 mod screen_door;
 mod stochastic;
-pub(crate) mod lists;
-pub mod hybrid;
-mod hybrid64;
 pub mod weighted;
 
 use std::collections::BTreeMap;
@@ -87,7 +87,30 @@ impl Params {
     }
 }
 
-const REGISTRY: &[MethodInfo] = &[abuffer::INFO, blend::UNSORTED, blend::SORTED, blend::ADDITIVE, blend::FILTER, hybrid::HYBRID, hybrid::KTAB, hybrid64::INFO, weighted::WAVG, weighted::WSUM, weighted::WBOIT, adaptive::INFO, pall::INFO, compact_abuffer::INFO, sbuffer::INFO, peel::DEPTH_PEELING, peel::DUAL_DEPTH_PEELING, screen_door::INFO, stochastic::INFO, mlab::INFO, bucket_peeling::INFO, auto::INFO];
+const REGISTRY: &[MethodInfo] = &[
+    abuffer::INFO,
+    blend::UNSORTED,
+    blend::SORTED,
+    blend::ADDITIVE,
+    blend::FILTER,
+    hybrid::HYBRID,
+    hybrid::KTAB,
+    hybrid64::INFO,
+    weighted::WAVG,
+    weighted::WSUM,
+    weighted::WBOIT,
+    adaptive::INFO,
+    pall::INFO,
+    compact_abuffer::INFO,
+    sbuffer::INFO,
+    peel::DEPTH_PEELING,
+    peel::DUAL_DEPTH_PEELING,
+    screen_door::INFO,
+    stochastic::INFO,
+    mlab::INFO,
+    bucket_peeling::INFO,
+    auto::INFO,
+];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY
@@ -122,11 +145,7 @@ fn did_you_mean<'a>(name: &str, options: impl Iterator<Item = &'a str>) -> Strin
 pub fn lookup(name: &str) -> Result<&'static MethodInfo> {
     REGISTRY.iter().find(|m| m.name == name).ok_or_else(|| {
         let names: Vec<&str> = REGISTRY.iter().map(|m| m.name).collect();
-        invalid!(
-            "unknown method '{name}'{}; valid methods: {}",
-            did_you_mean(name, names.iter().copied()),
-            names.join(", ")
-        )
+        invalid!("unknown method '{name}'{}; valid methods: {}", did_you_mean(name, names.iter().copied()), names.join(", "))
     })
 }
 

@@ -17,12 +17,16 @@ pub const INFO: MethodInfo = MethodInfo {
     passes: &["allocate per triangle (compute)", "capture (geometry)", "sweeps (compute)", "resolve (full screen)"],
     params: &[],
     create: |gpu, limits| {
-        Box::new(Pall(ListMethod::new(gpu, limits, ListLayout {
-            shader: "pall.wgsl",
-            node_bytes: std::mem::size_of::<PoolNode>() as u64,
-            state_words: STATE_WORDS,
-            aux: Aux::PerTriangle(std::mem::size_of::<PallBlock>() as u64),
-        })))
+        Box::new(Pall(ListMethod::new(
+            gpu,
+            limits,
+            ListLayout {
+                shader: "pall.wgsl",
+                node_bytes: std::mem::size_of::<PoolNode>() as u64,
+                state_words: STATE_WORDS,
+                aux: Aux::PerTriangle(std::mem::size_of::<PallBlock>() as u64),
+            },
+        )))
     },
 };
 

@@ -17,12 +17,16 @@ pub const INFO: MethodInfo = MethodInfo {
     passes: &["count (geometry)", "prefix sum (compute)", "capture (geometry)", "sweeps (compute)", "resolve (full screen)"],
     params: &[],
     create: |gpu, limits| {
-        Box::new(SBuffer(ListMethod::new(gpu, limits, ListLayout {
-            shader: "sbuffer.wgsl",
-            node_bytes: std::mem::size_of::<PoolNode>() as u64,
-            state_words: STATE_WORDS,
-            aux: Aux::PixelOffsets,
-        })))
+        Box::new(SBuffer(ListMethod::new(
+            gpu,
+            limits,
+            ListLayout {
+                shader: "sbuffer.wgsl",
+                node_bytes: std::mem::size_of::<PoolNode>() as u64,
+                state_words: STATE_WORDS,
+                aux: Aux::PixelOffsets,
+            },
+        )))
     },
 };
 

@@ -42,11 +42,19 @@ impl Method for ScreenDoor {
                 bias: Default::default(),
             };
             let layout = pipeline::layout(d, &[cx.scene_layout]);
-            self.pipeline = Some(pipeline::geometry(d, "screen door", &module, &layout, "fs_door", &[Some(COLOR_FORMAT.into())], Some(depth)));
+            self.pipeline =
+                Some(pipeline::geometry(d, "screen door", &module, &layout, "fs_door", &[Some(COLOR_FORMAT.into())], Some(depth)));
         }
         let size = (t.width, t.height);
         if self.depth.as_ref().is_none_or(|(s, _, _)| *s != size) {
-            let tex = texture(d, "screen door depth", size.0, size.1, DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST);
+            let tex = texture(
+                d,
+                "screen door depth",
+                size.0,
+                size.1,
+                DEPTH_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST,
+            );
             let view = tex.create_view(&Default::default());
             self.depth = Some((size, tex, view));
         }

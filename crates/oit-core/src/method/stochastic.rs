@@ -22,7 +22,11 @@ pub const INFO: MethodInfo = MethodInfo {
             kind: ParamKind::Int { min: 1, max: 64, default: 8 },
             doc: "coverage samples per pixel (the estimate's noise falls as 1/sqrt(samples))",
         },
-        ParamInfo { name: "seed", kind: ParamKind::Int { min: 0, max: u32::MAX as i64, default: 0 }, doc: "random seed of the coverage masks" },
+        ParamInfo {
+            name: "seed",
+            kind: ParamKind::Int { min: 0, max: u32::MAX as i64, default: 0 },
+            doc: "random seed of the coverage masks",
+        },
     ],
     create: |_, _| Box::new(Stochastic { pipelines: None, buffers: None }),
 };
@@ -144,7 +148,11 @@ impl Method for Stochastic {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("stochastic accumulate"),
                 color_attachments: &[attach(&b.accum, wgpu::Color::TRANSPARENT), attach(&b.aux, wgpu::Color::WHITE)],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: &t.depth, depth_ops: None, stencil_ops: None }),
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &t.depth,
+                    depth_ops: None,
+                    stencil_ops: None,
+                }),
                 timestamp_writes: cx.timer.render_pass("accumulate"),
                 occlusion_query_set: None,
                 multiview_mask: None,

@@ -58,11 +58,8 @@ pub fn memory_bytes(pixels: u64) -> u64 {
     pixels * (16 + 4)
 }
 
-pub(crate) const ADD: wgpu::BlendComponent = wgpu::BlendComponent {
-    src_factor: wgpu::BlendFactor::One,
-    dst_factor: wgpu::BlendFactor::One,
-    operation: wgpu::BlendOperation::Add,
-};
+pub(crate) const ADD: wgpu::BlendComponent =
+    wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
 
 /// dst * (1 - src): revealage, the product of (1 - alpha).
 pub(crate) const REVEAL: wgpu::BlendComponent = wgpu::BlendComponent {

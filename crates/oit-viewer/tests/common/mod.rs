@@ -50,10 +50,8 @@ impl TestRenderer for WgpuRenderer {
         let (device, queue) = (&self.state.device, &self.state.queue);
         let mut renderer = self.state.renderer.write();
         let size = ctx.content_rect().size() * ctx.pixels_per_point();
-        let screen = ScreenDescriptor {
-            pixels_per_point: ctx.pixels_per_point(),
-            size_in_pixels: [size.x.round() as u32, size.y.round() as u32],
-        };
+        let screen =
+            ScreenDescriptor { pixels_per_point: ctx.pixels_per_point(), size_in_pixels: [size.x.round() as u32, size.y.round() as u32] };
         let shapes = ctx.tessellate(output.shapes.clone(), ctx.pixels_per_point());
         let mut encoder = device.create_command_encoder(&Default::default());
         let user = renderer.update_buffers(device, queue, &mut encoder, &shapes, &screen);
