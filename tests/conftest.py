@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import hashlib
 from pathlib import Path
-from typing import Callable, Dict, List, Optional, Tuple
+from typing import Callable
 
 import pytest
 
@@ -23,7 +23,7 @@ REPO = Path(__file__).resolve().parent.parent
 # ---- the installed package should be the one in python/oit
 
 
-def _source_drift() -> Tuple[List[str], List[str]]:
+def _source_drift() -> tuple[list[str], list[str]]:
     """Modules of python/oit missing from the imported package, and those that differ."""
     source = REPO / "python" / "oit"
     installed = Path(oit.__file__).parent
@@ -37,7 +37,7 @@ def _source_drift() -> Tuple[List[str], List[str]]:
     return missing, differ
 
 
-def pytest_report_header(config: pytest.Config) -> List[str]:
+def pytest_report_header(config: pytest.Config) -> list[str]:
     lines = [f"oit from {Path(oit.__file__).parent}"]
     missing, differ = _source_drift()
     drift = ([f"missing: {', '.join(missing)}"] if missing else []) + ([f"changed: {', '.join(differ)}"] if differ else [])
@@ -53,9 +53,9 @@ def pytest_report_header(config: pytest.Config) -> List[str]:
 @pytest.fixture(scope="session")
 def renderer() -> Callable[..., oit.Renderer]:
     """renderer(width, height, max_binding_bytes=None): one cached oit.Renderer per arguments."""
-    cache: Dict[Tuple[int, int, Optional[int]], oit.Renderer] = {}
+    cache: dict[tuple[int, int, int | None], oit.Renderer] = {}
 
-    def get(width: int, height: int, max_binding_bytes: Optional[int] = None) -> oit.Renderer:
+    def get(width: int, height: int, max_binding_bytes: int | None = None) -> oit.Renderer:
         key = (width, height, max_binding_bytes)
         if key not in cache:
             cache[key] = oit.Renderer(width, height, max_binding_bytes=max_binding_bytes)

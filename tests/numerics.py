@@ -11,8 +11,9 @@ listed here by name.
 from __future__ import annotations
 
 import inspect
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Callable, Dict, List, Optional, Sequence
+from typing import Callable
 
 import numpy as np
 
@@ -20,8 +21,8 @@ import oit
 from oit import models
 
 BG = np.array([0.2, 0.4, 0.6])
-INFO: Dict[str, dict] = {m["name"]: m for m in oit.methods()}
-NAMES: List[str] = list(INFO)
+INFO: dict[str, dict] = {m["name"]: m for m in oit.methods()}
+NAMES: list[str] = list(INFO)
 EXACT = [n for n in NAMES if INFO[n]["exact"]]
 BOUNDED = [n for n in NAMES if INFO[n]["bounded_memory"]]
 # Methods with a `seed` parameter are randomized per fragment (by triangle index): adding
@@ -65,7 +66,7 @@ def over_blend(rgb: np.ndarray, alpha: np.ndarray, bg: Sequence[float], bg_a: fl
 
 
 def expected(name: str, z, rgb, alpha, bg=BG, bg_a: float = 0.0, mesh_per_fragment: bool = False,
-             pixel=(0, 0), **params) -> Optional[np.ndarray]:
+             pixel=(0, 0), **params) -> np.ndarray | None:
     """RGBA that `name` should return on one pixel's stack given in submission order, or None
     when there is no CPU model of it. `mesh_per_fragment`: each fragment is its own mesh
     (what `sorted` sorts); otherwise all of them are one mesh, drawn in submission order.
@@ -89,7 +90,7 @@ def expected(name: str, z, rgb, alpha, bg=BG, bg_a: float = 0.0, mesh_per_fragme
     return model(z, rgb, alpha, bg, bg_a, **p)
 
 
-def expected_image(name: str, width: int, height: int, z, rgb, alpha, bg=BG, **kw) -> Optional[np.ndarray]:
+def expected_image(name: str, width: int, height: int, z, rgb, alpha, bg=BG, **kw) -> np.ndarray | None:
     """(h, w, 4) expected image of one stack drawn on every pixel (full-screen layers)."""
     out = [expected(name, z, rgb, alpha, bg, pixel=(r, c), **kw) for r in range(height) for c in range(width)]
     return None if out[0] is None else np.array(out).reshape(height, width, 4)
@@ -164,7 +165,7 @@ def hybrid_tail_count(z, alpha, k: int) -> int:
     return sum(1 for key in keys if key not in core)
 
 
-def expected_overflow(name: str, z, alpha, **params) -> Optional[int]:
+def expected_overflow(name: str, z, alpha, **params) -> int | None:
     """What stats["overflow_fragments"] should say for one pixel's stack, or None when no
     model of it is known here. Only hybrid and ktab have a bounded structure that overflows;
     the blends have none, and the list methods grow theirs."""
@@ -186,9 +187,9 @@ class Stacks:
     scene: oit.Scene
     width: int
     height: int
-    z: List[np.ndarray]
-    rgb: List[np.ndarray]
-    alpha: List[np.ndarray]
+    z: list[np.ndarray]
+    rgb: list[np.ndarray]
+    alpha: list[np.ndarray]
 
     def expect(self, name: str, bg=BG, **params) -> np.ndarray:
         """(h, w, 4) float64 expected image, or None without a model."""
@@ -213,7 +214,7 @@ def pixel_quads(width: int, height: int, cells: np.ndarray, z: np.ndarray) -> np
     return pos
 
 
-def stacks(width: int, height: int, layers: int, seed: int = 0, alpha: Callable = None,
+def stacks(width: int, height: int, layers: int, seed: int = 0, alpha: Callable | None = None,
            z_range=(0.01, 0.99)) -> Stacks:
     """`layers` fragments on every pixel at distinct float32 depths (evenly spaced in
     z_range, so float32 and the 24-bit keys keep them apart), random colors, alphas from
@@ -256,8 +257,8 @@ def full_screen_layers(layers: Sequence, opaque: Sequence[int] = ()) -> oit.Scen
 
 def layer_arrays(layers: Sequence):
     """z, rgb, alpha arrays (float64 of the float32 values the GPU sees) of (z, rgba) layers."""
-    z = np.array([np.float32(l[0]) for l in layers], np.float64)
-    rgba = np.array([l[1] for l in layers], np.float32).astype(np.float64)
+    z = np.array([np.float32(layer[0]) for layer in layers], np.float64)
+    rgba = np.array([layer[1] for layer in layers], np.float32).astype(np.float64)
     return z, rgba[:, :3], rgba[:, 3]
 
 

@@ -3,8 +3,8 @@ conftest.py holds the fixtures)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import List, Sequence, Tuple
 
 import numpy as np
 
@@ -25,7 +25,7 @@ class MeshData:
     colors: np.ndarray
     opaque: bool = False
 
-    def shuffled(self, rng: np.random.Generator) -> "MeshData":
+    def shuffled(self, rng: np.random.Generator) -> MeshData:
         """The same triangles (each keeping its vertex order) in another order, with the
         vertex array permuted too."""
         perm = rng.permutation(len(self.positions))
@@ -80,7 +80,7 @@ def _ndc_xy(camera: oit.Camera, positions: np.ndarray) -> np.ndarray:
 
 
 def random_meshes(seed: int, transparent: int = 8, opaque: int = 2, triangles: int = 5,
-                  space: str = "ndc", spread: float = 0.6, on_screen: bool = True) -> List[MeshData]:
+                  space: str = "ndc", spread: float = 0.6, on_screen: bool = True) -> list[MeshData]:
     """Random meshes of independent triangles with random per-vertex colors; alphas
     include whole triangles of exactly 0 and exactly 1.
 
@@ -125,12 +125,12 @@ def random_meshes(seed: int, transparent: int = 8, opaque: int = 2, triangles: i
     return meshes
 
 
-def composite(layers: Sequence[Tuple[float, Sequence[float]]], background: Sequence[float]) -> np.ndarray:
+def composite(layers: Sequence[tuple[float, Sequence[float]]], background: Sequence[float]) -> np.ndarray:
     """float64 front-to-back over-compositing of (depth, straight RGBA) layers at distinct
     depths: RGBA as the renderer returns it."""
     accum = np.zeros(3)
     trans = 1.0
-    for _, c in sorted(layers, key=lambda l: l[0]):
+    for _, c in sorted(layers, key=lambda layer: layer[0]):
         c = np.asarray(c, dtype=np.float64)
         accum += trans * c[3] * c[:3]
         trans *= 1.0 - c[3]

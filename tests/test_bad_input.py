@@ -10,7 +10,7 @@ import oit
 from scenes import IDENTITY
 
 P = np.float32([[0.0, 0.0, 0.5], [1.0, 0.0, 0.5], [0.0, 1.0, 0.5]])
-I = np.array([[0, 1, 2]])
+I = np.array([[0, 1, 2]])  # noqa: E741 - P, I, C: positions, indices, color
 C = (1.0, 0.0, 0.0, 0.5)
 
 
@@ -248,9 +248,9 @@ def test_camera_builders_reject_degenerate_volumes():
 
 def test_render_needs_a_scene_and_a_camera(small):
     r, scene = small
-    with pytest.raises(TypeError, match="camera must be an oit.Camera, got ndarray"):
+    with pytest.raises(TypeError, match=r"camera must be an oit\.Camera, got ndarray"):
         r.render(scene, np.eye(4))
-    with pytest.raises(TypeError, match="scene must be an oit.Scene, got NoneType"):
+    with pytest.raises(TypeError, match=r"scene must be an oit\.Scene, got NoneType"):
         r.render(None, IDENTITY)
 
 

@@ -81,7 +81,7 @@ def test_cli_writes_tables_and_plots(tmp_path, capsys):
 
 
 def test_unknown_method_is_named():
-    with pytest.raises(ValueError, match="unknown method.*hybird"):
+    with pytest.raises(ValueError, match=r"unknown method.*hybird"):
         bench.run(["glass"], ["hybird"], [8], quick=True, with_peers=False, show_progress=False)
 
 

@@ -158,4 +158,4 @@ def test_bench_quick_defaults_run_every_showcase_scene_and_method():
     plan = bench.method_plan(args.methods, args.quick)
     assert [method for method, _, _ in plan] == [m["name"] for m in oit.methods()]
     assert all(is_default for *_, is_default in plan)
-    assert dict((m, p) for m, p, _ in plan)["hybrid"] == {"k": 8}
+    assert {m: p for m, p, _ in plan}["hybrid"] == {"k": 8}

@@ -223,7 +223,7 @@ def bad_params(draw):
         return name, {extra: 1}, [extra]
     if kind == "range" and p["type"] == "int":
         value = draw(st.one_of(st.integers(-2 ** 62, p["min"] - 1), st.integers(p["max"] + 1, 2 ** 62), st.just(10 ** 6)
-                               if 10 ** 6 > p["max"] else st.just(p["min"] - 1)))
+                               if p["max"] < 10 ** 6 else st.just(p["min"] - 1)))
         return name, {p["name"]: value}, [p["name"]]
     if kind == "range" and p["type"] == "choice":
         value = draw(st.text(max_size=6).filter(lambda s: s not in p["choices"]))

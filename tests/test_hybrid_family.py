@@ -94,8 +94,8 @@ def quads(layers, size=4):
 
 
 def composite_model(layers, method, **params):
-    z = np.array([l[0] for l in layers])
-    rgba = np.array([l[1] for l in layers], np.float64)
+    z = np.array([layer[0] for layer in layers])
+    rgba = np.array([layer[1] for layer in layers], np.float64)
     return models.MODELS[method](z, rgba[:, :3], rgba[:, 3], BG, **params)
 
 

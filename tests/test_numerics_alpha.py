@@ -10,8 +10,21 @@ import numpy as np
 import pytest
 
 import oit
-from numerics import (BG, BIT_ORDER_INDEPENDENT, EXACT, NAMES, RANDOMIZED, assert_within_error_bound, color_quantum,
-                      expected, expected_image, full_screen_layers, layer_arrays, params_for, tolerance)
+from numerics import (
+    BG,
+    BIT_ORDER_INDEPENDENT,
+    EXACT,
+    NAMES,
+    RANDOMIZED,
+    assert_within_error_bound,
+    color_quantum,
+    expected,
+    expected_image,
+    full_screen_layers,
+    layer_arrays,
+    params_for,
+    tolerance,
+)
 from scenes import IDENTITY
 
 DEPTHS = (0.7, 0.4, 0.1, 0.55)  # submission order, neither front to back nor back to front
@@ -45,7 +58,7 @@ def test_gpu_matches_model_at_alpha_extremes(renderer, name, case):
     assert_within_error_bound(frame, expected_image(EXACT[0], *SIZE, *layer_arrays(ls), BG))
     if want is None:
         pytest.skip(f"no CPU model of {name}")
-    z, rgb, a = layer_arrays(ls)
+    _, _, a = layer_arrays(ls)
     err = np.abs(frame.image.astype(np.float64) - want).max()
     assert err <= tolerance(name, len(ls), mass=a.sum()), (name, case, frame.image[0, 0], want)
 
@@ -57,7 +70,7 @@ def test_alpha_zero_everywhere_is_the_background_exactly(renderer, name):
     assert np.array_equal(frame.image[..., :3], np.broadcast_to(F32_BG, (*SIZE[::-1], 3))), frame.image[0, 0]
     assert (frame.image[..., 3] == 0).all()
     # In front of an opaque surface: that surface, exactly, with coverage 1.
-    scene = full_screen_layers(layers(ALPHAS["zero"]) + [(0.9, (0.25, 0.5, 0.75, 1.0))], opaque=[4])
+    scene = full_screen_layers([*layers(ALPHAS["zero"]), (0.9, (0.25, 0.5, 0.75, 1.0))], opaque=[4])
     frame = render(renderer, name, scene)
     assert np.array_equal(frame.image, np.broadcast_to(np.float32([0.25, 0.5, 0.75, 1.0]), (*SIZE[::-1], 4)))
 

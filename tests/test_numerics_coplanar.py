@@ -17,8 +17,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from numerics import (BG, BIT_ORDER_INDEPENDENT, EXACT, NAMES, SUBMISSION_TIES, SUM_ORDER_INDEPENDENT,
-                      exact_in_submission_order, expected, layer_arrays, params_for, tolerance)
+from numerics import (
+    BG,
+    BIT_ORDER_INDEPENDENT,
+    EXACT,
+    NAMES,
+    SUBMISSION_TIES,
+    SUM_ORDER_INDEPENDENT,
+    exact_in_submission_order,
+    expected,
+    layer_arrays,
+    params_for,
+    tolerance,
+)
 from scenes import IDENTITY, MeshData, build_scene, layer, random_meshes
 
 SIZE = (16, 16)
@@ -29,11 +40,9 @@ COLORS = [(1, 0, 0, 0.5), (0, 1, 0, 0.5), (0, 0, 1, 0.25), (1, 1, 0, 0.75), (0.2
 
 def full_screen(kind):
     """(z, rgba) layers: six coplanar ones between two others."""
-    if kind == "equal":
-        zs = [0.5] * len(COLORS)
-    else:  # distinct float32 depths within 6 x 2^-26 < 2^-23: one or two 24-bit keys
-        zs = [Z_NEAR + i * STEP for i in range(len(COLORS))]
-    return [(0.1, (0.3, 0.3, 0.3, 0.3))] + list(zip(zs, COLORS)) + [(0.9, (0.9, 0.1, 0.5, 0.6))]
+    # "distinct": float32 depths within 6 x 2^-26 < 2^-23, so one or two 24-bit keys.
+    zs = [0.5] * len(COLORS) if kind == "equal" else [Z_NEAR + i * STEP for i in range(len(COLORS))]
+    return [(0.1, (0.3, 0.3, 0.3, 0.3)), *list(zip(zs, COLORS)), (0.9, (0.9, 0.1, 0.5, 0.6))]
 
 
 def random_coplanar(kind, seed=5):

@@ -10,9 +10,21 @@ import numpy as np
 import pytest
 
 import oit
+from numerics import (
+    BG,
+    BOUNDED,
+    EXACT,
+    INFO,
+    NAMES,
+    PER_LAYER,
+    assert_within_error_bound,
+    expected_overflow,
+    params_for,
+    render_or_limit,
+    stacks,
+    tolerance,
+)
 from oit.formulas import memory_bytes
-from numerics import (BG, BOUNDED, EXACT, INFO, NAMES, PER_LAYER, assert_within_error_bound, expected_overflow,
-                      params_for, render_or_limit, stacks, tolerance)
 
 DEPTHS = [1, 32, 33, 300, 4000]
 REGIMES = {

@@ -13,9 +13,20 @@ import numpy as np
 import pytest
 
 import oit
+from numerics import (
+    BG,
+    EXACT,
+    INFO,
+    NAMES,
+    assert_within_error_bound,
+    expected_overflow,
+    full_screen_layers,
+    params_for,
+    render_or_limit,
+    stacks,
+    tolerance,
+)
 from oit.formulas import HYBRID_ACCUM_WORDS, memory_bytes
-from numerics import (BG, EXACT, INFO, NAMES, assert_within_error_bound, expected_overflow, full_screen_layers,
-                      params_for, render_or_limit, stacks, tolerance)
 from scenes import IDENTITY, build_scene, random_meshes
 
 SIZES = [(1, 1), (7, 3), (3, 7), (33, 17), (64, 1), (1, 64)]

@@ -4,8 +4,9 @@ messages that name the argument and say what to do."""
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -103,7 +104,7 @@ class Scene:
         return self._native.triangle_count
 
     @classmethod
-    def from_trimesh(cls, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False) -> "Scene":
+    def from_trimesh(cls, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False) -> Scene:
         """A scene from a trimesh Trimesh or Scene. Colors come from vertex colors, face
         colors or material alpha when present (sRGB 8-bit colors are linearized); `color`
         (RGB or RGBA) and `alpha` override them."""
@@ -211,7 +212,7 @@ class Camera:
 
     @classmethod
     def look_at(cls, eye: Sequence[float], target: Sequence[float], fov_y: float = 45.0, near: float = 0.1,
-                far: float = 100.0, up: Sequence[float] = (0.0, 1.0, 0.0), aspect: float = 1.0) -> "Camera":
+                far: float = 100.0, up: Sequence[float] = (0.0, 1.0, 0.0), aspect: float = 1.0) -> Camera:
         """Right-handed perspective camera; fov_y in degrees; depth 0 at `near`, 1 at `far`."""
         if not (0.0 < fov_y < 180.0):
             raise ValueError(f"fov_y must be in (0, 180) degrees, got {fov_y}")
@@ -229,7 +230,7 @@ class Camera:
     @classmethod
     def orthographic(cls, left: float, right: float, bottom: float, top: float, near: float, far: float,
                      eye: Sequence[float] | None = None, target: Sequence[float] | None = None,
-                     up: Sequence[float] = (0.0, 1.0, 0.0)) -> "Camera":
+                     up: Sequence[float] = (0.0, 1.0, 0.0)) -> Camera:
         """Orthographic projection of the view volume (right-handed: looking down -z),
         optionally placed with eye/target."""
         if right == left or top == bottom or far == near:
@@ -243,7 +244,7 @@ class Camera:
 
     @classmethod
     def fit(cls, positions: np.ndarray, direction: Sequence[float] = (0.3, 0.35, 1.0), fov_y: float = 40.0,
-            aspect: float = 1.0) -> "Camera":
+            aspect: float = 1.0) -> Camera:
         """A perspective camera that frames the given points' bounding sphere."""
         p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
         center = (p.min(0) + p.max(0)) / 2 if len(p) else np.zeros(3)
@@ -251,7 +252,8 @@ class Camera:
         d = np.asarray(direction, dtype=np.float64)
         d /= np.linalg.norm(d)
         dist = radius / np.sin(np.radians(fov_y) / 2) * 1.05
-        return cls.look_at(center + d * dist, center, fov_y, near=max(dist - radius * 1.5, dist * 1e-3), far=dist + radius * 1.5, aspect=aspect)
+        near, far = max(dist - radius * 1.5, dist * 1e-3), dist + radius * 1.5
+        return cls.look_at(center + d * dist, center, fov_y, near=near, far=far, aspect=aspect)
 
 
 @dataclass

@@ -23,14 +23,17 @@ import os
 import statistics
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterator
+from functools import partial
+from typing import Any, Callable
 
 import numpy as np
 
 from . import formulas, peers
 from . import scenes as scene_lib
-from ._api import Renderer, methods as list_methods
+from ._api import Renderer
+from ._api import methods as list_methods
 from .imageio import linear_to_srgb
 
 # Values tried for integer parameters (k, nodes, samples, layers), clipped to the declared range.
@@ -156,7 +159,7 @@ def format_params(params: Params) -> str:
 def _row(scene: str, size: str, method: str, params: Params, **values: Any) -> dict:
     row = {"scene": scene, "size": size, "method": method, "params": format_params(params),
            "status": "ok", "gpu_ms": math.nan, "wall_ms": math.nan, "memory_mib": math.nan, "formula_mib": math.nan,
-           "fragments": math.nan, "max_depth": math.nan, "overflow": math.nan, **{e: math.nan for e in ERRORS},
+           "fragments": math.nan, "max_depth": math.nan, "overflow": math.nan, **dict.fromkeys(ERRORS, math.nan),
            "adapter": "", "message": ""}
     row.update(values)
     # Other work on the machine skews times: the CSV keeps the 1-minute load average at each row.
@@ -248,7 +251,7 @@ def _run_scene(result: Result, scene_name: str, built: scene_lib.BuiltScene, ren
     for method, params, is_default in plan:
         progress.show(f"{scene_name} {size} {method} {' '.join(map(str, params.values()))}")
         try:
-            frame, gpu, wall = timed(lambda: renderer.render(built.scene, built.camera, method, **params), repeat)
+            frame, gpu, wall = timed(partial(renderer.render, built.scene, built.camera, method, **params), repeat)
         except (RuntimeError, MemoryError, ValueError) as e:
             rows.append(_row(scene_name, size, method, params, status="failed", adapter=adapter, message=str(e).splitlines()[0]))
             progress.step(method)
@@ -291,7 +294,7 @@ def _peer_row(scene_name: str, built: scene_lib.BuiltScene, w: int, h: int, libr
         for _ in range(repeat):
             image, ms = peer.render(built, mode)
             wall.append(ms)
-    except Exception as e:  # noqa: BLE001 - a third-party renderer fails in its own ways; the row says how
+    except Exception as e:  # a third-party renderer fails in its own ways; the row says how
         return _row(scene_name, f"{w}x{h}", label, {}, status="failed", message=f"{type(e).__name__}: {e}".splitlines()[0])
     row = _row(scene_name, f"{w}x{h}", label, {}, wall_ms=statistics.median(wall), adapter=peer.adapter)
     if exact is not None:
@@ -346,7 +349,7 @@ COLUMNS = [
 
 
 def _cell(value: Any, fmt: str) -> str:
-    if value is None or isinstance(value, float) and math.isnan(value):
+    if value is None or (isinstance(value, float) and math.isnan(value)):
         return ""
     return fmt.format(value)
 

@@ -8,7 +8,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+from collections.abc import Sequence
+from typing import Any, Callable
 
 EXIT_USAGE = 2
 
@@ -38,7 +39,7 @@ def _unit_float(text: str) -> float:
     return v
 
 
-def parse_param(text: str) -> Tuple[str, Any]:
+def parse_param(text: str) -> tuple[str, Any]:
     """'k=v' to (k, v) with v an int, else a float, else the string."""
     key, sep, value = text.partition("=")
     if not sep or not key:
@@ -103,7 +104,7 @@ def _render(args: argparse.Namespace) -> int:
     scene = Scene.from_trimesh(mesh, alpha=args.alpha)
     width, height = args.size
     camera = Camera.fit(mesh.vertices, aspect=width / height)
-    params: Dict[str, Any] = dict(args.param)
+    params: dict[str, Any] = dict(args.param)
     frame = Renderer(width, height, adapter=args.adapter).render(
         scene, camera, method=args.method, background=tuple(args.background), **params
     )
@@ -130,7 +131,7 @@ def _add_methods(p: argparse.ArgumentParser) -> None:
     pass
 
 
-def format_methods(methods: List[dict]) -> str:
+def format_methods(methods: list[dict]) -> str:
     """The method table (name, exact, bounded memory, parameters), then each method's
     summary and passes."""
 
@@ -203,7 +204,7 @@ def _view(args: argparse.Namespace) -> int:
         view.export_scene(args.scene, args.export)
         print(f"wrote {args.export}")
         return 0
-    extra: List[str] = []
+    extra: list[str] = []
     for flag, value in (("--method", args.method), ("--alpha", args.alpha), ("--screenshot", args.screenshot),
                         ("--frames", args.frames), ("--compare", args.compare), ("--view", args.view),
                         ("--size", args.size), ("--adapter", args.adapter)):
@@ -214,7 +215,7 @@ def _view(args: argparse.Namespace) -> int:
     return view.run(args.files, scene=args.scene, extra=extra)
 
 
-Subcommand = Tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]
+Subcommand = tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]
 
 SUBCOMMANDS: Sequence[Subcommand] = (
     ("demo", "render the built-in scene with every blending method and their errors into one PNG", _add_demo, _demo),
@@ -235,7 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

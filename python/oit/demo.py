@@ -9,7 +9,6 @@ largest over RGB. All heatmaps share one scale (black 0, white the largest error
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Dict, Optional, Tuple
 
 import numpy as np
 
@@ -29,7 +28,7 @@ SPHERES = (
 SPHERE_RADIUS = 0.7
 
 
-def demo_scene(detail: int = 24) -> Tuple[Scene, Camera]:
+def demo_scene(detail: int = 24) -> tuple[Scene, Camera]:
     """The demo scene and its camera (square aspect). `detail` is the sphere's ring count."""
     scene = Scene()
     for center, rgba in SPHERES:
@@ -48,9 +47,9 @@ def demo_scene(detail: int = 24) -> Tuple[Scene, Camera]:
 
 @dataclass
 class DemoResult:
-    frames: Dict[str, Frame]
+    frames: dict[str, Frame]
     # Per method: |method - abuffer| (for abuffer: |abuffer - reference| off ambiguous pixels).
-    errors: Dict[str, np.ndarray]
+    errors: dict[str, np.ndarray]
     reference_max_error: float
     ambiguous_fraction: float
     # The error shown white in the heatmaps.
@@ -58,7 +57,7 @@ class DemoResult:
     mosaic: np.ndarray
 
 
-def run(size: int = 384, adapter: Optional[str] = None) -> DemoResult:
+def run(size: int = 384, adapter: str | None = None) -> DemoResult:
     """Renders the demo at `size` x `size` and compares every method with abuffer."""
     scene, camera = demo_scene()
     renderer = Renderer(size, size, adapter=adapter)

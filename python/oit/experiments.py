@@ -10,15 +10,15 @@ from __future__ import annotations
 import math
 import os
 import statistics
+from functools import partial
 from typing import Any, Callable
 
 import numpy as np
 
 from . import scenes as scene_lib
-from ._api import Camera, methods as list_methods
-from .bench import (Params, Progress, Result, format_params, image_errors, mean_rgb_distance, method_plan, scene_jobs,
-                    timed)
-
+from ._api import Camera
+from ._api import methods as list_methods
+from .bench import Params, Progress, Result, format_params, image_errors, mean_rgb_distance, method_plan, scene_jobs, timed
 
 # ---- temporal stability: a slow camera orbit, each method's change between frames against abuffer's
 
@@ -78,7 +78,7 @@ def temporal(scenes: list[str], methods: list[str] | None = None, sizes: list[in
     for scene_name, built, renderer in scene_jobs(scenes, sizes, quick):
         size, adapter = f"{renderer.width}x{renderer.height}", renderer.adapter_info["name"]
         cameras = orbit(built, frames, step_deg)
-        row = lambda method, params, **v: _temporal_row(scene_name, size, method, params, frames, step_deg, adapter, **v)  # noqa: E731
+        row = partial(_temporal_row, scene_name, size, frames=frames, step_deg=step_deg, adapter=adapter)
         progress.show(f"{scene_name} {size} abuffer")
         try:
             exact_frames = [renderer.render(built.scene, c, "abuffer") for c in cameras]
@@ -155,7 +155,7 @@ def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances:
     progress = Progress(len(scenes) * len(sizes or [None]) * (1 + 2 * len(tolerances)), show_progress)
     for scene_name, built, renderer in scene_jobs(scenes, sizes, quick):
         size, adapter = f"{renderer.width}x{renderer.height}", renderer.adapter_info["name"]
-        render = lambda method, **p: renderer.render(built.scene, built.camera, method, **p)  # noqa: E731
+        render = partial(renderer.render, built.scene, built.camera)
         progress.show(f"{scene_name} {size} abuffer")
         try:
             exact_frame = render("abuffer")
@@ -167,9 +167,9 @@ def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances:
         progress.step("abuffer")
         fixed_errors: dict[int, float] = {}  # k -> measured max error, shared by every t
 
-        def fixed_error(k: int) -> float:
+        def fixed_error(k: int, fixed_errors=fixed_errors, render=render, exact=exact, label=f"{scene_name} {size}") -> float:
             if k not in fixed_errors:
-                progress.show(f"{scene_name} {size} hybrid k={k} (search)")
+                progress.show(f"{label} hybrid k={k} (search)")
                 fixed_errors[k] = max_abs_error(render("hybrid", k=k).image, exact)
             return fixed_errors[k]
 
@@ -178,7 +178,7 @@ def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances:
                    "message": ""}
             progress.show(f"{scene_name} {size} auto t={t:.4g}")
             try:
-                frame, gpu, wall = timed(lambda: render("auto", tolerance=t), repeat)
+                frame, gpu, wall = timed(partial(render, "auto", tolerance=t), repeat)
                 row.update(_measured("auto", frame, gpu, wall, exact, covered))
                 row.update({key: frame.stats.get(key, math.nan) for key in AUTO_STATS})
                 row["within_t"] = row["auto_max_abs"] <= t
@@ -187,7 +187,7 @@ def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances:
                 row["fixed_k"] = "none" if k is None else k
                 if k is not None:
                     progress.show(f"{scene_name} {size} hybrid k={k} (timed)")
-                    row.update(_measured("fixed", *timed(lambda: render("hybrid", k=k), repeat), exact, covered))
+                    row.update(_measured("fixed", *timed(partial(render, "hybrid", k=k), repeat), exact, covered))
                     for what in ("gpu_ms", "wall_ms", "mib"):
                         row[f"{what}_ratio"] = row[f"auto_{what}"] / row[f"fixed_{what}"]
                 progress.step("hybrid")
@@ -202,7 +202,7 @@ def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances:
 AUTO_STATS = ("auto_k", "auto_mean_k", "auto_slots", "auto_predicted_k", "auto_exact", "auto_attempts", "error_bound_max")
 _AUTO_EMPTY = {**{f"{who}_{what}": math.nan for who in ("auto", "fixed") for what in
                   ("gpu_ms", "wall_ms", "mib", "max_abs", "max_err", "max_err_all", "mean_err")},
-               **{key: math.nan for key in AUTO_STATS}, "within_t": None, "fixed_k": "",
+               **dict.fromkeys(AUTO_STATS, math.nan), "within_t": None, "fixed_k": "",
                "gpu_ms_ratio": math.nan, "wall_ms_ratio": math.nan, "mib_ratio": math.nan}
 
 
@@ -269,8 +269,8 @@ def antialias(scenes: list[str], methods: list[str] | None = None, sizes: list[i
                        "status": "ok", "adapter": adapter, "message": "", **{c: math.nan for c, _ in AA_COLUMNS[5:]}}
                 progress.show(f"{scene_name} {size} {method} x{s_count} {mode}")
                 try:
-                    frame, gpu, wall = timed(lambda: renderer.render(built.scene, built.camera, method, antialias=s_count,
-                                                                     antialias_mode=mode), repeat)
+                    frame, gpu, wall = timed(partial(renderer.render, built.scene, built.camera, method, antialias=s_count,
+                                                   antialias_mode=mode), repeat)
                 except (RuntimeError, MemoryError, ValueError) as e:
                     row.update(status="failed", message=str(e).splitlines()[0])
                     result.rows.append(row)

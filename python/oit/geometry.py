@@ -7,15 +7,15 @@ degenerate, and every vertex is used.
 
 from __future__ import annotations
 
-from typing import Sequence, Tuple, Union
+from collections.abc import Sequence
 
 import numpy as np
 
-Mesh = Tuple[np.ndarray, np.ndarray]
+Mesh = tuple[np.ndarray, np.ndarray]
 Vec3 = Sequence[float]
 
 
-def _vec3(v: Union[float, Vec3], name: str) -> np.ndarray:
+def _vec3(v: float | Vec3, name: str) -> np.ndarray:
     a = np.asarray(v, dtype=np.float64)
     if a.shape == ():
         a = np.full(3, float(a))
@@ -24,7 +24,7 @@ def _vec3(v: Union[float, Vec3], name: str) -> np.ndarray:
     return a
 
 
-def _frame(normal: Vec3, up: Vec3) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _frame(normal: Vec3, up: Vec3) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """An orthonormal (right, up, normal) frame; `up` is made orthogonal to `normal`."""
     n = _vec3(normal, "normal")
     if np.linalg.norm(n) == 0:
@@ -48,7 +48,7 @@ def _out(positions: np.ndarray, indices: np.ndarray) -> Mesh:
     return np.ascontiguousarray(positions, dtype=np.float32), np.ascontiguousarray(indices, dtype=np.uint32)
 
 
-def quad(center: Vec3 = (0.0, 0.0, 0.0), size: Union[float, Sequence[float]] = (1.0, 1.0),
+def quad(center: Vec3 = (0.0, 0.0, 0.0), size: float | Sequence[float] = (1.0, 1.0),
          normal: Vec3 = (0.0, 0.0, 1.0), up: Vec3 = (0.0, 1.0, 0.0)) -> Mesh:
     """A rectangle of `size` (width along right, height along `up`) facing `normal`:
     4 vertices (bottom-left, bottom-right, top-right, top-left) and 2 triangles."""
@@ -63,7 +63,7 @@ def quad(center: Vec3 = (0.0, 0.0, 0.0), size: Union[float, Sequence[float]] = (
     return _out(positions, [[0, 1, 2], [0, 2, 3]])
 
 
-def box(center: Vec3 = (0.0, 0.0, 0.0), size: Union[float, Vec3] = 1.0) -> Mesh:
+def box(center: Vec3 = (0.0, 0.0, 0.0), size: float | Vec3 = 1.0) -> Mesh:
     """An axis-aligned box: 8 shared corners and 12 triangles."""
     c, s = _vec3(center, "center"), _vec3(size, "size")
     if not (s > 0).all():
@@ -129,7 +129,7 @@ def torus(center: Vec3 = (0.0, 0.0, 0.0), major_radius: float = 1.0, minor_radiu
     return _out(positions.reshape(-1, 3), tris)
 
 
-def blob(center: Vec3 = (0.0, 0.0, 0.0), size: Union[float, Vec3] = 1.0, bumps: float = 0.3, rings: int = 24,
+def blob(center: Vec3 = (0.0, 0.0, 0.0), size: float | Vec3 = 1.0, bumps: float = 0.3, rings: int = 24,
          segments: int = 48, seed: int = 0) -> Mesh:
     """A closed, non-convex lump: a uv_sphere whose radius is modulated by a few random
     low-frequency waves (amplitude `bumps`), then scaled by `size` per axis. It folds over

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import struct
 import zlib
+from collections.abc import Sequence
 from os import PathLike
-from typing import Sequence, Union
 
 import numpy as np
 
@@ -66,7 +66,7 @@ def encode_png(image: np.ndarray) -> bytes:
     return PNG_SIGNATURE + _chunk(b"IHDR", header) + _chunk(b"IDAT", zlib.compress(rows.tobytes(), 6)) + _chunk(b"IEND", b"")
 
 
-def write_png(path: Union[str, PathLike], image: np.ndarray) -> None:
+def write_png(path: str | PathLike, image: np.ndarray) -> None:
     """Writes `image` (see `encode_png`) to `path`."""
     data = encode_png(image)
     with open(path, "wb") as f:

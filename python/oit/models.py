@@ -288,6 +288,6 @@ def bucket_peeling(z, rgb, alpha, bg, bg_a=0.0, buckets=32):
     return _out(c, t, bg, bg_a)
 
 
-MODELS = {"abuffer": exact, "hybrid": hybrid, "hybrid64": hybrid64, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit, "adaptive": adaptive,
-          "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab,
+MODELS = {"abuffer": exact, "hybrid": hybrid, "hybrid64": hybrid64, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit,
+          "adaptive": adaptive, "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab,
           "bucket_peeling": bucket_peeling}

@@ -52,7 +52,8 @@ import os
 import subprocess
 import sys
 import time
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -134,7 +135,7 @@ class PygfxRenderer:
     def render(self, built: BuiltScene, mode: str, background: Sequence[float] = (1.0, 1.0, 1.0)) -> tuple[np.ndarray, float]:
         """(h, w, 4) float32 linear RGBA (A = 1: the background is opaque) and the wall time in
         milliseconds of the render and the readback."""
-        if mode not in PYGFX_MODES + ("solid",):
+        if mode not in (*PYGFX_MODES, "solid"):
             raise ValueError(f"unknown pygfx alpha mode '{mode}'; choose one of {', '.join(PYGFX_MODES)}")
         scene = self._scene(built, mode, background)
         camera = _matrix_camera(built.camera.view_proj)

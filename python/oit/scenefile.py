@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import os
 import struct
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Optional, Sequence, Tuple, Union
+from typing import Any, Union
 
 import numpy as np
 
@@ -35,9 +36,9 @@ class LookAt:
     """A perspective camera by its placement, which the viewer can re-aim and fit to any
     window shape (a matrix fixes the aspect ratio it was made for)."""
 
-    eye: Tuple[float, float, float]
-    target: Tuple[float, float, float]
-    up: Tuple[float, float, float] = (0.0, 1.0, 0.0)
+    eye: tuple[float, float, float]
+    target: tuple[float, float, float]
+    up: tuple[float, float, float] = (0.0, 1.0, 0.0)
     fov_y: float = 45.0
     near: float = 0.1
     far: float = 100.0
@@ -49,8 +50,8 @@ class LookAt:
 SceneLike = Union[BuiltScene, Sequence[MeshArrays]]
 
 
-def save_scene(scene: SceneLike, path: Union[str, os.PathLike], camera: Union[Camera, LookAt, None] = None,
-               size: Optional[Tuple[int, int]] = None, names: Optional[Sequence[str]] = None) -> None:
+def save_scene(scene: SceneLike, path: str | os.PathLike, camera: Camera | LookAt | None = None,
+               size: tuple[int, int] | None = None, names: Sequence[str] | None = None) -> None:
     """Writes `scene` (a BuiltScene or a list of MeshArrays) with `camera` (default: the
     BuiltScene's) and `size` (default: the BuiltScene's) to `path`."""
     if isinstance(scene, Scene):
@@ -87,9 +88,10 @@ def save_scene(scene: SceneLike, path: Union[str, os.PathLike], camera: Union[Ca
         f.write(b"".join(out))
 
 
-def load_scene(path: Union[str, os.PathLike]) -> Tuple[list, Any, Optional[Tuple[int, int]]]:
+def load_scene(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | None]:
     """Reads a scene file back: (meshes as MeshArrays, Camera or LookAt or None, size or None)."""
-    data = open(path, "rb").read()
+    with open(path, "rb") as f:
+        data = f.read()
     if data[:8] != MAGIC:
         raise ValueError(f"{path}: not an oit scene file")
     at = 8

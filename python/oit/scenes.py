@@ -6,9 +6,10 @@ what was generated (`meta`). `SCENES` maps names to the functions the benchmark 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator, Optional, Sequence, Union
+from typing import Any
 
 import numpy as np
 
@@ -110,7 +111,7 @@ def stacks(layers: int = 20, alphas: str = "random", size: tuple[int, int] = (10
     rank = np.empty((pixels, layers), np.int64)
     rank[pix, lay] = np.arange(len(order))
     per_pixel = np.argsort(rank, axis=1)
-    take = lambda a: np.take_along_axis(a, per_pixel if a.ndim == 2 else per_pixel[..., None], axis=1)
+    take = lambda a: np.take_along_axis(a, per_pixel if a.ndim == 2 else per_pixel[..., None], axis=1)  # noqa: E731
     meta = {"z": take(z), "rgb": take(rgb), "alpha": take(alpha), "layers": layers, "alphas": alphas}
     return from_meshes([mesh], Camera(np.eye(4)), (w, h), meta)
 
@@ -231,7 +232,7 @@ DRAGON_ALPHAS = (0.05, 0.1, 0.05, 0.1, 0.2, 0.9, 0.2, 0.1, 0.05, 0.1, 0.05) * 2
 DRAGON_FILE = "dragon-100k.obj"
 
 
-def shared_data_dir() -> Optional[Path]:
+def shared_data_dir() -> Path | None:
     """The optional mesh folder: $OIT_DATA when set, else the first `shared/data` found beside
     the working directory or the package (walking up from each), else None. An installed wheel
     lives in site-packages, far from the checkout, so the working directory is searched too."""
@@ -246,13 +247,13 @@ def shared_data_dir() -> Optional[Path]:
     return None
 
 
-def default_dragon_path() -> Optional[Path]:
+def default_dragon_path() -> Path | None:
     """shared_data_dir()/dragon-100k.obj when it exists, else None (the stand-in is used)."""
     folder = shared_data_dir()
     return folder / DRAGON_FILE if folder is not None and (folder / DRAGON_FILE).is_file() else None
 
 
-def _dragon_mesh(path: Union[str, os.PathLike, None], max_triangles: int) -> tuple[np.ndarray, np.ndarray, str]:
+def _dragon_mesh(path: str | os.PathLike | None, max_triangles: int) -> tuple[np.ndarray, np.ndarray, str]:
     """The dragon (or the stand-in blob) centered, longest side 1, decimated to max_triangles."""
     if path is not None:
         import trimesh
@@ -270,7 +271,7 @@ def _dragon_mesh(path: Union[str, os.PathLike, None], max_triangles: int) -> tup
     return p, indices, source
 
 
-def dragons(path: Union[str, os.PathLike, None] = "default", max_triangles: int = 8000) -> BuiltScene:
+def dragons(path: str | os.PathLike | None = "default", max_triangles: int = 8000) -> BuiltScene:
     """The hybrid paper's 22 aligned dragons with its opacities (DRAGON_ALPHAS), one after
     another along the view, each lit by a fixed light baked into its vertex colors. `path`:
     the mesh (anything trimesh loads); "default" uses dragon-100k.obj from shared_data_dir()

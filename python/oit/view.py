@@ -7,8 +7,8 @@ import os
 import shutil
 import subprocess
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
-from typing import List, Optional, Sequence
 
 BUILD_HELP = ("build it with `make viewer` (cargo build --release -p oit-viewer) in the oit repository, "
               "or put oit-viewer on PATH")
@@ -44,11 +44,11 @@ def export_scene(name: str, path: str) -> None:
     save_scene(scenes.SCENES[name](), path)
 
 
-def viewer_command(files: Sequence[str], extra: Sequence[str] = ()) -> List[str]:
+def viewer_command(files: Sequence[str], extra: Sequence[str] = ()) -> list[str]:
     return [str(find_viewer()), *files, *extra]
 
 
-def run(files: Sequence[str], scene: Optional[str] = None, extra: Sequence[str] = ()) -> int:
+def run(files: Sequence[str], scene: str | None = None, extra: Sequence[str] = ()) -> int:
     """Runs the viewer on `files` and the built-in `scene` (exported to a temporary file);
     returns its exit status."""
     for f in files:
