@@ -28,12 +28,13 @@ def _source_drift() -> tuple[list[str], list[str]]:
     source = REPO / "python" / "oit"
     installed = Path(oit.__file__).parent
     missing, differ = [], []
-    for f in sorted(source.glob("*.py")):
-        other = installed / f.name
+    for f in sorted(source.rglob("*.py")):
+        name = f.relative_to(source).as_posix()
+        other = installed / name
         if not other.exists():
-            missing.append(f.name)
+            missing.append(name)
         elif hashlib.sha256(f.read_bytes()).digest() != hashlib.sha256(other.read_bytes()).digest():
-            differ.append(f.name)
+            differ.append(name)
     return missing, differ
 
 

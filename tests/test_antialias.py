@@ -110,9 +110,9 @@ def test_every_exact_method_antialiases_to_the_same_image(renderer, method):
 
 
 def test_the_antialiasing_benchmark_reports_ratios_to_one_sample():
-    from oit import bench, experiments
+    from oit.bench import antialias, harness
 
-    result = experiments.antialias(["glass"], ["abuffer", "hybrid"], sizes=[16], samples=(4,), repeat=1, quick=True,
+    result = antialias.antialias(["glass"], ["abuffer", "hybrid"], sizes=[16], samples=(4,), repeat=1, quick=True,
                              show_progress=False)
     rows = {(r["method"], r["antialias"], r["mode"]): r for r in result.rows}
     assert set(rows) == {("abuffer", 1, "frames"), ("abuffer", 4, "frames"), ("abuffer", 4, "coverage"),
@@ -126,7 +126,7 @@ def test_the_antialiasing_benchmark_reports_ratios_to_one_sample():
     assert rows[("abuffer", 4)]["mean_err"] == 0.0 and rows[("abuffer", 4)]["mean_err_vs_finest"] == 0.0
     assert rows[("abuffer", 1)]["mean_err_vs_finest"] > 0.0
     assert rows[("hybrid", 4)]["mib_x1"] == 1.0
-    assert "| antialias |" in bench.markdown(result.rows, experiments.AA_COLUMNS).splitlines()[0]
+    assert "| antialias |" in harness.markdown(result.rows, antialias.AA_COLUMNS).splitlines()[0]
 
 
 # ---- antialias_mode="coverage": one multisampled capture, a sample mask per stored fragment

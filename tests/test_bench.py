@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 import oit
-from oit import bench, cli, experiments, formulas, geometry, peers, plots, scenes
+from oit import cli, formulas, geometry, peers, plots, scenes
+from oit.bench import auto, harness, results, temporal
 from oit.imageio import linear_to_srgb
 
 TINY = dict(scenes=["glass"], methods=["abuffer", "unsorted", "sorted", "hybrid", "wboit"], sizes=[32], repeat=1,
@@ -19,7 +20,7 @@ TINY = dict(scenes=["glass"], methods=["abuffer", "unsorted", "sorted", "hybrid"
 
 @pytest.fixture(scope="module")
 def tiny():
-    return bench.run(**TINY)
+    return results.run(**TINY)
 
 
 def by_method(rows):
@@ -54,13 +55,13 @@ def test_a_failing_method_gives_a_failed_row(monkeypatch):
         return real(self, scene, camera, method, **kw)
 
     monkeypatch.setattr(oit.Renderer, "render", render)
-    rows = by_method(bench.run(**TINY).rows)
+    rows = by_method(results.run(**TINY).rows)
     assert rows["hybrid"]["status"] == "failed"
     assert rows["hybrid"]["message"] == "adapter limit: too many layers for this adapter"
     assert math.isnan(rows["hybrid"]["mean_err"])
     assert rows["wboit"]["status"] == "ok"
-    assert "| hybrid | k=8 |" in bench.markdown(list(rows.values()))
-    assert "failed: adapter limit" in bench.markdown(list(rows.values()))
+    assert "| hybrid | k=8 |" in harness.markdown(list(rows.values()), results.COLUMNS)
+    assert "failed: adapter limit" in harness.markdown(list(rows.values()), results.COLUMNS)
 
 
 def test_cli_writes_tables_and_plots(tmp_path, capsys):
@@ -82,7 +83,7 @@ def test_cli_writes_tables_and_plots(tmp_path, capsys):
 
 def test_unknown_method_is_named():
     with pytest.raises(ValueError, match=r"unknown method.*hybird"):
-        bench.run(["glass"], ["hybird"], [8], quick=True, with_peers=False, show_progress=False)
+        results.run(["glass"], ["hybird"], [8], quick=True, with_peers=False, show_progress=False)
 
 
 def test_sweep_follows_the_declared_ranges():
@@ -92,14 +93,14 @@ def test_sweep_follows_the_declared_ranges():
         {"name": "t", "type": "float", "min": 0.0, "max": 1.0, "default": 0.5},
         {"name": "seed", "type": "int", "min": 0, "max": 2 ** 32 - 1, "default": 0},
     ]}
-    runs = bench.sweep(method)
+    runs = harness.sweep(method)
     base = {"k": 3, "w": "a", "t": 0.5, "seed": 0}
     assert base in runs and len(runs) == len({tuple(r.items()) for r in runs})
     assert sorted(r["k"] for r in runs if r["w"] == "a" and r["t"] == 0.5) == [2, 3, 4, 8]
     assert {r["w"] for r in runs} == {"a", "b"} and {r["t"] for r in runs} == {0.0, 0.5, 1.0}
     assert {r["seed"] for r in runs} == {0}
-    assert bench.sweep(method, quick=True) == [base]
-    assert bench.sweep({"name": "plain", "params": []}) == [{}]
+    assert harness.sweep(method, quick=True) == [base]
+    assert harness.sweep({"name": "plain", "params": []}) == [{}]
 
 
 def test_image_errors():
@@ -108,13 +109,13 @@ def test_image_errors():
     image[:2, :, :3] = 0.1  # the top half is off by 0.1 per channel
     covered = np.zeros((4, 4), bool)
     covered[:2] = True
-    e = bench.image_errors(image, exact, covered)
+    e = harness.image_errors(image, exact, covered)
     assert e["mean_err"] == pytest.approx(0.1 * math.sqrt(3)) == e["max_err"]
     assert e["mean_err_all"] == pytest.approx(0.05 * math.sqrt(3))
     assert e["rmse"] == pytest.approx(0.1) and e["psnr"] == pytest.approx(20.0)
-    assert bench.image_errors(exact, exact, covered)["psnr"] == math.inf
-    if bench.flip_missing() is None:
-        assert e["flip"] > 0 and bench.image_errors(exact, exact, covered)["flip"] == 0
+    assert harness.image_errors(exact, exact, covered)["psnr"] == math.inf
+    if harness.flip_missing() is None:
+        assert e["flip"] > 0 and harness.image_errors(exact, exact, covered)["flip"] == 0
     else:
         assert math.isnan(e["flip"])
 
@@ -170,7 +171,7 @@ def test_pygfx_blend_sorts_objects_back_to_front_as_sorted_does(renderer):
 
 @needs_pygfx
 def test_bench_puts_pygfx_rows_in_the_table():
-    rows = by_method(bench.run(**{**TINY, "methods": ["abuffer", "unsorted"], "with_peers": True}).rows)
+    rows = by_method(results.run(**{**TINY, "methods": ["abuffer", "unsorted"], "with_peers": True}).rows)
     for mode in peers.PYGFX_MODES:
         row = rows[f"pygfx-{mode}"]
         assert row["status"] == "ok" and row["wall_ms"] > 0 and row["mean_err"] >= 0, row
@@ -181,7 +182,7 @@ def test_bench_puts_pygfx_rows_in_the_table():
 
 def test_orbit_turns_about_the_scene_center():
     built = scenes.glass(detail=8)
-    cameras = experiments.orbit(built, frames=4, step_deg=2.0)
+    cameras = temporal.orbit(built, frames=4, step_deg=2.0)
     assert len(cameras) == 4 and np.array_equal(cameras[0].view_proj, built.camera.view_proj)
 
     def ndc(camera, p):
@@ -208,12 +209,12 @@ def test_frame_changes():
     for images in (offset, noisy):
         for im in images:
             im[0] = rng.uniform(0, 1, (6, 4))
-    ref = experiments.frame_changes(exact, exact, covered)
+    ref = temporal.frame_changes(exact, exact, covered)
     steps = [np.sqrt(((exact[t + 1][1:, :, :3] - exact[t][1:, :, :3]) ** 2).sum(-1)) for t in range(3)]
     assert ref["change"] == pytest.approx(np.mean(steps)) and ref["flicker"] == 0 == ref["max_flicker"]
-    still = experiments.frame_changes(offset, exact, covered)
+    still = temporal.frame_changes(offset, exact, covered)
     assert still["change"] == pytest.approx(ref["change"]) and still["flicker"] == pytest.approx(0, abs=1e-12)
-    flips = experiments.frame_changes(noisy, exact, covered)
+    flips = temporal.frame_changes(noisy, exact, covered)
     assert flips["flicker"] == pytest.approx(2 * eps * math.sqrt(3)) == flips["max_flicker"]
 
 
@@ -222,11 +223,11 @@ TEMPORAL_TINY = dict(scenes=["glass"], methods=["hybrid", "unsorted", "stochasti
 
 
 def test_temporal_rows():
-    result = experiments.temporal(**TEMPORAL_TINY, step_deg=1.0)
+    result = temporal.temporal(**TEMPORAL_TINY, step_deg=1.0)
     rows = by_method(result.rows)
     assert list(rows) == ["abuffer", "unsorted", "hybrid", "stochastic"]  # abuffer, then as in oit.methods()
     for r in rows.values():
-        assert set(r) >= {c for c, _ in experiments.TEMPORAL_COLUMNS}
+        assert set(r) >= {c for c, _ in temporal.TEMPORAL_COLUMNS}
         assert r["status"] == "ok" and r["size"] == "24x24" and r["frames"] == 3 and r["step_deg"] == 1.0
         assert r["change"] > 0 and r["flicker"] <= r["max_flicker"]
     assert rows["abuffer"]["change_ratio"] == 1 and rows["abuffer"]["flicker"] == 0 == rows["abuffer"]["flicker_ratio"]
@@ -237,7 +238,7 @@ def test_temporal_rows():
 
 def test_temporal_with_a_still_camera_sees_no_change():
     # Every method repeats its frame bit for bit (stochastic is seeded), so nothing changes.
-    for r in experiments.temporal(**TEMPORAL_TINY, step_deg=0.0).rows:
+    for r in temporal.temporal(**TEMPORAL_TINY, step_deg=0.0).rows:
         assert r["change"] == 0 and r["flicker"] == 0 and math.isnan(r["change_ratio"]), r["method"]
 
 
@@ -260,11 +261,11 @@ def test_smallest_k_scans_upward_and_stops_at_the_first():
     errors = {1: 0.5, 2: 0.1, 3: 0.3, 4: 0.05}  # not monotone in k, as hybrid's need not be
     asked = []
     error = lambda k: asked.append(k) or errors[k]  # noqa: E731
-    assert experiments.smallest_k(error, 0.2, max_k=4) == 2 and asked == [1, 2]
-    assert experiments.smallest_k(error, 0.06, max_k=4) == 4
-    assert experiments.smallest_k(error, 0.3, max_k=4) == 2
-    assert experiments.smallest_k(error, 0.01, max_k=4) is None
-    assert experiments.smallest_k(error, 0.06, max_k=3) is None
+    assert auto.smallest_k(error, 0.2, max_k=4) == 2 and asked == [1, 2]
+    assert auto.smallest_k(error, 0.06, max_k=4) == 4
+    assert auto.smallest_k(error, 0.3, max_k=4) == 2
+    assert auto.smallest_k(error, 0.01, max_k=4) is None
+    assert auto.smallest_k(error, 0.06, max_k=3) is None
 
 
 AUTO_TINY = dict(scenes=["glass"], sizes=[24], tolerances=(1 / 255, 16 / 255), repeat=1, max_k=8, quick=True,
@@ -272,16 +273,16 @@ AUTO_TINY = dict(scenes=["glass"], sizes=[24], tolerances=(1 / 255, 16 / 255), r
 
 
 def test_auto_against_fixed_k(renderer):
-    result = experiments.auto_vs_fixed(**AUTO_TINY)
+    result = auto.auto_vs_fixed(**AUTO_TINY)
     assert [r["tolerance"] for r in result.rows] == list(AUTO_TINY["tolerances"])
     built = scenes.glass()
     r24 = renderer(24, 24)
     exact = r24.render(built.scene, built.camera, "abuffer").image
-    measured = {k: experiments.max_abs_error(r24.render(built.scene, built.camera, "hybrid", k=k).image, exact)
+    measured = {k: auto.max_abs_error(r24.render(built.scene, built.camera, "hybrid", k=k).image, exact)
                 for k in range(1, AUTO_TINY["max_k"] + 1)}
     for row in result.rows:
         t = row["tolerance"]
-        assert set(row) >= {c for c, _ in experiments.AUTO_COLUMNS} and row["status"] == "ok"
+        assert set(row) >= {c for c, _ in auto.AUTO_COLUMNS} and row["status"] == "ok"
         # auto's promise: every channel of every pixel within t of the exact image.
         assert row["within_t"] is True and row["auto_max_abs"] <= t
         assert row["auto_max_err"] <= row["auto_max_err_all"] and row["auto_mib"] > 0

@@ -12,7 +12,8 @@ import pytest
 import trimesh
 
 import oit
-from oit import bench, cli, scenes
+from oit import cli, scenes
+from oit.bench import harness
 
 
 def run_oit(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -155,7 +156,7 @@ def test_bench_quick_defaults_run_every_showcase_scene_and_method():
     # What `bench --quick` would run, without running it (that takes half a minute).
     args = cli.build_parser().parse_args(["bench", "--quick"])
     assert args.scenes == list(scenes.SHOWCASE) and args.methods is None and args.sizes is None
-    plan = bench.method_plan(args.methods, args.quick)
+    plan = harness.method_plan(args.methods, args.quick)
     assert [method for method, _, _ in plan] == [m["name"] for m in oit.methods()]
     assert all(is_default for *_, is_default in plan)
     assert {m: p for m, p, _ in plan}["hybrid"] == {"k": 8}

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import pytest
 
-from oit.bench import FIGURE7_KS as KS
-from oit.bench import figure7_errors
+from oit.bench.figure7 import FIGURE7_KS as KS
+from oit.bench.figure7 import figure7_errors
 
 SIZE = (20, 20)  # 400 stacks per configuration
 

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 import oit
-from oit import bench, geometry, peers, scenes
+from oit import geometry, peers, scenes
+from oit.bench import results
 
 needs_vtk = pytest.mark.skipif(peers.vtk_missing() is not None, reason=str(peers.vtk_missing()))
 # Not square, so that a transposed matrix or a lost aspect ratio shows.
@@ -98,7 +99,7 @@ def test_a_vtk_row_fails_when_vtk_does_not_peel(monkeypatch):
         vtk.render(built, "depth_peeling")
     exact = np.ones((H, W, 4), np.float32)
     sheet: dict = {}
-    row = bench._peer_row("quads", built, W, H, "vtk", "depth_peeling", 1, exact, np.ones((H, W), bool), sheet)
+    row = results._peer_row("quads", built, W, H, "vtk", "depth_peeling", 1, exact, np.ones((H, W), bool), sheet)
     assert row["status"] == "failed" and "did not use depth peeling" in row["message"], row
     assert math.isnan(row["wall_ms"]) and math.isnan(row["mean_err"]) and "vtk-depth_peeling" not in sheet
     # An opaque scene has nothing to peel: VTK says it did not, and that is no failure.
@@ -109,14 +110,14 @@ def test_a_vtk_row_fails_when_vtk_does_not_peel(monkeypatch):
 @needs_vtk
 def test_bench_puts_vtk_rows_in_the_table():
     tiny = dict(scenes=["glass"], methods=["abuffer", "unsorted"], sizes=[32], repeat=1, quick=True, show_progress=False)
-    rows = {r["method"]: r for r in bench.run(**tiny, with_peers=True).rows}
+    rows = {r["method"]: r for r in results.run(**tiny, with_peers=True).rows}
     for mode in peers.VTK_MODES:
         row = rows[f"vtk-{mode}"]
         assert row["status"] == "ok" and row["wall_ms"] > 0 and row["mean_err"] >= 0, row
         assert row["adapter"].startswith("VTK ") and math.isnan(row["gpu_ms"])
     # Peeling is exact but for 8-bit rounding; blending in actor order is not.
     assert rows["vtk-depth_peeling"]["mean_err"] < 0.01 < rows["vtk-blend"]["mean_err"]
-    without = bench.run(**tiny, with_peers=False)
+    without = results.run(**tiny, with_peers=False)
     assert not [r for r in without.rows if r["method"].startswith(("vtk-", "pygfx-"))]
     assert not [n for n in without.notes if "vtk" in n or "pygfx" in n]
 
@@ -142,7 +143,7 @@ def test_bench_notes_why_vtk_rows_are_missing(monkeypatch):
     """Where VTK cannot render, the sweep runs without its rows and says why (needs no VTK)."""
     for library, (modes, _, make) in list(peers.PEERS.items()):
         monkeypatch.setitem(peers.PEERS, library, (modes, lambda lib=library: f"{lib} left out here", make))
-    result = bench.run(scenes=["glass"], methods=["unsorted"], sizes=[16], repeat=1, quick=True, show_progress=False)
+    result = results.run(scenes=["glass"], methods=["unsorted"], sizes=[16], repeat=1, quick=True, show_progress=False)
     assert [r["method"] for r in result.rows] == ["unsorted"]
     assert "vtk rows are missing: vtk left out here" in result.notes
     assert "pygfx rows are missing: pygfx left out here" in result.notes

@@ -163,15 +163,15 @@ def _methods(args: argparse.Namespace) -> int:
 
 
 def _add_bench(p: argparse.ArgumentParser) -> None:
-    from . import bench
+    from .bench import cli as bench_cli
 
-    bench.add_arguments(p)
+    bench_cli.add_arguments(p)
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from . import bench
+    from .bench import cli as bench_cli
 
-    return bench.run_cli(args)
+    return bench_cli.run_cli(args)
 
 
 # ---- view

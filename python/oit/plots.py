@@ -133,7 +133,7 @@ def image_sheet(images: dict[str, np.ndarray], title: str, path: str) -> None:
 
 
 def write_all(result: Any, out: str) -> list[str]:
-    """The trade-off plot and the image sheet of every scene and size of a bench.Result, as
+    """The trade-off plot and the image sheet of every scene and size of an oit.bench.harness.Result, as
     PNGs in `out`; returns their paths."""
     paths = []
     for scene, size in dict.fromkeys((r["scene"], r["size"]) for r in result.rows):
@@ -154,7 +154,7 @@ TEMPORAL_CLIP = 4.0  # bars of the temporal figure stop here, with their value w
 
 
 def temporal(rows: list[dict], path: str, columns: int = 3) -> None:
-    """The temporal-stability figure of experiments.temporal: one panel per scene and size, a pair of
+    """The temporal-stability figure of oit.bench.temporal.temporal: one panel per scene and size, a pair of
     bars per method — its mean change between consecutive frames and its flicker (the change
     of its error), both over abuffer's change — with abuffer's change (1) as a dashed line.
     A method that follows the motion exactly has bars at 1 and 0."""

@@ -1,0 +1,113 @@
+"""The bench's command line (`python -m oit bench`, also `python -m oit.bench`): the main sweep
+(oit.bench.results) or, instead of it, the experiments (--temporal, --auto, --antialias), and
+the tables and plots they write into --out."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+
+from .. import scenes as scene_lib
+from .antialias import AA_COLUMNS, AA_METHODS, AA_SAMPLES, antialias
+from .auto import AUTO_COLUMNS, AUTO_MAX_K, AUTO_TOLERANCES, auto_vs_fixed
+from .figure7 import figure7_table
+from .harness import QUICK_SIZE, write_tables
+from .results import COLUMNS, run
+from .temporal import TEMPORAL_COLUMNS, TEMPORAL_FRAMES, TEMPORAL_STEP_DEG, temporal
+
+
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("--scenes", nargs="+", default=list(scene_lib.SHOWCASE), choices=sorted(scene_lib.SCENES),
+                    help="scenes to run (default: %(default)s)")
+    ap.add_argument("--methods", nargs="+", default=None,
+                    help="methods to run (default: every method of `oit methods`; with --temporal every approximate one)")
+    ap.add_argument("--sizes", type=int, nargs="+", default=None, help="square frame sizes (default: each scene's own)")
+    ap.add_argument("--repeat", type=int, default=5, help="timed renders per row after one warm-up (median)")
+    ap.add_argument("--out", default="out/bench", help="directory for the tables and the plots")
+    ap.add_argument("--quick", action="store_true",
+                    help=f"default parameters only, one timed render, frames of at most {QUICK_SIZE} pixels: a smoke test")
+    ap.add_argument("--no-peers", action="store_true", help="skip the peers (pygfx, VTK) even when installed")
+    ap.add_argument("--no-plots", action="store_true", help="skip the matplotlib plots")
+    ap.add_argument("--figure7", action="store_true", help="also run the hybrid paper's Figure 7 experiment (400 stacks)")
+    ap.add_argument("--temporal", action="store_true",
+                    help="instead of the method sweep: the change between frames of a slow camera orbit, each approximate "
+                         "method against abuffer (temporal.csv, temporal.md, temporal.png)")
+    ap.add_argument("--frames", type=int, default=TEMPORAL_FRAMES, help="--temporal: frames of the orbit (default: %(default)s)")
+    ap.add_argument("--step", type=float, default=TEMPORAL_STEP_DEG,
+                    help="--temporal: degrees the camera turns a frame (default: %(default)s)")
+    ap.add_argument("--auto", action="store_true",
+                    help="instead of the method sweep: auto against the cheapest fixed-k hybrid that meets each tolerance, "
+                         "found by search (auto.csv, auto.md)")
+    ap.add_argument("--tolerances", type=float, nargs="+", default=list(AUTO_TOLERANCES),
+                    help="--auto: tolerances (default: 1/255 4/255 16/255)")
+    ap.add_argument("--max-k", type=int, default=AUTO_MAX_K, help="--auto: the largest k searched (default: %(default)s)")
+    ap.add_argument("--antialias", action="store_true",
+                    help="run the antialiasing benchmark instead: time and memory of each method (default: "
+                         f"{', '.join(AA_METHODS)}) at --aa-samples samples a pixel against one (antialias.csv, .md)")
+    ap.add_argument("--aa-samples", type=int, nargs="+", default=list(AA_SAMPLES),
+                    help="--antialias: samples a pixel to measure (default: %(default)s; 1 is always added)")
+
+
+def _plots_missing(a: argparse.Namespace) -> bool:
+    """True (and says why) when the plots are to be skipped."""
+    if a.no_plots:
+        return True
+    from .. import plots
+
+    missing = plots.matplotlib_missing()
+    if missing:
+        print(f"note: no plots: {missing}")
+    return missing is not None
+
+
+def run_cli(a: argparse.Namespace) -> int:
+    repeat = 1 if a.quick else max(1, a.repeat)
+    if a.temporal or a.auto or a.antialias:
+        if a.antialias:
+            result = antialias(a.scenes, a.methods, a.sizes, tuple(a.aa_samples), repeat, a.quick)
+            write_tables(a.out, "antialias", result, AA_COLUMNS)
+        if a.temporal:
+            result = temporal(a.scenes, a.methods, a.sizes, a.frames, a.step, a.quick)
+            write_tables(a.out, "temporal", result, TEMPORAL_COLUMNS)
+            if not _plots_missing(a):
+                from .. import plots
+
+                path = os.path.join(a.out, "temporal.png")
+                plots.temporal(result.rows, path)
+                print(f"wrote {path}")
+        if a.auto:
+            if a.methods is not None:
+                print("note: --auto compares auto with hybrid; --methods is ignored")
+            result = auto_vs_fixed(a.scenes, a.sizes, tuple(a.tolerances), repeat, a.max_k, a.quick)
+            write_tables(a.out, "auto", result, AUTO_COLUMNS)
+            over = [r for r in result.rows if r["within_t"] is False]
+            for r in over:
+                print(f"error: auto exceeded its tolerance on {r['scene']} {r['size']}: measured {r['auto_max_abs']:.6f} "
+                      f"> t = {r['tolerance']:.6f}", file=sys.stderr)
+            if over:
+                return 1
+        return 0
+    result = run(a.scenes, a.methods, a.sizes, repeat, a.quick, with_peers=not a.no_peers)
+    write_tables(a.out, "results", result, COLUMNS)
+    if not _plots_missing(a):
+        from .. import plots
+
+        for path in plots.write_all(result, a.out):
+            print(f"wrote {path}")
+    if a.figure7:
+        fig7 = figure7_table()
+        with open(os.path.join(a.out, "figure7.md"), "w") as f:
+            f.write(fig7 + "\n")
+        print("\nFigure 7 (mean per-pixel RGB distance to the A-buffer, 400 stacks):")
+        print(fig7)
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """`python -m oit.bench`, the same as `python -m oit bench`."""
+    ap = argparse.ArgumentParser(prog="python -m oit bench",
+                                 description="time, memory and error of every method against the exact A-buffer")
+    add_arguments(ap)
+    return run_cli(ap.parse_args(argv))
