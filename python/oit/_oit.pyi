@@ -1,0 +1,91 @@
+# The native module (crates/oit-py/src/lib.rs). It is private: python/oit/_api.py wraps it. Keep
+# this file in step with the #[pyclass], #[pymethods] and #[pyfunction] items there;
+# tests/test_stub.py checks that the names match.
+
+from typing import Any, Literal, TypedDict, final
+
+import numpy as np
+import numpy.typing as npt
+
+_ParamValue = int | float | str
+
+class _AdapterInfo(TypedDict):
+    name: str
+    backend: str
+    device_type: str
+    driver: str
+    driver_info: str
+    timestamps: bool
+    float32_blendable: bool
+    int64_atomic_min_max: bool
+    max_storage_binding_bytes: int
+
+class _ParamInfo(TypedDict, total=False):
+    name: str
+    doc: str
+    type: Literal["int", "float", "choice"]
+    min: int | float  # int and float only
+    max: int | float  # int and float only
+    choices: list[str]  # choice only
+    default: _ParamValue
+
+class _MethodInfo(TypedDict):
+    name: str
+    summary: str
+    exact: bool
+    bounded_memory: bool
+    passes: list[str]
+    params: list[_ParamInfo]
+
+@final
+class Scene:
+    """Meshes in submission order (validated on the way in)."""
+
+    def __init__(self) -> None: ...
+    def add_mesh(
+        self,
+        positions: npt.NDArray[np.float32],
+        indices: npt.NDArray[np.uint32],
+        colors: npt.NDArray[np.float32],
+        opaque: bool,
+    ) -> int:
+        """positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32."""
+    def set_mesh_alpha(self, mesh: int, alpha: float) -> None: ...
+    @property
+    def mesh_count(self) -> int: ...
+    @property
+    def triangle_count(self) -> int: ...
+    def mesh_summary(self) -> list[tuple[int, int, bool]]:
+        """(triangles, vertices, opaque) per mesh."""
+
+@final
+class Renderer:
+    def __init__(self, width: int, height: int, adapter: str | None = None, max_binding_bytes: int | None = None) -> None: ...
+    @property
+    def adapter_info(self) -> _AdapterInfo: ...
+    def render(
+        self,
+        scene: Scene,
+        view_proj: npt.NDArray[np.float64],
+        method: str,
+        background: tuple[float, float, float],
+        params: dict[str, _ParamValue],
+        antialias: int = 1,
+        antialias_mode: str = "frames",
+    ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32], dict[str, Any], npt.NDArray[np.float32] | None]:
+        """Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict,
+        error bound (h, w) float32 or None)."""
+
+def methods() -> list[_MethodInfo]:
+    """Every method: name, summary, exact, bounded memory, passes, parameters."""
+
+def reference(
+    scene: Scene,
+    view_proj: npt.NDArray[np.float64],
+    width: int,
+    height: int,
+    background: tuple[float, float, float],
+    antialias: int = 1,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_], npt.NDArray[np.uint32]]:
+    """CPU float64 reference: (image (h, w, 4) float64, ambiguous (h, w) bool, depth complexity),
+    the mean over the standard pattern's positions when `antialias` > 1."""
