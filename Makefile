@@ -3,7 +3,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 export CARGO_TARGET_DIR ?= $(HOME)/.cache/oit/target
 
-.PHONY: setup demo test test-rust test-python test-bench bench viewer test-viewer
+.PHONY: setup demo lint test test-rust test-python test-bench bench viewer test-viewer
 
 setup:
 	bash scripts/setup.sh
@@ -11,7 +11,16 @@ setup:
 demo: setup
 	$(PY) -m oit demo -o out/demo.png
 
-test: setup test-rust test-viewer test-bench test-python
+test: setup lint test-rust test-viewer test-bench test-python
+
+# Any finding fails: rustfmt (rustfmt.toml), clippy on every target with warnings as errors (in
+# release, the profile of the tests, so the two share build scripts and proc-macros), and ruff
+# (pyproject.toml's [tool.ruff]) over python/ and tests/. Fix ruff's findings with
+# `$(VENV)/bin/ruff check --fix python tests`, rustfmt's with `cargo fmt --all`.
+lint:
+	cargo fmt --all --check
+	cargo clippy --workspace --release --all-targets -- -D warnings
+	$(VENV)/bin/ruff check python tests
 
 test-rust:
 	cargo test --release -p oit-core

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Prepares a fresh machine: a Vulkan driver (lavapipe through apt when none is present),
-# the Python virtual environment, and the abi3 wheel of the extension, built once.
+# Prepares a fresh machine: a Vulkan driver (lavapipe through apt when none is present), an EGL
+# driver for VTK's offscreen windows, clippy and rustfmt, the Python virtual environment with
+# ruff, and the abi3 wheel of the extension, built once and installed with its bench, peers and
+# test extras (matplotlib, FLIP, pygfx, VTK, pytest: all from PyPI).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${VENV:-.venv}
@@ -8,31 +10,51 @@ PYTHON=${PYTHON:-python3}
 # One cargo target directory outside the clone, reused by later clones on this machine.
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$HOME/.cache/oit/target}
 
+# apt_install WHAT PACKAGE...: installs Debian packages as root or through sudo; fails saying
+# what is missing where apt-get is not usable.
+apt_install() {
+  local what=$1
+  shift
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    echo "setup: installing $what ($*)"
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$@" >/dev/null
+  elif command -v apt-get >/dev/null && command -v sudo >/dev/null; then
+    echo "setup: installing $what ($*)"
+    sudo apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$@" >/dev/null
+  else
+    echo "setup: no $what found and apt-get is not usable here; install it" \
+         "(on Debian/Ubuntu: $*) and run again" >&2
+    exit 1
+  fi
+}
+
 have_vulkan_driver() {
   ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json 2>/dev/null | grep -q .
 }
 if ! have_vulkan_driver || ! ldconfig -p 2>/dev/null | grep -q libvulkan.so.1; then
-  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
-    echo "setup: installing the Vulkan loader and lavapipe (mesa-vulkan-drivers)"
-    apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >/dev/null
-  elif command -v apt-get >/dev/null && command -v sudo >/dev/null; then
-    sudo apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >/dev/null
-  else
-    echo "setup: no Vulkan driver found and apt-get is not usable here; install a Vulkan driver" \
-         "(on Debian/Ubuntu: mesa-vulkan-drivers) and run again" >&2
-    exit 1
-  fi
+  apt_install "Vulkan loader and driver" mesa-vulkan-drivers libvulkan1
+fi
+# VTK (the peers extra) opens its offscreen window through EGL (oit.peers); Mesa's EGL renders
+# with llvmpipe where there is no GPU.
+if ! ls /usr/share/glvnd/egl_vendor.d/*.json 2>/dev/null | grep -q . || ! ldconfig -p 2>/dev/null | grep -q libEGL.so.1; then
+  apt_install "EGL driver" libegl1 libegl-mesa0 libgl1-mesa-dri
+fi
+# `make lint` runs clippy and rustfmt.
+if command -v rustup >/dev/null && ! { cargo clippy --version && cargo fmt --version; } >/dev/null 2>&1; then
+  rustup component add clippy rustfmt
 fi
 
 if [ ! -x "$VENV/bin/python" ]; then
   "$PYTHON" -m venv "$VENV"
 fi
 "$VENV/bin/python" -m pip install -q --upgrade pip >/dev/null
-"$VENV/bin/python" -m pip install -q "maturin>=1.16,<2" numpy trimesh pytest hypothesis
+"$VENV/bin/python" -m pip install -q "maturin>=1.16,<2" "ruff>=0.17,<0.18"
 
 rm -rf dist
 "$VENV/bin/maturin" build --release --out dist -q 2>&1 | grep -v "^🔗\|^📦\|^🍹\|^⚠️" || true
 wheel=$(ls dist/oit-*.whl)
 "$VENV/bin/python" -m pip install -q --force-reinstall --no-deps "$wheel"
-echo "setup: installed $(basename "$wheel")"
+# Then its dependencies and extras (the same version is installed: pip adds only what is missing).
+"$VENV/bin/python" -m pip install -q "$wheel[bench,peers,test]"
+echo "setup: installed $(basename "$wheel") with the bench, peers and test extras"
