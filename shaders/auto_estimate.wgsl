@@ -13,10 +13,7 @@
 // Optical depth -ln(1 - alpha) per fragment, capped (alpha = 1 gives the cap), at 2^-12 per
 // unit: 65,536 capped fragments fit in a word; its square at 2^-10 (16,384 capped fragments).
 // Alpha quantization at 2^-24 per unit, rounded up.
-const TAU_CAP: f32 = 16.0;
-const TAU_SCALE: f32 = 4096.0;
-const TAU2_SCALE: f32 = 1024.0;
-const QUANT_SCALE: f32 = 16777216.0;
+// TAU_CAP and the scales TAU_SCALE, TAU2_SCALE, QUANT_SCALE come from crates/oit-core/src/consts.rs.
 
 @fragment
 fn fs_estimate(in: VsOut) {

@@ -20,7 +20,7 @@ const QUANT_W: u32 = 14u;    // sum over core fragments of |alpha - q| * T' (fix
 const QUANT_D: u32 = 15u;    // sum over core fragments of |alpha - q| (fixed point)
 const TAIL_LO: u32 = 16u;    // smallest tail color channel (f32 bits, inverted: 0 = none)
 const TAIL_HI: u32 = 17u;    // largest tail color channel (f32 bits)
-const ACCUM_WORDS: u32 = 18u;
+const ACCUM_WORDS: u32 = HYBRID_ACCUM_WORDS;
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
 @group(2) @binding(1) var<storage, read_write> vis: array<f32>;
@@ -44,7 +44,7 @@ fn slots(px: u32) -> vec2<u32> {
 // 24-bit depth over 8-bit alpha, inverted so that a cleared (zero) slot is empty and
 // atomicMax keeps the nearest: a larger key is a nearer fragment (lower alpha first on ties).
 fn pack_key(z: f32, alpha: f32) -> u32 {
-    let d = min(u32(z * 16777215.0), 0xfffffeu);
+    let d = min(u32(z * DEPTH_SCALE), DEPTH_MAX);
     return ~((d << 8u) | alpha_8bit(alpha));
 }
 
@@ -192,7 +192,7 @@ fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
     // the base, so they differ by at most T_core times the range of those values; float32
     // and fixed-point rounding of K + count terms.
     let d = read_fixed32(word(acc + QUANT_D));
-    var bound = read_fixed32(word(acc + QUANT_W)) + d * d + f32(slots(pixel_index(pos)).y + count + 2u) * 2.4e-7;
+    var bound = read_fixed32(word(acc + QUANT_W)) + d * d + f32(slots(pixel_index(pos)).y + count + 2u) * ROUNDING_TERM;
     if count > 0u {
         let lo = min(bitcast<f32>(~word(acc + TAIL_LO)), min(base.r, min(base.g, base.b)));
         let hi = max(bitcast<f32>(word(acc + TAIL_HI)), max(base.r, max(base.g, base.b)));

@@ -13,7 +13,7 @@
 // Per-pixel accumulator words (mirrors oit_core::method::hybrid64::ACCUM_WORDS).
 const TAIL_R: u32 = 0u;      // 8 words: tail C * alpha (rgb) and alpha, (lo, hi) pairs
 const TAIL_COUNT: u32 = 8u;
-const ACCUM_WORDS: u32 = 9u;
+const ACCUM_WORDS: u32 = HYBRID64_ACCUM_WORDS;
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u64>>;
 @group(2) @binding(1) var<storage, read_write> accum: array<atomic<u32>>;
@@ -22,7 +22,7 @@ const ACCUM_WORDS: u32 = 9u;
 //!include common/alpha8.wgsl
 
 fn pack_word(z: f32, c: vec4<f32>) -> u64 {
-    let d = min(u32(z * 16777215.0), 0xfffffeu);
+    let d = min(u32(z * DEPTH_SCALE), DEPTH_MAX);
     let a = alpha_8bit(c.a);
     let q = vec3<u32>(round(clamp(c.rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * vec3<f32>(2047.0, 2047.0, 1023.0)));
     let rgb = (q.r << 21u) | (q.g << 10u) | q.b;
@@ -95,7 +95,7 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
     let rgb = core + t_core * (tail.color + tail.trans * base.rgb); // eq. 11
     // Core colors quantized to 11/11/10 bits (visibilities sum to at most 1), core alphas as
     // above, at most T_core for what lies behind when there is a tail, and rounding.
-    var bound = 1.0 / 2046.0 + alpha_bound + f32(K + count + 2u) * 2.4e-7;
+    var bound = 1.0 / 2046.0 + alpha_bound + f32(K + count + 2u) * ROUNDING_TERM;
     if count > 0u {
         bound += t_core;
     }

@@ -21,7 +21,6 @@
 @group(2) @binding(3) var<storage, read_write> peeled: atomic<u32>;
 
 // Mirrors oit_core::method::peel::PEEL_WORDS.
-const PEEL_WORDS: u32 = 9u;
 // No fragment has this key (its depth bits would be a NaN).
 const NO_KEY: u64 = 0xfffffffffffffffflu;
 

@@ -34,14 +34,17 @@ PER_LAYER = [n for n in NAMES if any(p.startswith("per ") for p in INFO[n]["pass
 # docs/methods.md, "depth_peeling and dual_depth_peeling": the exact peeling methods order
 # fragments at equal depth by submission (their (depth, triangle) keys), not by color as the
 # A-buffer and the reference do: exact, but order-dependent where depths tie exactly.
-SUBMISSION_TIES = [n for n in EXACT if n in PER_LAYER]
+ORDER_TIES = [n for n in NAMES if INFO[n]["order"] == "bitwise_except_ties"]
+SUBMISSION_TIES = [n for n in EXACT if n in ORDER_TIES]
 
-# docs/methods.md, "Determinism": hybrid, hybrid64 and ktab accumulate in fixed point, so
-# their images repeat bit for bit under any submission order, as the exact methods' do.
-BIT_ORDER_INDEPENDENT = sorted(set(EXACT) | ({"hybrid", "hybrid64", "ktab"} & set(NAMES)))
+# The registry's `order` (docs/methods.md, "Guarantees"): the exact methods and those
+# bit-identical under any submission order ("bitwise") with a CPU model of one pixel's stack
+# here (screen_door's model depends on the pixel, bucket_peeling keeps a bucket's nearest).
+BIT_ORDER_INDEPENDENT = sorted(n for n in NAMES if (INFO[n]["exact"] and INFO[n]["order_independent"])
+                               or (INFO[n]["order"] == "bitwise" and n in models.MODELS))
 # Commutative float accumulation (additive or multiplicative blending): a reordered
-# submission changes only the last bits (docs/methods.md).
-SUM_ORDER_INDEPENDENT = sorted({"wsum", "wavg", "wboit", "additive", "filter"} & set(NAMES))
+# submission changes only the last bits.
+SUM_ORDER_INDEPENDENT = sorted(n for n in NAMES if INFO[n]["order"] == "rounding")
 
 U = 2.0 ** -24  # float32 unit roundoff
 # WGSL: log2 has an absolute error below 2^-21 on [0.5, 2], and pow(x, y) is exp2(y log2 x),

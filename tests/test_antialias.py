@@ -177,7 +177,7 @@ def test_coverage_stores_one_fragment_per_pixel_and_triangle(renderer):
     frames = r.render(scene, PERSPECTIVE, antialias=4)
     one = r.render(scene, PERSPECTIVE)
     # Every node is a counted fragment; edges add some over one sample, far fewer than 4 frames.
-    assert cov.stats["pool_nodes"] == cov.stats["fragments"]
+    assert cov.stats["extra"]["pool_nodes"] == cov.stats["fragments"]
     assert one.stats["fragments"] <= cov.stats["fragments"] < 1.5 * one.stats["fragments"]
     assert frames.stats["fragments"] > 3.5 * one.stats["fragments"]
     assert cov.stats["target_bytes"] == one.stats["target_bytes"] + 48 * 40 * 4 * (16 + 4 + 4)

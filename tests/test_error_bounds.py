@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from oit import formulas
+import oit
 from oit.scenes import stacks
 from scenes import IDENTITY, PERSPECTIVE, build_scene, layer, random_meshes
 
@@ -60,9 +60,9 @@ def test_auto_meets_its_tolerance(renderer, tolerance):
 def test_auto_uses_no_more_slots_than_the_depth_complexity(renderer):
     built = stacks(layers=5, alphas="constant", size=(8, 8), seed=1)
     frame = renderer(8, 8).render(built.scene, built.camera, "auto", tolerance=0.05)
-    assert frame.stats["auto_k"] == 5 and frame.stats["overflow_fragments"] == 0
-    assert frame.stats["auto_attempts"] == 1 and frame.stats["auto_slots"] == 5 * 64
-    assert frame.stats["memory_bytes"] == formulas.memory_bytes("auto", 8, 8, slots=5 * 64)
+    assert frame.stats["extra"]["auto_k"] == 5 and frame.stats["overflow_fragments"] == 0
+    assert frame.stats["extra"]["auto_attempts"] == 1 and frame.stats["extra"]["auto_slots"] == 5 * 64
+    assert frame.stats["memory_bytes"] == oit.memory_bytes("auto", 8, 8, slots=5 * 64)
 
 
 def test_auto_gives_each_pixel_its_own_slots(renderer):
@@ -78,11 +78,11 @@ def test_auto_gives_each_pixel_its_own_slots(renderer):
     r = renderer(8, 8)
     frame = r.render(scene, IDENTITY, "auto", tolerance=0.02)
     exact = r.render(scene, IDENTITY, "abuffer")
-    k_left = frame.stats["auto_k"]
-    assert frame.stats["auto_exact"] == 0 and 3 < k_left < 20
-    assert frame.stats["auto_slots"] == 32 * k_left + 32 * 3
+    k_left = frame.stats["extra"]["auto_k"]
+    assert frame.stats["extra"]["auto_exact"] == 0 and 3 < k_left < 20
+    assert frame.stats["extra"]["auto_slots"] == 32 * k_left + 32 * 3
     assert measured(frame, exact).max() <= 0.02
-    assert frame.stats["memory_bytes"] == formulas.memory_bytes("auto", 8, 8, slots=frame.stats["auto_slots"])
+    assert frame.stats["memory_bytes"] == oit.memory_bytes("auto", 8, 8, slots=int(frame.stats["extra"]["auto_slots"]))
 
 
 def test_auto_predicts_k_on_hair_like_stacks(renderer):
@@ -92,17 +92,17 @@ def test_auto_predicts_k_on_hair_like_stacks(renderer):
     frame = r.render(built.scene, built.camera, "auto", tolerance=16 / 255)
     exact = r.render(built.scene, built.camera, "abuffer")
     assert measured(frame, exact).max() <= 16 / 255
-    assert frame.stats["auto_exact"] == 0 and frame.stats["auto_attempts"] == 1
-    assert frame.stats["auto_k"] == frame.stats["auto_predicted_k"] < 40
+    assert frame.stats["extra"]["auto_exact"] == 0 and frame.stats["extra"]["auto_attempts"] == 1
+    assert frame.stats["extra"]["auto_k"] == frame.stats["extra"]["auto_predicted_k"] < 40
 
 
 def test_auto_falls_back_to_exact_for_a_tiny_tolerance(renderer):
     built = stacks(layers=60, alphas="random", size=(8, 8), seed=2)
     r = renderer(8, 8)
     frame = r.render(built.scene, built.camera, "auto", tolerance=1e-4)
-    assert frame.stats["auto_exact"] == 1
+    assert frame.stats["extra"]["auto_exact"] == 1
     # Predicted before rendering: no hybrid is tried, and the exact image is the A-buffer's.
-    assert frame.stats["auto_attempts"] == 1 and frame.stats["auto_predicted_k"] == 0
+    assert frame.stats["extra"]["auto_attempts"] == 1 and frame.stats["extra"]["auto_predicted_k"] == 0
     assert np.array_equal(frame.image, r.render(built.scene, built.camera, "abuffer").image)
     # The exact composite's own bound: float32 rounding of 62 terms.
     assert frame.stats["error_bound_max"] == pytest.approx(62 * 2.4e-7, rel=1e-6)

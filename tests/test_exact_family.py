@@ -60,7 +60,7 @@ def test_compact_abuffer_saves_memory_when_triangles_cover_many_pixels(renderer)
 def test_pall_allocates_a_conservative_bound(renderer):
     scene = build_scene(random_meshes(4, transparent=6, triangles=4))
     frame = renderer(32, 32).render(scene, IDENTITY, "pall")
-    assert frame.stats["pool_nodes"] >= frame.stats["fragments"]
+    assert frame.stats["extra"]["pool_nodes"] >= frame.stats["fragments"]
 
 
 @pytest.mark.parametrize("method", ["depth_peeling", "dual_depth_peeling"])
@@ -72,7 +72,7 @@ def test_peeling_with_a_layer_limit_counts_what_it_left(renderer, method):
     limited = r.render(scene, IDENTITY, method, layers=2)
     # Two layers of five peeled at every pixel (dual peels the nearest and the farthest).
     assert limited.stats["overflow_fragments"] == 3 * 64
-    assert limited.stats["peeled_fragments"] == 2 * 64
+    assert limited.stats["extra"]["peeled_fragments"] == 2 * 64
     assert not np.allclose(limited.image, full.image)
 
 

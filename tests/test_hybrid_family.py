@@ -10,7 +10,7 @@ import pytest
 
 import oit
 from oit import models
-from oit.formulas import memory_bytes
+from oit import memory_bytes
 from oit.models import ALPHA_8BIT_ERROR
 from oit.scenes import stacks
 from scenes import IDENTITY, build_scene, layer, random_meshes

@@ -22,6 +22,7 @@ from numerics import (
     BIT_ORDER_INDEPENDENT,
     EXACT,
     NAMES,
+    ORDER_TIES,
     SUBMISSION_TIES,
     SUM_ORDER_INDEPENDENT,
     exact_in_submission_order,
@@ -68,11 +69,11 @@ RUNS += [(name, {"k": k}) for name in ("hybrid", "hybrid64", "ktab") if name in 
 
 
 def runs(tied=True):
-    """pytest params of RUNS. Where the scene has exactly tied depths (`tied`), the peeling
-    methods are left out: they composite ties in submission order (SUBMISSION_TIES), tested
-    on their own below."""
+    """pytest params of RUNS. Where the scene has exactly tied depths (`tied`), the methods that
+    take ties in submission order (ORDER_TIES) are left out; the exact ones among them
+    (SUBMISSION_TIES) are tested on their own below."""
     return [pytest.param(name, params, id=f"{name}-{params}" if params else name)
-            for name, params in RUNS if not (tied and name in SUBMISSION_TIES)]
+            for name, params in RUNS if not (tied and name in ORDER_TIES)]
 
 
 def shuffles(meshes, count, seed=0):

@@ -24,7 +24,7 @@ from numerics import (
     stacks,
     tolerance,
 )
-from oit.formulas import memory_bytes
+from oit import memory_bytes
 
 DEPTHS = [1, 32, 33, 300, 4000]
 REGIMES = {

@@ -26,7 +26,7 @@ from numerics import (
     stacks,
     tolerance,
 )
-from oit.formulas import HYBRID_ACCUM_WORDS, memory_bytes
+from oit import constants, memory_bytes
 from scenes import IDENTITY, build_scene, random_meshes
 
 SIZES = [(1, 1), (7, 3), (3, 7), (33, 17), (64, 1), (1, 64)]
@@ -168,7 +168,7 @@ def test_hybrid_says_the_largest_frame_that_fits(renderer, name):
     # accumulators); with k = 32 the k-TAB is the larger.
     limit, top = binding_limit(renderer), largest_texture()
     k = 32
-    per_pixel = 4 * max(k, HYBRID_ACCUM_WORDS)
+    per_pixel = 4 * max(k, constants()["HYBRID_ACCUM_WORDS"])
     fits = limit // per_pixel
     side = int(np.sqrt(fits))
     if side + 1 > top:
@@ -190,7 +190,7 @@ def test_hybrid_memory_error_names_the_buffer_that_does_not_fit(renderer, name):
     # k = 8 < the accumulator words: the accumulators are what does not fit, and the message
     # gives their size (it once gave the k-TAB's, below the limit, and said 'hybrid' for ktab).
     limit = binding_limit(renderer)
-    per_pixel = 4 * HYBRID_ACCUM_WORDS
+    per_pixel = 4 * constants()["HYBRID_ACCUM_WORDS"]
     size = pixels_past(limit, per_pixel, largest_texture())
     if size is None:
         pytest.skip("the binding limit cannot be passed within the largest texture")

@@ -327,13 +327,13 @@ class Renderer:
         if bound is not None:
             stats["error_bound_max"] = float(bound.max()) if bound.size else 0.0
             return Frame(image=image, stats=stats, depth_complexity=dc, error_bound=np.repeat(bound[..., None], 3, axis=2))
-        exact = any(m["name"] == method and m["exact"] for m in methods())
+        exact = any(m["name"] == method and m["error_bound"] == "exact" for m in methods())
         reason = ("exact method: the error is float32 compositing, at most about (n + 2) * 2**-23 for n layers"
                   if exact else f"no per-pixel bound is derived for '{method}' (docs/methods.md)")
         return Frame(image=image, stats=stats, depth_complexity=dc, error_bound_reason=reason)
 
 
-ANTIALIAS = (1, 2, 4, 8, 16)
+ANTIALIAS = tuple(_oit.constants()["ANTIALIAS_SAMPLES"])  # the core's standard patterns
 
 
 def _antialias(antialias: Any) -> int:
@@ -354,9 +354,35 @@ def _background(background: Sequence[float]) -> tuple[float, float, float]:
 
 
 def methods() -> list[dict]:
-    """Every method: name, summary, whether it is exact, whether its memory is bounded,
-    the passes it runs, and its parameters with defaults and ranges."""
+    """Every method and what the core knows of it: name, summary, `exact`, `bounded_memory`,
+    `passes`, `params` (defaults and ranges), the adapter `features` it needs, `order` (how
+    its image depends on submission order: "bitwise", "bitwise_except_ties", "rounding" or
+    "submission") and `order_independent`, `antialias_modes`, `memory` (its "kind" -- "frame",
+    "scene" or "slots" -- and "formula") and `error_bound` ("exact", "per_pixel" or "none")."""
     return _oit.methods()
+
+
+def memory_bytes(method: str, width: int, height: int, slots: int | None = None, **params: Any) -> int | None:
+    """GPU bytes `method` allocates for a width x height frame with `params`, from the core's
+    formula (what `frame.stats["memory_bytes"]` reports); None when that grows with the scene
+    (the storing methods). `auto` chooses its slots per frame: pass `slots` =
+    frame.stats["extra"]["auto_slots"] for the bytes of the hybrid it rendered."""
+    if not isinstance(method, str):
+        raise TypeError(f"method must be a string, got {type(method).__name__}")
+    w, h = _int(width, "width"), _int(height, "height")
+    if slots is not None:
+        slots = _int(slots, "slots")
+    return _oit.memory_bytes(method, w, h, params, slots)
+
+
+def constants() -> dict:
+    """The numbers the core, its shaders and these models share (crates/oit-core/src/consts.rs):
+    accumulator words, fixed-point scales, the 8-bit alpha's bias and error, the depth maximum
+    of packed keys, rounding terms, the antialiasing sample counts."""
+    return dict(_CONSTANTS)
+
+
+_CONSTANTS = _oit.constants()
 
 
 def reference(scene: Scene, camera: Camera, width: int, height: int, background: Sequence[float] = (1.0, 1.0, 1.0),

@@ -19,6 +19,8 @@ class _AdapterInfo(TypedDict):
     float32_blendable: bool
     int64_atomic_min_max: bool
     max_storage_binding_bytes: int
+    features: list[str]
+    methods: list[str]  # the methods this adapter's features allow
 
 class _ParamInfo(TypedDict, total=False):
     name: str
@@ -29,6 +31,10 @@ class _ParamInfo(TypedDict, total=False):
     choices: list[str]  # choice only
     default: _ParamValue
 
+class _MemoryInfo(TypedDict):
+    kind: Literal["frame", "scene", "slots"]
+    formula: str
+
 class _MethodInfo(TypedDict):
     name: str
     summary: str
@@ -36,6 +42,12 @@ class _MethodInfo(TypedDict):
     bounded_memory: bool
     passes: list[str]
     params: list[_ParamInfo]
+    features: list[str]
+    order: Literal["bitwise", "bitwise_except_ties", "rounding", "submission"]
+    order_independent: bool
+    antialias_modes: list[Literal["frames", "coverage"]]
+    memory: _MemoryInfo
+    error_bound: Literal["exact", "per_pixel", "none"]
 
 @final
 class Scene:
@@ -78,6 +90,13 @@ class Renderer:
 
 def methods() -> list[_MethodInfo]:
     """Every method: name, summary, exact, bounded memory, passes, parameters."""
+
+def memory_bytes(method: str, width: int, height: int, params: dict[str, _ParamValue], slots: int | None = None) -> int | None:
+    """GPU bytes `method` allocates at `width` x `height` with `params` (its memory formula), or
+    None when that grows with the scene; `slots` is auto's k-TAB slots in all."""
+
+def constants() -> dict[str, Any]:
+    """The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs)."""
 
 def reference(
     scene: Scene,

@@ -11,12 +11,17 @@ from __future__ import annotations
 
 import numpy as np
 
-DEPTH_MAX = 0xFFFFFE
+from ._api import constants
+
+_SHARED = constants()  # the core's numbers (crates/oit-core/src/consts.rs), not copies
+# 24-bit depths of k-TAB keys: z * DEPTH_SCALE in float32, at most DEPTH_MAX.
+DEPTH_SCALE = np.float32(_SHARED["DEPTH_SCALE"])
+DEPTH_MAX = int(_SHARED["DEPTH_MAX"])
 # hybrid's 8-bit alpha (shaders/common/alpha8.wgsl): rounded after a bias of 2^-10 of a step,
 # so that alphas on exact half steps (0.1, 0.3, 0.5, ...) always go up; error at most
 # ALPHA_8BIT_ERROR.
-ALPHA_8BIT_BIAS = np.float32(2.0 ** -10)
-ALPHA_8BIT_ERROR = (0.5 + 2.0 ** -10) / 255.0
+ALPHA_8BIT_BIAS = np.float32(_SHARED["ALPHA_8BIT_BIAS"])
+ALPHA_8BIT_ERROR = float(_SHARED["ALPHA_8BIT_ERROR"])
 
 
 def alpha_8bit(alpha) -> np.ndarray:
@@ -48,7 +53,7 @@ def exact(z, rgb, alpha, bg, bg_a=0.0):
 
 def hybrid_keys(z, alpha):
     """The k-TAB key: 24-bit depth over 8-bit alpha, inverted (larger = nearer)."""
-    d = np.minimum((np.asarray(z, np.float32) * np.float32(16777215.0)).astype(np.uint64), DEPTH_MAX)
+    d = np.minimum((np.asarray(z, np.float32) * DEPTH_SCALE).astype(np.uint64), DEPTH_MAX)
     a = alpha_8bit(alpha)
     return (~((d << np.uint64(8)) | a)) & np.uint64(0xFFFFFFFF)
 
@@ -93,7 +98,7 @@ def hybrid(z, rgb, alpha, bg, bg_a=0.0, k=8, tail=True):
 
 def hybrid64_words(z, rgb, alpha):
     """hybrid64's words before inversion: 24-bit depth, 8-bit alpha, R11G11B10 color."""
-    d = np.minimum((np.asarray(z, np.float32) * np.float32(16777215.0)).astype(np.uint64), DEPTH_MAX)
+    d = np.minimum((np.asarray(z, np.float32) * DEPTH_SCALE).astype(np.uint64), DEPTH_MAX)
     a = alpha_8bit(alpha)
     q = np.round(np.clip(np.asarray(rgb, np.float32), 0, 1) * np.float32([2047.0, 2047.0, 1023.0])).astype(np.uint64)
     color = (q[:, 0] << np.uint64(21)) | (q[:, 1] << np.uint64(10)) | q[:, 2]

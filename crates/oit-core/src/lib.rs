@@ -2,6 +2,7 @@
 //! CPU float64 reference to measure them against. No Python, no windowing.
 
 pub mod antialias;
+pub mod consts;
 pub mod context;
 pub mod error;
 pub mod gpu_types;
@@ -18,7 +19,7 @@ mod upload;
 
 pub use context::GpuContext;
 pub use error::{OitError, Result};
-pub use method::{methods, MethodInfo, ParamInfo, ParamKind, ParamValue, Params};
+pub use method::{memory_bytes, methods, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, ParamInfo, ParamKind, ParamValue, Params};
 pub use reference::{reference, reference_antialiased, ReferenceImage};
-pub use renderer::{shared_context, AntialiasMode, Frame, Renderer, Stats, COVERAGE_METHODS, COVERAGE_SAMPLES};
+pub use renderer::{coverage_methods, shared_context, Frame, Renderer, Stats, COVERAGE_SAMPLES};
 pub use scene::{Camera, Mesh, Scene};

@@ -9,7 +9,7 @@ use crate::antialias;
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
 use crate::gpu_types::FrameUniform;
-use crate::method::{self, FrameCtx, Limits, Method, MethodInfo, ParamValue, Params};
+use crate::method::{self, AntialiasMode, FrameCtx, Limits, Method, MethodInfo, ParamValue, Params};
 use crate::pipeline;
 use crate::scene::{Camera, Scene};
 use crate::shader;
@@ -40,27 +40,10 @@ pub struct Stats {
     pub antialias_mode: AntialiasMode,
 }
 
-/// How a frame of several samples a pixel is made (docs/methods.md, "Antialiasing").
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum AntialiasMode {
-    /// One full frame per sample position, averaged: any method, memory of one sample.
-    #[default]
-    Frames,
-    /// One multisampled capture with a sample mask per stored fragment.
-    Coverage,
+/// Methods that take coverage masks (`AntialiasMode::Coverage` in their `antialias_modes`).
+pub fn coverage_methods() -> Vec<&'static str> {
+    method::methods().iter().filter(|m| m.antialias_modes.contains(&AntialiasMode::Coverage)).map(|m| m.name).collect()
 }
-
-impl AntialiasMode {
-    pub fn name(self) -> &'static str {
-        match self {
-            AntialiasMode::Frames => "frames",
-            AntialiasMode::Coverage => "coverage",
-        }
-    }
-}
-
-/// Methods that take coverage masks (`AntialiasMode::Coverage`).
-pub const COVERAGE_METHODS: &[&str] = &["abuffer"];
 /// Samples a pixel of a coverage-mask frame: WebGPU guarantees multisampling at 4 (lavapipe
 /// offers no other count).
 pub const COVERAGE_SAMPLES: u32 = 4;
@@ -222,7 +205,7 @@ impl Renderer {
     ///
     /// `AntialiasMode::Coverage` instead rasterizes the transparent geometry once,
     /// multisampled, and stores one fragment per pixel with its sample mask (the methods of
-    /// COVERAGE_METHODS, at COVERAGE_SAMPLES samples); docs/methods.md, "Antialiasing".
+    /// `coverage_methods()`, at COVERAGE_SAMPLES samples); docs/methods.md, "Antialiasing".
     #[allow(clippy::too_many_arguments)]
     pub fn render_antialiased(
         &mut self,
@@ -238,15 +221,16 @@ impl Renderer {
         let offsets = antialias::sample_offsets(antialias)?;
         let info = method::lookup(method_name)?;
         let params = info.resolve_params(params)?;
+        info.check_features(&self.gpu)?;
         if background.iter().any(|c| !c.is_finite() || !(0.0..=1.0).contains(c)) {
             return Err(invalid!("background {background:?} must be three linear RGB values in [0, 1]"));
         }
         let coverage = mode == AntialiasMode::Coverage && antialias > 1;
         if coverage {
-            if !COVERAGE_METHODS.contains(&info.name) {
+            if !info.antialias_modes.contains(&AntialiasMode::Coverage) {
                 return Err(invalid!(
                     "antialias_mode 'coverage' is implemented by {} only; '{}' antialiases with antialias_mode 'frames'",
-                    COVERAGE_METHODS.join(", "),
+                    coverage_methods().join(", "),
                     info.name
                 ));
             }

@@ -45,3 +45,37 @@ fn layout_sizes() {
     let m = validate("pall.wgsl");
     assert_eq!(struct_size(&m, "Block") as usize, std::mem::size_of::<PallBlock>());
 }
+
+/// The value naga evaluates for the global constant `name` of `module`.
+fn naga_constant(module: &naga::Module, name: &str) -> Option<naga::Literal> {
+    let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name))?;
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(l) => Some(l),
+        ref e => panic!("constant {name} is not a literal: {e:?}"),
+    }
+}
+
+#[test]
+fn shared_constants_reach_every_shader_with_the_rust_values() {
+    use oit_core::consts::SHARED;
+    use oit_core::shader::{Const, SOURCES};
+    for path in entry_files() {
+        let m = validate(path);
+        for c in SHARED {
+            let (name, want) = match *c {
+                Const::U32(n, v) => (n, naga::Literal::U32(v)),
+                Const::F32(n, v) => (n, naga::Literal::F32(v)),
+            };
+            assert_eq!(naga_constant(&m, name), Some(want), "{path}: {name}");
+        }
+    }
+    // Defined once: no WGSL file declares a shared constant of its own.
+    for (path, src) in SOURCES {
+        for c in SHARED {
+            let name = match *c {
+                Const::U32(n, _) | Const::F32(n, _) => n,
+            };
+            assert!(!src.contains(&format!("const {name}:")), "{path} defines {name}, which consts.rs owns");
+        }
+    }
+}

@@ -128,6 +128,15 @@ fn param_value(v: &Bound<'_, PyAny>, name: &str) -> PyResult<ParamValue> {
     Err(PyValueError::new_err(format!("parameter '{name}' must be a number or a string, got {}", v.get_type().name()?)))
 }
 
+fn param_list(params: &Bound<'_, PyDict>) -> PyResult<Vec<(String, ParamValue)>> {
+    let mut plist = Vec::new();
+    for (k, v) in params.iter() {
+        let name: String = k.extract()?;
+        plist.push((name.clone(), param_value(&v, &name)?));
+    }
+    Ok(plist)
+}
+
 fn value_to_py<'py>(py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAny>> {
     Ok(match v {
         ParamValue::Int(i) => i.into_pyobject(py)?.into_any(),
@@ -167,9 +176,11 @@ fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, 
     d.set_item("wall_time_ms", s.wall_time_ms)?;
     d.set_item("antialias", s.antialias)?;
     d.set_item("antialias_mode", s.antialias_mode.name())?;
+    let extra = PyDict::new(py);
     for (k, v) in &s.extra {
-        d.set_item(*k, v)?;
+        extra.set_item(*k, v)?;
     }
+    d.set_item("extra", extra)?;
     Ok(d)
 }
 
@@ -206,6 +217,9 @@ impl Renderer {
         d.set_item("float32_blendable", self.context.has(wgpu::Features::FLOAT32_BLENDABLE))?;
         d.set_item("int64_atomic_min_max", self.context.has(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX))?;
         d.set_item("max_storage_binding_bytes", self.context.max_binding_bytes())?;
+        d.set_item("features", oit_core::method::feature_names(self.context.features))?;
+        let works: Vec<&str> = oit_core::methods().iter().filter(|m| self.context.features.contains(m.features)).map(|m| m.name).collect();
+        d.set_item("methods", works)?;
         Ok(d)
     }
 
@@ -230,11 +244,7 @@ impl Renderer {
             other => return Err(PyValueError::new_err(format!("antialias_mode must be 'frames' or 'coverage', got '{other}'"))),
         };
         let camera = oit_core::Camera::from_rows(matrix(&view_proj)?).map_err(Error::from)?;
-        let mut plist = Vec::new();
-        for (k, v) in params.iter() {
-            let name: String = k.extract()?;
-            plist.push((name.clone(), param_value(&v, &name)?));
-        }
+        let plist = param_list(&params)?;
         let inner_scene = &scene.inner;
         let bg = [background.0, background.1, background.2];
         let frame = py
@@ -266,6 +276,15 @@ fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         d.set_item("exact", m.exact)?;
         d.set_item("bounded_memory", m.bounded_memory)?;
         d.set_item("passes", m.passes.to_vec())?;
+        d.set_item("features", oit_core::method::feature_names(m.features))?;
+        d.set_item("order", m.order.name())?;
+        d.set_item("order_independent", m.order.independent())?;
+        d.set_item("antialias_modes", m.antialias_modes.iter().map(|a| a.name()).collect::<Vec<_>>())?;
+        let memory = PyDict::new(py);
+        memory.set_item("kind", m.memory.kind())?;
+        memory.set_item("formula", m.memory.formula())?;
+        d.set_item("memory", memory)?;
+        d.set_item("error_bound", m.error_bound.name())?;
         let params = PyList::empty(py);
         for p in m.params {
             let pd = PyDict::new(py);
@@ -296,6 +315,36 @@ fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         out.append(d)?;
     }
     Ok(out)
+}
+
+/// GPU bytes `method` allocates at `width` x `height` with `params` (its memory formula), or
+/// None when that grows with the scene; `slots` is auto's k-TAB slots in all.
+#[pyfunction]
+#[pyo3(signature = (method, width, height, params, slots=None))]
+fn memory_bytes(method: &str, width: i64, height: i64, params: Bound<'_, PyDict>, slots: Option<i64>) -> PyResult<Option<u64>> {
+    if width <= 0 || height <= 0 || width > u32::MAX as i64 || height > u32::MAX as i64 {
+        return Err(PyValueError::new_err(format!("width and height must be positive integers, got {width} x {height}")));
+    }
+    let slots = slots.map(|s| u64::try_from(s).map_err(|_| PyValueError::new_err(format!("slots must be >= 0, got {s}")))).transpose()?;
+    let plist = param_list(&params)?;
+    Ok(oit_core::memory_bytes(method, width as u32, height as u32, &plist, slots).map_err(Error::from)?)
+}
+
+/// The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs).
+#[pyfunction]
+fn constants<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for c in oit_core::consts::SHARED {
+        match *c {
+            oit_core::shader::Const::U32(n, v) => d.set_item(n, v)?,
+            oit_core::shader::Const::F32(n, v) => d.set_item(n, v as f64)?,
+        }
+    }
+    d.set_item("ALPHA_8BIT_ERROR", oit_core::consts::ALPHA_8BIT_ERROR)?;
+    d.set_item("ROUNDING_TERM", oit_core::consts::ROUNDING_TERM)?;
+    d.set_item("COVERAGE_SAMPLES", oit_core::COVERAGE_SAMPLES)?;
+    d.set_item("ANTIALIAS_SAMPLES", oit_core::antialias::SAMPLE_COUNTS.to_vec())?;
+    Ok(d)
 }
 
 /// CPU float64 reference: (image (h, w, 4) float64, ambiguous (h, w) bool, depth complexity),
@@ -333,5 +382,7 @@ fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Renderer>()?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(reference, m)?)?;
+    m.add_function(wrap_pyfunction!(memory_bytes, m)?)?;
+    m.add_function(wrap_pyfunction!(constants, m)?)?;
     Ok(())
 }

@@ -10,13 +10,14 @@ from typing import Any
 
 import numpy as np
 
+from .._api import constants, methods as list_methods
 from .harness import Progress, Result, mean_rgb_distance, scene_jobs, timed
 
 AA_METHODS = ("abuffer", "hybrid", "hybrid64", "wboit", "unsorted")
 AA_SAMPLES = (1, 4, 8)
-# Methods and the sample count of antialias_mode="coverage" (oit_core::renderer).
-COVERAGE_METHODS = ("abuffer",)
-COVERAGE_SAMPLES = 4
+# Methods and the sample count of antialias_mode="coverage", as the core declares them.
+COVERAGE_METHODS = tuple(m["name"] for m in list_methods() if "coverage" in m["antialias_modes"])
+COVERAGE_SAMPLES = constants()["COVERAGE_SAMPLES"]
 
 
 def antialias(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | None = None,

@@ -66,7 +66,7 @@ def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances:
             try:
                 frame, gpu, wall = timed(partial(render, "auto", tolerance=t), repeat)
                 row.update(_measured("auto", frame, gpu, wall, exact, covered))
-                row.update({key: frame.stats.get(key, math.nan) for key in AUTO_STATS})
+                row.update({key: {**frame.stats, **frame.stats["extra"]}.get(key, math.nan) for key in AUTO_STATS})
                 row["within_t"] = row["auto_max_abs"] <= t
                 progress.step("auto")
                 k = smallest_k(fixed_error, t, max_k)

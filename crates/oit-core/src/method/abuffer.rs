@@ -2,7 +2,7 @@
 //! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
 use super::lists::{loop_limited, Aux, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
-use super::{FrameCtx, Limits, Method, MethodInfo, MethodReport};
+use super::{AntialiasMode, ErrorBound, FrameCtx, Limits, Memory, Method, MethodInfo, MethodReport, Order};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::{CoverageNode, PoolNode};
@@ -14,6 +14,11 @@ pub const INFO: MethodInfo = MethodInfo {
     bounded_memory: false,
     passes: &["capture (geometry)", "resolve (full screen)"],
     params: &[],
+    features: wgpu::Features::empty(),
+    order: Order::Bitwise,
+    antialias_modes: &[AntialiasMode::Frames, AntialiasMode::Coverage],
+    memory: Memory::Scene { formula: "24 B/fragment + 52 B/pixel (the node pool grows with the scene)" },
+    error_bound: ErrorBound::Exact,
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 

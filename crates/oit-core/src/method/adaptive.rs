@@ -4,7 +4,7 @@
 //! order and composites every fragment by it (shaders/adaptive.wgsl).
 
 use super::lists::{loop_limited, Aux, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
 use crate::error::{OitError, Result};
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;
@@ -20,6 +20,11 @@ pub const INFO: MethodInfo = MethodInfo {
         kind: ParamKind::Int { min: 1, max: 32, default: 8 },
         doc: "steps of the per-pixel visibility function",
     }],
+    features: wgpu::Features::empty(),
+    order: Order::Submission,
+    antialias_modes: FRAMES,
+    memory: Memory::Scene { formula: "32 B/fragment + 4 B/pixel (grows with the scene)" },
+    error_bound: ErrorBound::None,
     create: |gpu, limits| {
         Box::new(Adaptive(ListMethod::new(
             gpu,

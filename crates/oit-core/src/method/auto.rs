@@ -9,7 +9,8 @@
 //! predicted to meet t, the A-buffer is rendered directly.
 
 use super::hybrid::{Hybrid, Slots};
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind, Params};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, Params};
+use crate::consts::{self, ALPHA_8BIT_ERROR, ROUNDING_TERM as ROUNDING};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::pipeline;
@@ -31,19 +32,20 @@ pub const INFO: MethodInfo = MethodInfo {
         kind: ParamKind::Float { min: 0.0, max: 1.0, default: 1.0 / 255.0 },
         doc: "largest error allowed at any pixel and channel, against the exact composite",
     }],
+    features: wgpu::Features::empty(),
+    order: Order::Bitwise,
+    antialias_modes: FRAMES,
+    memory: Memory::Slots { formula: "2·Σk·4 + W·H·96 + 8 (hybrid with per-pixel slots and the estimate), or the A-buffer's", bytes: memory_bytes },
+    error_bound: ErrorBound::PerPixel,
     create: |gpu, limits| Box::new(Auto::new(gpu, limits)),
 };
 
 /// Slots hybrid can hold (its `k` range).
 const MAX_K: u32 = 32;
 /// Fixed-point scales of shaders/auto_estimate.wgsl.
-const TAU_SCALE: f64 = 4096.0;
-const TAU2_SCALE: f64 = 1024.0;
-const QUANT_SCALE: f64 = 16_777_216.0;
-/// Largest |alpha - q| of hybrid's 8-bit alpha (shaders/common/alpha8.wgsl).
-const ALPHA_8BIT_ERROR: f64 = (0.5 + 1.0 / 1024.0) / 255.0;
-/// Float32 and fixed-point rounding per term of hybrid's bound (hybrid.wgsl, fs_final).
-const ROUNDING: f64 = 2.4e-7;
+const TAU_SCALE: f64 = consts::TAU_SCALE as f64;
+const TAU2_SCALE: f64 = consts::TAU2_SCALE as f64;
+const QUANT_SCALE: f64 = consts::QUANT_SCALE as f64;
 
 struct Estimate {
     pipeline: wgpu::RenderPipeline,
@@ -125,6 +127,12 @@ impl Auto {
 
 /// Words per pixel of the estimate pass.
 const WORDS: u64 = 5;
+
+/// Bytes auto allocates when it renders hybrid with `slots` k-TAB slots in all: hybrid's
+/// per-pixel-slot buffers and the estimate's words.
+pub fn memory_bytes(pixels: u64, slots: u64) -> u64 {
+    super::hybrid::memory_bytes_per_pixel(pixels, slots) + pixels * WORDS * 4
+}
 /// How many standard deviations below its mean the nearest fragments' optical depth is taken.
 const SPREAD: f64 = 3.0;
 
@@ -226,7 +234,6 @@ impl Method for Auto {
                     ("auto_predicted_k", predicted_k as f64),
                     ("auto_exact", 0.0),
                     ("auto_attempts", attempts as f64),
-                    ("error_bound_max", worst),
                 ]);
                 return Ok(report);
             }
@@ -264,7 +271,6 @@ impl Method for Auto {
             ("auto_predicted_k", predicted_k as f64),
             ("auto_exact", 1.0),
             ("auto_attempts", (attempts + 1) as f64),
-            ("error_bound_max", rounding),
         ]);
         Ok(report)
     }

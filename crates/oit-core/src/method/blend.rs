@@ -1,8 +1,8 @@
 //! `unsorted` and `sorted`: fixed-function over-blending onto the opaque image, in
 //! submission order or per mesh back to front by centroid (docs/methods.md).
 
-use super::{FrameCtx, Method, MethodInfo, MethodReport};
-use crate::error::{OitError, Result};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order};
+use crate::error::Result;
 use crate::pipeline;
 use crate::shader;
 use crate::targets::COLOR_FORMAT;
@@ -14,6 +14,11 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["blend"],
     params: &[],
+    features: wgpu::Features::FLOAT32_BLENDABLE,
+    order: Order::Submission,
+    antialias_modes: FRAMES,
+    memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Blend::new(Kind::Unsorted)),
 };
 
@@ -24,6 +29,11 @@ pub const SORTED: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["sort meshes (CPU)", "blend"],
     params: &[],
+    features: wgpu::Features::FLOAT32_BLENDABLE,
+    order: Order::Submission,
+    antialias_modes: FRAMES,
+    memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Blend::new(Kind::Sorted)),
 };
 
@@ -34,6 +44,11 @@ pub const ADDITIVE: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["blend"],
     params: &[],
+    features: wgpu::Features::FLOAT32_BLENDABLE,
+    order: Order::Rounding,
+    antialias_modes: FRAMES,
+    memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Blend::new(Kind::Additive)),
 };
 
@@ -44,6 +59,11 @@ pub const FILTER: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["blend"],
     params: &[],
+    features: wgpu::Features::FLOAT32_BLENDABLE,
+    order: Order::Rounding,
+    antialias_modes: FRAMES,
+    memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Blend::new(Kind::Filter)),
 };
 
@@ -94,13 +114,6 @@ impl Blend {
 }
 
 fn blend_pipeline(cx: &FrameCtx<'_>, kind: Kind) -> Result<wgpu::RenderPipeline> {
-    if !cx.gpu.has(wgpu::Features::FLOAT32_BLENDABLE) {
-        return Err(OitError::Unsupported(format!(
-            "adapter '{}' cannot blend into RGBA32F targets (feature FLOAT32_BLENDABLE), which the blend \
-             methods (unsorted, sorted, additive, filter) need; the exact and storage-based methods still work",
-            cx.gpu.info.name
-        )));
-    }
     let d = &cx.gpu.device;
     let module = shader::module(d, "blend.wgsl", &[]);
     let layout = pipeline::layout(d, &[cx.scene_layout]);

@@ -2,8 +2,8 @@
 //! per pixel from a uniform split of its depth range, the nearest fragment of each bucket
 //! kept, the others dropped and counted (shaders/bucket_peeling.wgsl).
 
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
-use crate::error::{OitError, Result};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
+use crate::error::Result;
 use crate::pipeline;
 use crate::shader::{self, Const};
 use crate::targets::{read_buffer, storage_buffer};
@@ -15,6 +15,11 @@ pub const INFO: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["depth bounds (geometry)", "bucket keys (geometry)", "bucket colors (geometry)", "resolve (full screen)"],
     params: &[ParamInfo { name: "buckets", kind: ParamKind::Int { min: 1, max: 32, default: 32 }, doc: "buckets (layers) per pixel" }],
+    features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
+    order: Order::BitwiseExceptTies,
+    antialias_modes: FRAMES,
+    memory: Memory::Frame { formula: "W·H·(8 + 24·buckets) + 4", bytes: |px, p| memory_bytes(px, p.int("buckets") as u64) },
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Buckets { pipelines: None, buffers: None }),
 };
 
@@ -68,14 +73,6 @@ fn build(cx: &FrameCtx<'_>, buckets: u32) -> Pipelines {
 
 impl Method for Buckets {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        let needed = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
-        if !cx.gpu.features.contains(needed) {
-            return Err(OitError::Unsupported(format!(
-                "adapter '{}' lacks 64-bit atomic min/max (SHADER_INT64, SHADER_INT64_ATOMIC_MIN_MAX), which \
-                 bucket_peeling uses to keep each bucket's nearest fragment",
-                cx.gpu.info.name
-            )));
-        }
         let buckets = cx.params.int("buckets") as u32;
         if self.pipelines.as_ref().is_none_or(|p| p.buckets != buckets) {
             self.pipelines = Some(build(cx, buckets));

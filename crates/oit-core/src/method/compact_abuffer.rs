@@ -5,7 +5,7 @@
 
 use super::abuffer::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{FrameCtx, Method, MethodInfo, MethodReport};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order};
 use crate::error::Result;
 use crate::gpu_types::{CompactNode, PrimShading};
 
@@ -16,6 +16,11 @@ pub const INFO: MethodInfo = MethodInfo {
     bounded_memory: false,
     passes: &["triangle setup (compute)", "capture (geometry)", "sweeps (compute)", "resolve (full screen)"],
     params: &[],
+    features: wgpu::Features::empty(),
+    order: Order::Bitwise,
+    antialias_modes: FRAMES,
+    memory: Memory::Scene { formula: "12 B/fragment + 52 B/pixel + 96 B/triangle" },
+    error_bound: ErrorBound::Exact,
     create: |gpu, limits| {
         Box::new(Compact(ListMethod::new(
             gpu,

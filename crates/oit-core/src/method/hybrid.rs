@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
 use crate::error::Result;
 use crate::pipeline;
 use crate::shader::{self, Const};
@@ -23,6 +23,11 @@ pub const HYBRID: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core and tail (geometry)", "final composite (full screen)"],
     params: &[K_PARAM],
+    features: wgpu::Features::empty(),
+    order: Order::Bitwise,
+    antialias_modes: FRAMES,
+    memory: MEMORY,
+    error_bound: ErrorBound::PerPixel,
     create: |_, _| Box::new(Hybrid::new(true)),
 };
 
@@ -33,20 +38,24 @@ pub const KTAB: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core (geometry)", "final composite (full screen)"],
     params: &[K_PARAM],
+    features: wgpu::Features::empty(),
+    order: Order::Bitwise,
+    antialias_modes: FRAMES,
+    memory: MEMORY,
+    error_bound: ErrorBound::PerPixel,
     create: |_, _| Box::new(Hybrid::new(false)),
 };
 
-/// Words per pixel of the accumulators (mirrors ACCUM_WORDS in shaders/hybrid.wgsl).
-pub const ACCUM_WORDS: u64 = 18;
-/// Fixed-point scales of core sums (values in [0, 1], total <= 1) and tail sums.
-pub const CORE_SCALE: f32 = 2147483648.0; // 2^31
-pub const TAIL_SCALE: f32 = 16777216.0; // 2^24
+/// Words per pixel of the accumulators.
+pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_ACCUM_WORDS as u64;
 
 /// Bytes hybrid allocates at W x H pixels with core size k: k-TAB and visibility (k words
 /// each), the accumulators, and the overflow counter.
 pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
     pixels * (2 * k + ACCUM_WORDS) * 4 + 4
 }
+
+const MEMORY: Memory = Memory::Frame { formula: "W·H·(2k + 18)·4 + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) };
 
 /// Bytes with each pixel's own slot count (`slots` in all): k-TAB and visibility (a word
 /// each per slot), the accumulators, the per-pixel offsets (pixels + 1 words) and the counter.
@@ -103,8 +112,6 @@ impl Hybrid {
             Const::U32("K", k.max(1)),
             Const::U32("PER_PIXEL", (k == PER_PIXEL_KEY) as u32),
             Const::U32("TAIL", self.tail as u32),
-            Const::F32("CORE_SCALE", CORE_SCALE),
-            Const::F32("TAIL_SCALE", TAIL_SCALE),
         ];
         let module = shader::module(d, "hybrid.wgsl", &consts);
         let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, layout]);

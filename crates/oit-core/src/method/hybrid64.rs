@@ -4,9 +4,8 @@
 //! result does not suffice); the word pushed off the table joins the tail in the same pass.
 //! One geometry pass and one full-screen resolve (shaders/hybrid64.wgsl).
 
-use super::hybrid::{CORE_SCALE, TAIL_SCALE};
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
-use crate::error::{OitError, Result};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
+use crate::error::Result;
 use crate::pipeline;
 use crate::shader::{self, Const};
 use crate::targets::{read_buffer, storage_buffer};
@@ -22,11 +21,16 @@ pub const INFO: MethodInfo = MethodInfo {
         kind: ParamKind::Int { min: 1, max: 32, default: 8 },
         doc: "core size: fragments per pixel kept, sorted, with their colors",
     }],
+    features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS),
+    order: Order::Bitwise,
+    antialias_modes: FRAMES,
+    memory: Memory::Frame { formula: "W·H·(8k + 36) + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) },
+    error_bound: ErrorBound::PerPixel,
     create: |_, _| Box::new(Hybrid64 { pipelines: None, buffers: None }),
 };
 
-/// Words per pixel of the tail accumulators (mirrors ACCUM_WORDS in shaders/hybrid64.wgsl).
-pub const ACCUM_WORDS: u64 = 9;
+/// Words per pixel of the tail accumulators.
+pub const ACCUM_WORDS: u64 = crate::consts::HYBRID64_ACCUM_WORDS as u64;
 
 /// Bytes hybrid64 allocates: k 64-bit words and the tail accumulators per pixel, a counter.
 pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
@@ -60,7 +64,7 @@ fn build(cx: &FrameCtx<'_>, k: u32) -> Pipelines {
         label: Some("hybrid64"),
         entries: &(0..3).map(pipeline::storage_entry).collect::<Vec<_>>(),
     });
-    let consts = [Const::U32("K", k), Const::F32("CORE_SCALE", CORE_SCALE), Const::F32("TAIL_SCALE", TAIL_SCALE)];
+    let consts = [Const::U32("K", k)];
     let module = shader::module(d, "hybrid64.wgsl", &consts);
     let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &layout]);
     Pipelines {
@@ -73,15 +77,6 @@ fn build(cx: &FrameCtx<'_>, k: u32) -> Pipelines {
 
 impl Method for Hybrid64 {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        let needed = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS;
-        if !cx.gpu.features.contains(needed) {
-            return Err(OitError::Unsupported(format!(
-                "adapter '{}' lacks 64-bit atomics that return their previous value (SHADER_INT64, \\
-                 SHADER_INT64_ATOMIC_ALL_OPS), which hybrid64's single-pass insertion needs; two-pass `hybrid` \\
-                 works with 32-bit atomics",
-                cx.gpu.info.name
-            )));
-        }
         let k = cx.params.int("k") as u32;
         if self.pipelines.as_ref().is_none_or(|p| p.k != k) {
             self.pipelines = Some(build(cx, k));

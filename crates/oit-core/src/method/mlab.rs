@@ -4,7 +4,7 @@
 
 use super::adaptive::check_replay_budget;
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
 use crate::error::Result;
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;
@@ -16,6 +16,11 @@ pub const INFO: MethodInfo = MethodInfo {
     bounded_memory: false,
     passes: &["capture (geometry)", "replay in submission order and composite (full screen)"],
     params: &[ParamInfo { name: "layers", kind: ParamKind::Int { min: 1, max: 32, default: 4 }, doc: "blended layers kept per pixel" }],
+    features: wgpu::Features::empty(),
+    order: Order::Submission,
+    antialias_modes: FRAMES,
+    memory: Memory::Scene { formula: "32 B/fragment + 4 B/pixel (grows with the scene)" },
+    error_bound: ErrorBound::None,
     create: |gpu, limits| {
         Box::new(Mlab(ListMethod::new(
             gpu,

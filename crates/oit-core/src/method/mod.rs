@@ -17,8 +17,9 @@ mod sbuffer;
 mod screen_door;
 mod stochastic;
 pub mod weighted;
+mod info;
 
-use std::collections::BTreeMap;
+pub use info::*;
 
 use crate::context::GpuContext;
 use crate::error::{invalid, Result};
@@ -26,66 +27,6 @@ use crate::scene::Camera;
 use crate::targets::{SampleTargets, Targets};
 use crate::timer::PassTimer;
 use crate::upload::GpuScene;
-
-/// A parameter's type, range and default.
-#[derive(Clone, Copy, Debug)]
-pub enum ParamKind {
-    Int { min: i64, max: i64, default: i64 },
-    Float { min: f64, max: f64, default: f64 },
-    Choice { choices: &'static [&'static str], default: &'static str },
-}
-
-#[derive(Clone, Copy, Debug)]
-pub struct ParamInfo {
-    pub name: &'static str,
-    pub kind: ParamKind,
-    pub doc: &'static str,
-}
-
-/// What `oit.methods()` reports about a method.
-#[derive(Clone, Copy, Debug)]
-pub struct MethodInfo {
-    pub name: &'static str,
-    pub summary: &'static str,
-    pub exact: bool,
-    pub bounded_memory: bool,
-    pub passes: &'static [&'static str],
-    pub params: &'static [ParamInfo],
-    create: fn(&GpuContext, &Limits) -> Box<dyn Method>,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum ParamValue {
-    Int(i64),
-    Float(f64),
-    Str(String),
-}
-
-/// Parameters after validation, every declared one present (defaults filled in).
-#[derive(Clone, Debug, Default)]
-pub struct Params(pub BTreeMap<&'static str, ParamValue>);
-
-impl Params {
-    pub fn int(&self, name: &str) -> i64 {
-        match self.0.get(name) {
-            Some(ParamValue::Int(v)) => *v,
-            other => panic!("parameter '{name}' is not an int: {other:?}"),
-        }
-    }
-    pub fn float(&self, name: &str) -> f64 {
-        match self.0.get(name) {
-            Some(ParamValue::Float(v)) => *v,
-            Some(ParamValue::Int(v)) => *v as f64,
-            other => panic!("parameter '{name}' is not a float: {other:?}"),
-        }
-    }
-    pub fn choice(&self, name: &str) -> &str {
-        match self.0.get(name) {
-            Some(ParamValue::Str(v)) => v,
-            other => panic!("parameter '{name}' is not a choice: {other:?}"),
-        }
-    }
-}
 
 const REGISTRY: &[MethodInfo] = &[
     abuffer::INFO,
@@ -116,32 +57,6 @@ pub fn methods() -> &'static [MethodInfo] {
     REGISTRY
 }
 
-/// Levenshtein distance, for "did you mean" hints.
-fn distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + (ca != *cb) as usize).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
-}
-
-fn did_you_mean<'a>(name: &str, options: impl Iterator<Item = &'a str>) -> String {
-    let lower = name.to_lowercase();
-    options
-        .map(|o| (distance(&lower, o), o))
-        .filter(|(d, _)| *d <= 2)
-        .min()
-        .map(|(_, o)| format!(" (did you mean '{o}'?)"))
-        .unwrap_or_default()
-}
-
 pub fn lookup(name: &str) -> Result<&'static MethodInfo> {
     REGISTRY.iter().find(|m| m.name == name).ok_or_else(|| {
         let names: Vec<&str> = REGISTRY.iter().map(|m| m.name).collect();
@@ -149,78 +64,15 @@ pub fn lookup(name: &str) -> Result<&'static MethodInfo> {
     })
 }
 
-impl MethodInfo {
-    /// Checks names, types and ranges of `given` and fills in defaults.
-    pub fn resolve_params(&self, given: &[(String, ParamValue)]) -> Result<Params> {
-        let mut out = BTreeMap::new();
-        for (name, value) in given {
-            let info = self.params.iter().find(|p| p.name == name).ok_or_else(|| {
-                let valid: Vec<&str> = self.params.iter().map(|p| p.name).collect();
-                invalid!(
-                    "method '{}' has no parameter '{name}'{}; its parameters: {}",
-                    self.name,
-                    did_you_mean(name, valid.iter().copied()),
-                    if valid.is_empty() { "none".to_string() } else { valid.join(", ") }
-                )
-            })?;
-            let v = check(self.name, info, value)?;
-            out.insert(info.name, v);
-        }
-        for p in self.params {
-            out.entry(p.name).or_insert_with(|| match p.kind {
-                ParamKind::Int { default, .. } => ParamValue::Int(default),
-                ParamKind::Float { default, .. } => ParamValue::Float(default),
-                ParamKind::Choice { default, .. } => ParamValue::Str(default.to_string()),
-            });
-        }
-        Ok(Params(out))
+/// GPU bytes `name` allocates for a `width` x `height` frame with `params` (the formula of its
+/// `MethodInfo::memory`): None when that grows with the scene, or for auto without `slots`.
+pub fn memory_bytes(name: &str, width: u32, height: u32, params: &[(String, ParamValue)], slots: Option<u64>) -> Result<Option<u64>> {
+    let info = lookup(name)?;
+    if slots.is_some() && !matches!(info.memory, Memory::Slots { .. }) {
+        return Err(invalid!("'{name}' has no per-pixel slots; `slots` is for methods that choose them per frame (auto)"));
     }
-
-    pub(crate) fn instantiate(&self, gpu: &GpuContext, limits: &Limits) -> Box<dyn Method> {
-        (self.create)(gpu, limits)
-    }
-}
-
-fn check(method: &str, info: &ParamInfo, value: &ParamValue) -> Result<ParamValue> {
-    let name = info.name;
-    match (info.kind, value) {
-        (ParamKind::Int { min, max, .. }, ParamValue::Int(v)) => {
-            if *v < min || *v > max {
-                return Err(invalid!("{method}: {name} = {v} is out of range; use {min} <= {name} <= {max}"));
-            }
-            Ok(ParamValue::Int(*v))
-        }
-        (ParamKind::Float { min, max, .. }, ParamValue::Float(_) | ParamValue::Int(_)) => {
-            let v = match value {
-                ParamValue::Float(f) => *f,
-                ParamValue::Int(i) => *i as f64,
-                ParamValue::Str(_) => unreachable!(),
-            };
-            if !v.is_finite() || v < min || v > max {
-                return Err(invalid!("{method}: {name} = {v} is out of range; use {min} <= {name} <= {max}"));
-            }
-            Ok(ParamValue::Float(v))
-        }
-        (ParamKind::Choice { choices, .. }, ParamValue::Str(s)) => {
-            if !choices.contains(&s.as_str()) {
-                return Err(invalid!("{method}: {name} = '{s}' is not one of: {}", choices.join(", ")));
-            }
-            Ok(ParamValue::Str(s.clone()))
-        }
-        (kind, v) => {
-            let got = match v {
-                ParamValue::Int(i) => format!("the integer {i}"),
-                ParamValue::Float(f) => format!("the number {f}"),
-                ParamValue::Str(s) => format!("the string '{s}'"),
-            };
-            let want = match kind {
-                ParamKind::Int { min, max, .. } => format!("an integer in [{min}, {max}]"),
-                ParamKind::Float { min, max, .. } => format!("a number in [{min}, {max}]"),
-                ParamKind::Choice { choices, .. } => format!("one of {}", choices.join(", ")),
-            };
-            Err(invalid!("{method}: {name} must be {want}, got {got}"))
-        }
-    }
+    let params = info.resolve_params(params)?;
+    Ok(info.memory_bytes(width as u64 * height as u64, &params, slots))
 }
 
 /// Limits a method sizes its buffers by: the adapter's, or lower ones a caller asks for

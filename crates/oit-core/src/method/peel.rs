@@ -3,8 +3,8 @@
 //! atomic min/max over (depth, triangle) keys, so coplanar fragments peel one by one
 //! (shaders/peel.wgsl, docs/methods.md).
 
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
-use crate::error::{OitError, Result};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
+use crate::error::Result;
 use crate::pipeline;
 use crate::shader::{self, Const};
 use crate::targets::{read_buffer, storage_buffer};
@@ -22,6 +22,11 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["per layer: peel (geometry) and composite (compute)", "resolve (full screen)"],
     params: &[LAYERS],
+    features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
+    order: Order::BitwiseExceptTies,
+    antialias_modes: FRAMES,
+    memory: MEMORY,
+    error_bound: ErrorBound::Exact,
     create: |_, _| Box::new(Peel::new(false)),
 };
 
@@ -32,17 +37,24 @@ pub const DUAL_DEPTH_PEELING: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["per two layers: peel (geometry) and composite (compute)", "resolve (full screen)"],
     params: &[LAYERS],
+    features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
+    order: Order::BitwiseExceptTies,
+    antialias_modes: FRAMES,
+    memory: MEMORY,
+    error_bound: ErrorBound::Exact,
     create: |_, _| Box::new(Peel::new(true)),
 };
 
-/// Words of per-pixel accumulation (mirrors PEEL_WORDS in shaders/peel.wgsl).
-pub const PEEL_WORDS: u64 = 9;
+/// Words of per-pixel accumulation.
+pub const PEEL_WORDS: u64 = crate::consts::PEEL_WORDS as u64;
 
 /// Bytes either peeling method allocates: four 64-bit keys, two layer colors and the
 /// accumulators per pixel, and a counter.
 pub fn memory_bytes(pixels: u64) -> u64 {
     pixels * (4 * 8 + 2 * 16 + PEEL_WORDS * 4) + 4
 }
+
+const MEMORY: Memory = Memory::Frame { formula: "W·H·100 + 4", bytes: |px, _| memory_bytes(px) };
 
 struct Pipelines {
     init: wgpu::ComputePipeline,
@@ -124,15 +136,6 @@ impl Peel {
 
 impl Method for Peel {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        let needed = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
-        if !cx.gpu.features.contains(needed) {
-            return Err(OitError::Unsupported(format!(
-                "adapter '{}' lacks 64-bit atomic min/max (SHADER_INT64, SHADER_INT64_ATOMIC_MIN_MAX), which \
-                 depth_peeling and dual_depth_peeling use to order fragments; abuffer, sbuffer and the other \
-                 methods still work",
-                cx.gpu.info.name
-            )));
-        }
         if self.pipelines.is_none() {
             self.pipelines = Some(self.build(cx));
         }

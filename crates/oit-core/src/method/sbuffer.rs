@@ -5,7 +5,7 @@
 
 use super::abuffer::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{FrameCtx, Method, MethodInfo, MethodReport};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order};
 use crate::error::Result;
 use crate::gpu_types::PoolNode;
 
@@ -16,6 +16,11 @@ pub const INFO: MethodInfo = MethodInfo {
     bounded_memory: false,
     passes: &["count (geometry)", "prefix sum (compute)", "capture (geometry)", "sweeps (compute)", "resolve (full screen)"],
     params: &[],
+    features: wgpu::Features::empty(),
+    order: Order::Bitwise,
+    antialias_modes: FRAMES,
+    memory: Memory::Scene { formula: "24 B/fragment + 56 B/pixel + scan sums" },
+    error_bound: ErrorBound::Exact,
     create: |gpu, limits| {
         Box::new(SBuffer(ListMethod::new(
             gpu,

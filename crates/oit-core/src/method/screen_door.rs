@@ -2,7 +2,7 @@
 //! geometry pass that draws the nearest fragment whose alpha beats its pixel's threshold,
 //! opaque (shaders/screen_door.wgsl).
 
-use super::{FrameCtx, Method, MethodInfo, MethodReport};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order};
 use crate::error::Result;
 use crate::pipeline;
 use crate::shader;
@@ -15,6 +15,11 @@ pub const INFO: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["dithered geometry (depth test and write)"],
     params: &[],
+    features: wgpu::Features::empty(),
+    order: Order::BitwiseExceptTies,
+    antialias_modes: FRAMES,
+    memory: Memory::Frame { formula: "W·H·4", bytes: |px, _| memory_bytes(px) },
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(ScreenDoor { pipeline: None, depth: None }),
 };
 

@@ -3,8 +3,8 @@
 //! an accumulation pass and a resolve (shaders/stochastic.wgsl). Deterministic for a seed.
 
 use super::weighted::{accumulation_targets, target, ACCUM_FORMAT, AUX_FORMAT, REVEAL};
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
-use crate::error::{OitError, Result};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
+use crate::error::Result;
 use crate::gpu_types::FrameUniform;
 use crate::pipeline;
 use crate::shader::{self, Const};
@@ -28,6 +28,11 @@ pub const INFO: MethodInfo = MethodInfo {
             doc: "random seed of the coverage masks",
         },
     ],
+    features: wgpu::Features::FLOAT32_BLENDABLE,
+    order: Order::Submission,
+    antialias_modes: FRAMES,
+    memory: Memory::Frame { formula: "W·H·(4·samples + 20)", bytes: |px, p| memory_bytes(px, p.int("samples") as u64) },
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Stochastic { pipelines: None, buffers: None }),
 };
 
@@ -86,12 +91,6 @@ fn build(cx: &FrameCtx<'_>, samples: u32) -> Pipelines {
 
 impl Method for Stochastic {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        if !cx.gpu.has(wgpu::Features::FLOAT32_BLENDABLE) {
-            return Err(OitError::Unsupported(format!(
-                "adapter '{}' cannot blend into 32-bit float targets (FLOAT32_BLENDABLE), which stochastic needs",
-                cx.gpu.info.name
-            )));
-        }
         let samples = cx.params.int("samples") as u32;
         let seed = cx.params.int("seed") as u32;
         if self.pipelines.as_ref().is_none_or(|p| p.samples != samples) {

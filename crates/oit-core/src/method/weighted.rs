@@ -1,8 +1,8 @@
 //! `wsum`, `wavg` and `wboit`: one geometry pass with additive (and, for wboit's revealage,
 //! multiplicative) blending into two float targets, then a full-screen resolve.
 
-use super::{FrameCtx, Method, MethodInfo, MethodReport, ParamInfo, ParamKind};
-use crate::error::{OitError, Result};
+use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
+use crate::error::Result;
 use crate::pipeline;
 use crate::shader::{self, Const};
 
@@ -20,6 +20,11 @@ pub const WSUM: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["accumulate (geometry, blended)", "resolve (full screen)"],
     params: &[],
+    features: wgpu::Features::FLOAT32_BLENDABLE,
+    order: Order::Rounding,
+    antialias_modes: FRAMES,
+    memory: MEMORY,
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Weighted::new(Kind::Sum)),
 };
 
@@ -30,6 +35,11 @@ pub const WAVG: MethodInfo = MethodInfo {
     bounded_memory: true,
     passes: &["accumulate (geometry, blended)", "resolve (full screen)"],
     params: &[],
+    features: wgpu::Features::FLOAT32_BLENDABLE,
+    order: Order::Rounding,
+    antialias_modes: FRAMES,
+    memory: MEMORY,
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Weighted::new(Kind::Average)),
 };
 
@@ -47,6 +57,11 @@ pub const WBOIT: MethodInfo = MethodInfo {
         kind: ParamKind::Choice { choices: WBOIT_WEIGHTS, default: "eq10" },
         doc: "weight function (paper's eq. 7-10); eq7-9 use the view distance, eq10 the window depth",
     }],
+    features: wgpu::Features::FLOAT32_BLENDABLE,
+    order: Order::Rounding,
+    antialias_modes: FRAMES,
+    memory: MEMORY,
+    error_bound: ErrorBound::None,
     create: |_, _| Box::new(Weighted::new(Kind::Blended)),
 };
 
@@ -57,6 +72,8 @@ pub(crate) const AUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float
 pub fn memory_bytes(pixels: u64) -> u64 {
     pixels * (16 + 4)
 }
+
+const MEMORY: Memory = Memory::Frame { formula: "W·H·20", bytes: |px, _| memory_bytes(px) };
 
 pub(crate) const ADD: wgpu::BlendComponent =
     wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
@@ -161,13 +178,6 @@ pub(crate) fn target(device: &wgpu::Device, size: (u32, u32), format: wgpu::Text
 
 impl Method for Weighted {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        if !cx.gpu.has(wgpu::Features::FLOAT32_BLENDABLE) {
-            return Err(OitError::Unsupported(format!(
-                "adapter '{}' cannot blend into 32-bit float targets (FLOAT32_BLENDABLE), which wsum, wavg and \
-                 wboit need; hybrid, ktab and the exact methods still work",
-                cx.gpu.info.name
-            )));
-        }
         let weight = if self.kind == Kind::Blended { cx.params.choice("weight").to_string() } else { "eq10".into() };
         if self.pipelines.as_ref().is_none_or(|p| p.weight != weight) {
             self.pipelines = Some(self.build(cx, &weight));

@@ -1,0 +1,33 @@
+//! Embeds every WGSL file under `shaders/` (the list `shader::SOURCES` is generated here, not
+//! kept by hand): a new shader file is picked up by the next build.
+
+use std::path::{Path, PathBuf};
+
+fn collect(dir: &Path, root: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<_> = std::fs::read_dir(dir).expect("shaders/ is readable").map(|e| e.expect("entry").path()).collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            collect(&p, root, out);
+        } else if p.extension().is_some_and(|e| e == "wgsl") {
+            out.push(p.strip_prefix(root).expect("under shaders/").to_path_buf());
+        }
+    }
+}
+
+fn main() {
+    let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
+    let root = manifest.join("../../shaders").canonicalize().expect("shaders/ beside the crates");
+    println!("cargo::rerun-if-changed={}", root.display());
+    let mut files = Vec::new();
+    collect(&root, &root, &mut files);
+    let mut code = String::from("/// Every WGSL file, embedded at build time, by path relative to `shaders/`.\npub const SOURCES: &[(&str, &str)] = &[\n");
+    for f in &files {
+        let rel = f.to_str().expect("UTF-8 shader path").replace('\\', "/");
+        println!("cargo::rerun-if-changed={}", root.join(f).display());
+        code.push_str(&format!("    ({rel:?}, include_str!({:?})),\n", root.join(f).display().to_string()));
+    }
+    code.push_str("];\n");
+    let out = PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo")).join("shader_sources.rs");
+    std::fs::write(out, code).expect("OUT_DIR is writable");
+}

@@ -1,0 +1,54 @@
+//! Numbers shared by Rust, WGSL and Python. Each is defined here once: `shader::compose`
+//! prepends every one of them to every shader, and `oit.constants()` exports them to Python
+//! (python/oit/models.py reads them there). `tests/shader_validation.rs` checks that naga sees
+//! the same values and that no shader defines one of its own.
+
+use crate::shader::Const;
+
+/// Words per pixel of hybrid's accumulators: core RGB (3), tail sums as 64-bit pairs (8), tail
+/// count, transmittance behind the core, nearest evicted key, two error-bound sums, and the tail
+/// colors' smallest and largest channel (shaders/hybrid.wgsl).
+pub const HYBRID_ACCUM_WORDS: u32 = 18;
+/// Words per pixel of hybrid64's tail accumulators: the 64-bit sum pairs and a count.
+pub const HYBRID64_ACCUM_WORDS: u32 = 9;
+/// Words per pixel of the peeling methods' accumulators (shaders/peel.wgsl).
+pub const PEEL_WORDS: u32 = 9;
+/// Fixed-point scale of hybrid's core sums (values in [0, 1], total <= 1): 2^31.
+pub const CORE_SCALE: f32 = 2_147_483_648.0;
+/// Fixed-point scale of hybrid's tail sums (64-bit pairs): 2^24.
+pub const TAIL_SCALE: f32 = 16_777_216.0;
+/// Window depth to the 24-bit depth of k-TAB keys: z · DEPTH_SCALE, at most DEPTH_MAX (the
+/// largest value leaves 0xffffff free, so that an empty slot sorts behind every fragment).
+pub const DEPTH_SCALE: f32 = 16_777_215.0;
+pub const DEPTH_MAX: u32 = 0x00ff_fffe;
+/// The 8-bit alpha's rounding bias, 2^-10 of a step (shaders/common/alpha8.wgsl).
+pub const ALPHA_8BIT_BIAS: f32 = 0.000_976_562_5;
+/// Largest |q - alpha| of the biased 8-bit alpha: (1/2 + 2^-10) / 255.
+pub const ALPHA_8BIT_ERROR: f64 = (0.5 + 1.0 / 1024.0) / 255.0;
+/// Float32 and fixed-point rounding per term of hybrid's error bound (docs/methods.md).
+pub const ROUNDING_TERM: f64 = 2.4e-7;
+/// auto's estimate: optical depth per fragment capped at TAU_CAP, and the fixed-point scales of
+/// its sums of τ, τ² and |alpha - q| (shaders/auto_estimate.wgsl).
+pub const TAU_CAP: f32 = 16.0;
+pub const TAU_SCALE: f32 = 4096.0;
+pub const TAU2_SCALE: f32 = 1024.0;
+pub const QUANT_SCALE: f32 = 16_777_216.0;
+
+/// Every shared constant, in the order they are prepended (float64 ones as the float32 the
+/// shaders compute with).
+pub const SHARED: &[Const] = &[
+    Const::U32("HYBRID_ACCUM_WORDS", HYBRID_ACCUM_WORDS),
+    Const::U32("HYBRID64_ACCUM_WORDS", HYBRID64_ACCUM_WORDS),
+    Const::U32("PEEL_WORDS", PEEL_WORDS),
+    Const::F32("CORE_SCALE", CORE_SCALE),
+    Const::F32("TAIL_SCALE", TAIL_SCALE),
+    Const::F32("DEPTH_SCALE", DEPTH_SCALE),
+    Const::U32("DEPTH_MAX", DEPTH_MAX),
+    Const::F32("ALPHA_8BIT_BIAS", ALPHA_8BIT_BIAS),
+    Const::F32("ALPHA_8BIT_ERROR", ALPHA_8BIT_ERROR as f32),
+    Const::F32("ROUNDING_TERM", ROUNDING_TERM as f32),
+    Const::F32("TAU_CAP", TAU_CAP),
+    Const::F32("TAU_SCALE", TAU_SCALE),
+    Const::F32("TAU2_SCALE", TAU2_SCALE),
+    Const::F32("QUANT_SCALE", QUANT_SCALE),
+];
