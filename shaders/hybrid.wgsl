@@ -25,10 +25,10 @@ const ACCUM_WORDS: u32 = HYBRID_ACCUM_WORDS;
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
 @group(2) @binding(1) var<storage, read_write> vis: array<f32>;
 @group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
-@group(2) @binding(3) var<storage, read_write> overflow: atomic<u32>;
+@group(2) @binding(4) var<storage, read_write> overflow: atomic<u32>;
 // With PER_PIXEL, pixel px owns slots offsets[px] .. offsets[px + 1] (a prefix sum of each
 // pixel's own k, chosen by auto); otherwise K slots a pixel and this binding is unused.
-@group(2) @binding(4) var<storage, read_write> offsets: array<u32>;
+@group(2) @binding(3) var<storage, read_write> offsets: array<u32>;
 
 // The first slot and the slot count of pixel px.
 fn slots(px: u32) -> vec2<u32> {

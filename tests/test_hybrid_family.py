@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 import oit
-from oit import models
-from oit import memory_bytes
+from oit import memory_bytes, models
 from oit.models import ALPHA_8BIT_ERROR
 from oit.scenes import stacks
 from scenes import IDENTITY, build_scene, layer, random_meshes

@@ -23,8 +23,8 @@ def scene():
 
 
 def runs():
-    for name, info in INFO.items():
-        for params in [{}] + VARIANTS.get(name, []):
+    for name in INFO:
+        for params in [{}, *VARIANTS.get(name, [])]:
             yield pytest.param(name, params, id=f"{name}-{params}" if params else name)
 
 
@@ -84,7 +84,7 @@ def test_the_adapter_runs_exactly_the_methods_whose_features_it_has(renderer):
 
 
 def test_memory_bytes_refuses_what_it_cannot_answer():
-    with pytest.raises(ValueError, match="unknown method 'hybird'.*did you mean 'hybrid'"):
+    with pytest.raises(ValueError, match=r"unknown method 'hybird'.*did you mean 'hybrid'"):
         oit.memory_bytes("hybird", 4, 4)
     with pytest.raises(ValueError, match="k = 99 is out of range"):
         oit.memory_bytes("hybrid", 4, 4, k=99)
@@ -101,6 +101,16 @@ def test_shared_constants_are_the_models():
     from oit import models
 
     c = oit.constants()
-    assert models.DEPTH_MAX == c["DEPTH_MAX"] and models.ALPHA_8BIT_ERROR == c["ALPHA_8BIT_ERROR"]
-    assert models.ALPHA_8BIT_BIAS == np.float32(c["ALPHA_8BIT_BIAS"])
+    assert c["DEPTH_MAX"] == models.DEPTH_MAX and c["ALPHA_8BIT_ERROR"] == models.ALPHA_8BIT_ERROR
+    assert np.float32(c["ALPHA_8BIT_BIAS"]) == models.ALPHA_8BIT_BIAS
     assert c["ALPHA_8BIT_ERROR"] == (0.5 + 2.0 ** -10) / 255.0
+
+
+@pytest.mark.parametrize("name", ["abuffer", "hybrid", "wboit"])
+def test_stats_have_the_documented_keys(renderer, name):
+    # oit.Stats documents every key; method-specific figures are under "extra" only.
+    frame = renderer(*SIZE).render(scene(), IDENTITY, name)
+    documented = set(oit.Stats.__annotations__)
+    keys = set(frame.stats)
+    assert keys <= documented and documented - keys <= {"error_bound_max"}, keys ^ documented
+    assert all(isinstance(v, float) for v in frame.stats["extra"].values())

@@ -21,7 +21,9 @@ fn main() {
     println!("cargo::rerun-if-changed={}", root.display());
     let mut files = Vec::new();
     collect(&root, &root, &mut files);
-    let mut code = String::from("/// Every WGSL file, embedded at build time, by path relative to `shaders/`.\npub const SOURCES: &[(&str, &str)] = &[\n");
+    let mut code = String::from(
+        "/// Every WGSL file, embedded at build time, by path relative to `shaders/`.\npub const SOURCES: &[(&str, &str)] = &[\n",
+    );
     for f in &files {
         let rel = f.to_str().expect("UTF-8 shader path").replace('\\', "/");
         println!("cargo::rerun-if-changed={}", root.join(f).display());

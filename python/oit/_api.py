@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 
@@ -256,6 +256,30 @@ class Camera:
         return cls.look_at(center + d * dist, center, fov_y, near=near, far=far, aspect=aspect)
 
 
+class Stats(TypedDict, total=False):
+    """`frame.stats`: what every frame reports. Method-specific figures are under `extra`."""
+
+    method: str
+    params: dict[str, Any]  # every parameter, defaults filled in
+    fragments: int  # transparent fragments in front of the opaque depth (summed over samples)
+    max_depth_complexity: int
+    memory_bytes: int  # what the method allocated (oit.memory_bytes gives its formula)
+    target_bytes: int  # the shared frame targets: base color, depth, output, census, bound
+    scene_bytes: int
+    gpu_time_ms: float | None  # None where the adapter has no timestamp queries
+    pass_times_ms: dict[str, float]  # per pass; a pass run more than once adds up
+    overflow_fragments: int  # fragments a bounded structure could not hold
+    wall_time_ms: float
+    antialias: int
+    antialias_mode: str
+    adapter: str
+    error_bound_max: float  # the largest of frame.error_bound, where the method derives one
+    # Method-specific: the node pool's `pool_nodes`, `pool_regrown`, `resolve_sweeps` (list
+    # methods); `tail_fragments` (k-TAB methods); `geometry_passes`, `peeled_fragments` (peeling);
+    # `auto_k`, `auto_mean_k`, `auto_slots`, `auto_predicted_k`, `auto_exact`, `auto_attempts` (auto).
+    extra: dict[str, float]
+
+
 @dataclass
 class Frame:
     """One rendered frame. `image`: (h, w, 4) float32, linear; RGB is the final color and A
@@ -265,7 +289,7 @@ class Frame:
     otherwise None, and `error_bound_reason` says why."""
 
     image: np.ndarray
-    stats: dict
+    stats: Stats
     depth_complexity: np.ndarray = field(repr=False)
     error_bound: np.ndarray | None = field(default=None, repr=False)
     error_bound_reason: str = ""

@@ -12,6 +12,8 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     pub features: wgpu::Features,
     pub limits: wgpu::Limits,
+    /// Modules, layouts and pipelines of this device, built at their first use.
+    pub cache: crate::resources::PipelineCache,
 }
 
 const NO_ADAPTER_HELP: &str = "no GPU adapter found: install a Vulkan driver, or the software \
@@ -91,7 +93,7 @@ impl GpuContext {
             let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
             slot.get_or_insert_with(|| e.to_string());
         }));
-        Self { device, errors, queue, info, features, limits }
+        Self { device, errors, queue, info, features, limits, cache: Default::default() }
     }
 
     pub fn has(&self, f: wgpu::Features) -> bool {

@@ -10,6 +10,7 @@ pub mod method;
 mod pipeline;
 pub mod reference;
 pub mod renderer;
+pub mod resources;
 mod scan;
 pub mod scene;
 pub mod shader;

@@ -1,7 +1,7 @@
 //! Builders for the two kinds of pipeline every method uses: geometry passes over the
 //! scene (vertex pulling) and full-screen passes.
 
-use crate::targets::{BOUND_FORMAT, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::targets::DEPTH_FORMAT;
 
 /// Depth state of transparent geometry passes: test against the opaque depth, never write.
 pub fn depth_test_only() -> Option<wgpu::DepthStencilState> {
@@ -67,29 +67,8 @@ pub fn geometry_samples(
     })
 }
 
-/// A full-screen pass writing one RGBA32F target with the fragment entry `fs`.
-pub fn fullscreen(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::PipelineLayout,
-    fs: &str,
-) -> wgpu::RenderPipeline {
-    fullscreen_targets(device, label, module, layout, fs, &[Some(COLOR_FORMAT.into())])
-}
-
-/// A full-screen pass writing the RGBA32F output and the R32F error bound.
-pub fn fullscreen_with_bound(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::PipelineLayout,
-    fs: &str,
-) -> wgpu::RenderPipeline {
-    fullscreen_targets(device, label, module, layout, fs, &[Some(COLOR_FORMAT.into()), Some(BOUND_FORMAT.into())])
-}
-
-fn fullscreen_targets(
+/// A full-screen pass writing `targets` with the fragment entry `fs`.
+pub fn fullscreen_targets(
     device: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,

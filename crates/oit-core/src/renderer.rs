@@ -11,11 +11,12 @@ use crate::error::{invalid, OitError, Result};
 use crate::gpu_types::FrameUniform;
 use crate::method::{self, AntialiasMode, FrameCtx, Limits, Method, MethodInfo, ParamValue, Params};
 use crate::pipeline;
+use crate::resources::Layout;
 use crate::scene::{Camera, Scene};
 use crate::shader;
-use crate::targets::{read_buffer, read_rows, samples_layout, targets_layout, SampleTargets, Targets, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::targets::{read_buffer, read_rows, SampleTargets, Targets, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::timer::PassTimer;
-use crate::upload::{scene_layout, GpuScene};
+use crate::upload::GpuScene;
 
 /// Numbers about one frame (see the contract in README and docs/methods.md).
 #[derive(Clone, Debug, Default)]
@@ -74,8 +75,8 @@ struct Shared {
 impl Shared {
     fn new(gpu: &GpuContext) -> Self {
         let d = &gpu.device;
-        let scene_layout = scene_layout(d);
-        let targets_layout = targets_layout(d);
+        let scene_layout = gpu.cache.layout(d, Layout::Scene);
+        let targets_layout = gpu.cache.layout(d, Layout::Targets);
         let counts_layout =
             d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("census"), entries: &[pipeline::storage_entry(0)] });
         let opaque_module = shader::module(d, "opaque.wgsl", &[]);
@@ -323,8 +324,6 @@ impl Renderer {
             scene: gpu_scene,
             camera,
             targets: &self.targets,
-            targets_layout: cov.map_or(&self.shared.targets_layout, |c| &c.layout),
-            scene_layout: &self.shared.scene_layout,
             timer: &mut self.timer,
             params,
             depth_complexity: &depth_complexity,
@@ -447,10 +446,9 @@ impl Renderer {
     }
 }
 
-/// What a coverage-mask frame needs besides the frame targets: the per-sample targets, their
-/// layout, and the multisampled census.
+/// What a coverage-mask frame needs besides the frame targets: the per-sample targets and the
+/// multisampled census.
 struct Coverage {
-    layout: wgpu::BindGroupLayout,
     targets: SampleTargets,
     census: wgpu::RenderPipeline,
 }
@@ -458,11 +456,11 @@ struct Coverage {
 impl Coverage {
     fn new(gpu: &GpuContext, width: u32, height: u32, shared: &Shared) -> Self {
         let d = &gpu.device;
-        let layout = samples_layout(d);
+        let layout = gpu.cache.layout(d, Layout::SampleTargets);
         let targets = SampleTargets::new(gpu, width, height, COVERAGE_SAMPLES, &layout);
         let module = shader::module(d, "census_samples.wgsl", &[]);
         let pl = pipeline::layout(d, &[&shared.scene_layout, &layout, &shared.counts_layout]);
         let census = pipeline::geometry_samples(d, "census", &module, &pl, "fs_census", &[], pipeline::raster_only(), COVERAGE_SAMPLES);
-        Self { layout, targets, census }
+        Self { targets, census }
     }
 }

@@ -64,3 +64,25 @@ fn opaque_occludes_and_unsorted_agrees_when_submitted_back_to_front() {
         assert!((u.image[i] as f64 - want.image[i]).abs() < 1e-6, "unsorted {i}: {} vs {}", u.image[i], want.image[i]);
     }
 }
+
+#[test]
+fn frames_look_pipelines_up_and_never_build_them_twice() {
+    // Every method once, then every method again on another renderer of the same device: the
+    // second round finds each pipeline in the device's cache.
+    let mut scene = Scene::new();
+    scene.add_mesh(quad(0.3, [1.0, 0.0, 0.0, 0.5], false));
+    scene.add_mesh(quad(0.6, [0.0, 0.0, 1.0, 0.5], false));
+    // A device of its own: other tests' frames build pipelines in the shared device's cache.
+    let ctx = std::sync::Arc::new(oit_core::GpuContext::new(None).expect("a GPU adapter (lavapipe in CI)"));
+    let names: Vec<&str> = oit_core::methods().iter().filter(|m| ctx.features.contains(m.features)).map(|m| m.name).collect();
+    let mut first = Renderer::new(ctx.clone(), 8, 8).unwrap();
+    for name in &names {
+        first.render(&scene, &identity(), name, &[], [1.0; 3]).unwrap();
+    }
+    let built = ctx.cache.pipelines();
+    let mut second = Renderer::new(ctx.clone(), 6, 4).unwrap();
+    for name in &names {
+        second.render(&scene, &identity(), name, &[], [1.0; 3]).unwrap();
+    }
+    assert_eq!(ctx.cache.pipelines(), built, "a frame built a pipeline that an earlier frame had built");
+}

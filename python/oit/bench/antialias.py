@@ -10,7 +10,8 @@ from typing import Any
 
 import numpy as np
 
-from .._api import constants, methods as list_methods
+from .._api import constants
+from .._api import methods as list_methods
 from .harness import Progress, Result, mean_rgb_distance, scene_jobs, timed
 
 AA_METHODS = ("abuffer", "hybrid", "hybrid64", "wboit", "unsorted")

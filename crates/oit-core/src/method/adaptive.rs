@@ -4,7 +4,7 @@
 //! order and composites every fragment by it (shaders/adaptive.wgsl).
 
 use super::lists::{loop_limited, Aux, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
-use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
+use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
 use crate::error::{OitError, Result};
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;

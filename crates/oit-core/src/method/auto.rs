@@ -8,14 +8,13 @@
 //! slots once, and then the exact A-buffer is rendered. When some pixel has no k ≤ 32
 //! predicted to meet t, the A-buffer is rendered directly.
 
-use super::hybrid::{Hybrid, Slots};
-use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, Params};
+use super::ktab::{KTab, Slots};
+use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, Params, FRAMES};
 use crate::consts::{self, ALPHA_8BIT_ERROR, ROUNDING_TERM as ROUNDING};
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::pipeline;
-use crate::shader;
-use crate::targets::{read_buffer, read_rows, storage_buffer};
+use crate::resources::{Readback, ShaderKey, StorageGroup};
+use crate::targets::read_rows;
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "auto",
@@ -35,7 +34,10 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Slots { formula: "2·Σk·4 + W·H·96 + 8 (hybrid with per-pixel slots and the estimate), or the A-buffer's", bytes: memory_bytes },
+    memory: Memory::Slots {
+        formula: "2·Σk·4 + W·H·96 + 8 (hybrid with per-pixel slots and the estimate), or the A-buffer's",
+        bytes: memory_bytes,
+    },
     error_bound: ErrorBound::PerPixel,
     create: |gpu, limits| Box::new(Auto::new(gpu, limits)),
 };
@@ -47,71 +49,37 @@ const TAU_SCALE: f64 = consts::TAU_SCALE as f64;
 const TAU2_SCALE: f64 = consts::TAU2_SCALE as f64;
 const QUANT_SCALE: f64 = consts::QUANT_SCALE as f64;
 
-struct Estimate {
-    pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
-    /// (pixels, buffer, readback, group)
-    buffers: Option<(u64, wgpu::Buffer, wgpu::Buffer, wgpu::BindGroup)>,
-}
-
 struct Auto {
-    hybrid: Hybrid,
+    hybrid: KTab,
     exact: Box<dyn Method>,
-    estimate: Option<Estimate>,
+    /// The estimate pass's sums, and their readback by size.
+    estimate: Option<StorageGroup>,
+    readback: Option<(u64, Readback)>,
 }
 
 impl Auto {
     fn new(gpu: &GpuContext, limits: &super::Limits) -> Self {
-        let hybrid = Hybrid::new(true);
+        let hybrid = KTab::new(true);
         let exact = super::lookup("abuffer").expect("registered").instantiate(gpu, limits);
-        Self { hybrid, exact, estimate: None }
+        Self { hybrid, exact, estimate: None, readback: None }
     }
 
     /// Runs the estimate pass; returns its sums per pixel.
     fn measure(&mut self, cx: &mut FrameCtx<'_>) -> Result<Vec<Sums>> {
-        let d = &cx.gpu.device;
-        let est = self.estimate.get_or_insert_with(|| {
-            let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("auto estimate"),
-                entries: &[pipeline::storage_entry(0)],
-            });
-            let module = shader::module(d, "auto_estimate.wgsl", &[]);
-            let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &layout]);
-            let pipeline = pipeline::geometry(d, "auto estimate", &module, &pl, "fs_estimate", &[], pipeline::depth_test_only());
-            Estimate { pipeline, layout, buffers: None }
-        });
-        let t = cx.targets;
-        let pixels = t.width as u64 * t.height as u64;
-        if est.buffers.as_ref().is_none_or(|b| b.0 != pixels) {
-            est.buffers = None;
-            cx.check_per_pixel("auto's estimate", WORDS * 4)?;
-            let buffer = storage_buffer(d, "auto estimate", pixels * WORDS * 4, wgpu::BufferUsages::COPY_SRC);
-            let readback = d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("auto estimate readback"),
-                size: pixels * WORDS * 4,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("auto estimate"),
-                layout: &est.layout,
-                entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
-            });
-            est.buffers = Some((pixels, buffer, readback, group));
+        let bytes = cx.pixels() * WORDS * 4;
+        cx.check_per_pixel("auto's estimate", WORDS * 4)?;
+        let b = StorageGroup::ensure(&mut self.estimate, cx.gpu, &[("auto estimate", bytes)], &[]);
+        if self.readback.as_ref().is_none_or(|(n, _)| *n != bytes) {
+            self.readback = Some((bytes, Readback::new(cx.gpu, "auto estimate readback", bytes)));
         }
-        let (_, buffer, readback, group) = est.buffers.as_ref().expect("made above");
-        let mut enc = d.create_command_encoder(&Default::default());
-        enc.clear_buffer(buffer, 0, None);
-        {
-            let mut pass = pipeline::capture_pass(&mut enc, "auto estimate", &t.depth, cx.timer.render_pass("estimate"));
-            pass.set_pipeline(&est.pipeline);
-            pass.set_bind_group(1, &t.group, &[]);
-            pass.set_bind_group(2, group, &[]);
-            cx.scene.transparent.draw_all(&mut pass);
-        }
-        enc.copy_buffer_to_buffer(buffer, 0, readback, 0, pixels * WORDS * 4);
-        cx.gpu.queue.submit([enc.finish()]);
-        let raw = read_buffer(cx.gpu, readback, pixels * WORDS * 4)?;
+        let (_, readback) = self.readback.as_ref().expect("made above");
+        let pipeline = cx.capture_pipeline(&ShaderKey::new("auto_estimate.wgsl", &[]), "fs_estimate", b.layout());
+        let mut enc = cx.encoder();
+        b.clear(&mut enc);
+        cx.capture(&mut enc, "estimate", &pipeline, &b.group);
+        readback.copy(&mut enc, &b.buffers[0]);
+        cx.submit(enc);
+        let raw = readback.read(cx.gpu)?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&raw);
         Ok(words
             .chunks_exact(WORDS as usize)
@@ -131,7 +99,7 @@ const WORDS: u64 = 5;
 /// Bytes auto allocates when it renders hybrid with `slots` k-TAB slots in all: hybrid's
 /// per-pixel-slot buffers and the estimate's words.
 pub fn memory_bytes(pixels: u64, slots: u64) -> u64 {
-    super::hybrid::memory_bytes_per_pixel(pixels, slots) + pixels * WORDS * 4
+    super::ktab::memory_bytes_per_pixel(pixels, slots) + pixels * WORDS * 4
 }
 /// How many standard deviations below its mean the nearest fragments' optical depth is taken.
 const SPREAD: f64 = 3.0;

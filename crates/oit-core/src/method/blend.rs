@@ -1,10 +1,10 @@
 //! `unsorted` and `sorted`: fixed-function over-blending onto the opaque image, in
 //! submission order or per mesh back to front by centroid (docs/methods.md).
 
-use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order};
+use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, FRAMES};
 use crate::error::Result;
 use crate::pipeline;
-use crate::shader;
+use crate::resources::{Layout, ShaderKey};
 use crate::targets::COLOR_FORMAT;
 
 pub const UNSORTED: MethodInfo = MethodInfo {
@@ -19,7 +19,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
-    create: |_, _| Box::new(Blend::new(Kind::Unsorted)),
+    create: |_, _| Box::new(Blend { kind: Kind::Unsorted }),
 };
 
 pub const SORTED: MethodInfo = MethodInfo {
@@ -34,7 +34,7 @@ pub const SORTED: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
-    create: |_, _| Box::new(Blend::new(Kind::Sorted)),
+    create: |_, _| Box::new(Blend { kind: Kind::Sorted }),
 };
 
 pub const ADDITIVE: MethodInfo = MethodInfo {
@@ -49,7 +49,7 @@ pub const ADDITIVE: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
-    create: |_, _| Box::new(Blend::new(Kind::Additive)),
+    create: |_, _| Box::new(Blend { kind: Kind::Additive }),
 };
 
 pub const FILTER: MethodInfo = MethodInfo {
@@ -64,7 +64,7 @@ pub const FILTER: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
-    create: |_, _| Box::new(Blend::new(Kind::Filter)),
+    create: |_, _| Box::new(Blend { kind: Kind::Filter }),
 };
 
 #[derive(Clone, Copy, PartialEq)]
@@ -104,28 +104,13 @@ impl Kind {
 
 struct Blend {
     kind: Kind,
-    pipeline: Option<wgpu::RenderPipeline>,
-}
-
-impl Blend {
-    fn new(kind: Kind) -> Self {
-        Self { kind, pipeline: None }
-    }
-}
-
-fn blend_pipeline(cx: &FrameCtx<'_>, kind: Kind) -> Result<wgpu::RenderPipeline> {
-    let d = &cx.gpu.device;
-    let module = shader::module(d, "blend.wgsl", &[]);
-    let layout = pipeline::layout(d, &[cx.scene_layout]);
-    let target = wgpu::ColorTargetState { format: COLOR_FORMAT, blend: Some(kind.blend()), write_mask: wgpu::ColorWrites::ALL };
-    Ok(pipeline::geometry(d, "blend", &module, &layout, kind.entry(), &[Some(target)], pipeline::depth_test_only()))
 }
 
 impl Method for Blend {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        if self.pipeline.is_none() {
-            self.pipeline = Some(blend_pipeline(cx, self.kind)?);
-        }
+        let target = wgpu::ColorTargetState { format: COLOR_FORMAT, blend: Some(self.kind.blend()), write_mask: wgpu::ColorWrites::ALL };
+        let shader = ShaderKey::new("blend.wgsl", &[]);
+        let pipeline = cx.draw_pipeline(&shader, self.kind.entry(), vec![Layout::Scene], vec![Some(target)], pipeline::depth_test_only());
         let geo = &cx.scene.transparent;
         let mut order: Vec<usize> = (0..geo.meshes.len()).collect();
         if self.kind == Kind::Sorted {
@@ -145,7 +130,7 @@ impl Method for Blend {
         let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = pipeline::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.timer.render_pass("blend"));
-            pass.set_pipeline(self.pipeline.as_ref().expect("built above"));
+            pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &geo.group, &[]);
             for i in order {
                 let m = geo.meshes[i];

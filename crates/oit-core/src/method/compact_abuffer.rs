@@ -5,7 +5,7 @@
 
 use super::abuffer::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order};
+use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, FRAMES};
 use crate::error::Result;
 use crate::gpu_types::{CompactNode, PrimShading};
 

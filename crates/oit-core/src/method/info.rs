@@ -308,4 +308,3 @@ fn check(method: &str, info: &ParamInfo, value: &ParamValue) -> Result<ParamValu
         }
     }
 }
-

@@ -7,15 +7,18 @@ use super::{FrameCtx, Limits, MethodReport};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::Alloc;
-use crate::pipeline;
+use crate::resources::{Layout, ShaderKey};
 use crate::scan::Scan;
-use crate::shader::{self, Const};
+use crate::shader::Const;
 use crate::targets::{read_buffer, storage_buffer};
 
 /// Storage bindings the pool is split across (shaders/common/pool.wgsl).
 pub const POOL_BINDINGS: u64 = 4;
 /// Fragments sorted per sweep of a resolve (shaders/abuffer.wgsl, adaptive.wgsl).
 pub const BATCH: u32 = 32;
+
+/// The pool's group: heads, allocator, the pool bindings, sweep state and binding 7.
+const POOL_LAYOUT: Layout = Layout::Storage(4 + POOL_BINDINGS as u32);
 
 const ALLOC_BYTES: u64 = std::mem::size_of::<Alloc>() as u64;
 
@@ -53,10 +56,7 @@ pub(crate) struct NodePool {
 impl NodePool {
     pub fn new(gpu: &GpuContext, limits: &Limits, node_bytes: u64, state_words: u64, aux_kind: Aux) -> Self {
         let d = &gpu.device;
-        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("node pool"),
-            entries: &(0..4 + POOL_BINDINGS as u32).map(pipeline::storage_entry).collect::<Vec<_>>(),
-        });
+        let layout = gpu.cache.layout(d, POOL_LAYOUT);
         let alloc = storage_buffer(d, "alloc", ALLOC_BYTES, wgpu::BufferUsages::COPY_SRC);
         let alloc_readback = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("alloc readback"),
@@ -187,7 +187,6 @@ pub(crate) struct ListMethod {
     /// Whether the resolve runs `cs_sweep` dispatches before the full-screen pass.
     sweeps: bool,
     aux: Aux,
-    pipelines: Option<Pipelines>,
     /// The prefix sum over binding 7, for `Aux::PixelOffsets`, and the pixels it is for.
     scan: Option<(u64, Scan)>,
 }
@@ -229,39 +228,29 @@ impl ListMethod {
             pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.aux),
             sweeps: layout.state_words > 0,
             aux: layout.aux,
-            pipelines: None,
             scan: None,
         }
     }
 
-    /// Sets the shader constants (besides the pool's); pipelines are rebuilt when they change.
+    /// Sets the shader constants (besides the pool's).
     pub fn set_consts(&mut self, consts: Vec<Const>) {
-        if consts.iter().map(|c| format!("{c:?}")).ne(self.consts.iter().map(|c| format!("{c:?}"))) {
-            self.consts = consts;
-            self.pipelines = None;
-        }
+        self.consts = consts;
     }
 
-    fn build(&mut self, cx: &FrameCtx<'_>) {
-        let d = &cx.gpu.device;
+    /// This frame's pipelines, from the device's cache.
+    fn pipelines(&self, cx: &FrameCtx<'_>) -> Pipelines {
         let mut consts = self.pool.consts().to_vec();
         consts.push(Const::U32("BATCH", BATCH));
         consts.extend(self.consts.iter().copied());
-        let module = shader::module(d, self.shader, &consts);
-        let layout = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &self.pool.layout]);
-        let capture = match cx.coverage {
-            Some(c) => {
-                pipeline::geometry_samples(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::raster_only(), c.samples)
-            }
-            None => pipeline::geometry(d, "list capture", &module, &layout, "fs_capture", &[], pipeline::depth_test_only()),
-        };
-        let resolve = pipeline::fullscreen(d, "list resolve", &module, &layout, "fs_resolve");
-        let compute = |entry: &str| pipeline::compute(d, &layout, &module, entry);
-        let sweep = self.sweeps.then(|| compute("cs_sweep"));
-        let allocate = matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate"));
-        let count = (self.aux == Aux::PixelOffsets)
-            .then(|| pipeline::geometry(d, "list count", &module, &layout, "fs_count", &[], pipeline::depth_test_only()));
-        self.pipelines = Some(Pipelines { allocate, count, capture, sweep, resolve });
+        let shader = ShaderKey::new(self.shader, &consts);
+        let compute = |entry| cx.compute_pipeline(&shader, entry, POOL_LAYOUT);
+        Pipelines {
+            allocate: matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate")),
+            count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(&shader, "fs_count", POOL_LAYOUT)),
+            capture: cx.capture_pipeline(&shader, "fs_capture", POOL_LAYOUT),
+            sweep: self.sweeps.then(|| compute("cs_sweep")),
+            resolve: cx.resolve_pipeline(&shader, "fs_resolve", POOL_LAYOUT, false),
+        }
     }
 
     /// S-buffer preparation: per-pixel counts into binding 7, their exclusive prefix sum in
@@ -275,17 +264,9 @@ impl ListMethod {
         scan: &Scan,
         pixels: u64,
     ) {
-        let t = cx.targets;
         let group = self.pool.group.as_ref().expect("reserved");
-        let targets_group = cx.targets_group();
         enc.clear_buffer(&self.pool.aux, 0, None);
-        {
-            let mut pass = pipeline::capture_pass(enc, "list count", &t.depth, cx.timer.render_pass("count"));
-            pass.set_pipeline(count);
-            pass.set_bind_group(1, targets_group, &[]);
-            pass.set_bind_group(2, group, &[]);
-            cx.scene.transparent.draw_all(&mut pass);
-        }
+        cx.capture(enc, "count", count, group);
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("prefix sum"),
@@ -298,9 +279,7 @@ impl ListMethod {
     }
 
     pub fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        if self.pipelines.is_none() {
-            self.build(cx);
-        }
+        let p = self.pipelines(cx);
         let t = cx.targets;
         let pixels = t.width as u64 * t.height as u64;
         cx.check_per_pixel(
@@ -316,10 +295,9 @@ impl ListMethod {
             self.scan = Some((pixels, Scan::new(cx.gpu, &self.pool.aux, pixels + 1)));
         }
         let mut regrown = 0.0;
-        let (targets_group, raster_depth) = (cx.targets_group(), cx.raster_depth());
+        let targets_group = cx.targets_group();
         loop {
             cx.timer.reset();
-            let p = self.pipelines.as_ref().expect("built above");
             let group = self.pool.group.as_ref().expect("reserved above");
             let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
             self.pool.clear(cx.gpu, &mut enc);
@@ -338,13 +316,7 @@ impl ListMethod {
             if let (Some(count), Some((_, scan))) = (&p.count, &self.scan) {
                 self.count_and_scan(cx, &mut enc, count, scan, pixels);
             }
-            {
-                let mut pass = pipeline::capture_pass(&mut enc, "list capture", raster_depth, cx.timer.render_pass("capture"));
-                pass.set_pipeline(&p.capture);
-                pass.set_bind_group(1, targets_group, &[]);
-                pass.set_bind_group(2, group, &[]);
-                cx.scene.transparent.draw_all(&mut pass);
-            }
+            cx.capture(&mut enc, "capture", &p.capture, group);
             self.pool.copy_count(&mut enc);
             if let Some(sweep) = &p.sweep {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -359,14 +331,7 @@ impl ListMethod {
                     pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
                 }
             }
-            {
-                let mut pass = pipeline::resolve_pass(&mut enc, "list resolve", &t.out, cx.timer.render_pass("resolve"));
-                pass.set_pipeline(&p.resolve);
-                pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
-                pass.set_bind_group(1, targets_group, &[]);
-                pass.set_bind_group(2, group, &[]);
-                pass.draw(0..3, 0..1);
-            }
+            cx.resolve(&mut enc, "resolve", &p.resolve, group, false);
             cx.gpu.queue.submit([enc.finish()]);
             let alloc = self.pool.read_alloc(cx.gpu)?;
             if alloc.escaped > 0 {
@@ -379,7 +344,6 @@ impl ListMethod {
             let count = alloc.count as u64;
             if count <= self.pool.capacity {
                 let memory = self.pool.bytes() + self.scan.as_ref().map_or(0, |(_, s)| s.bytes);
-                let p = self.pipelines.as_ref().expect("built above");
                 // Shrink for the next frame when this one used little of the pool.
                 if count < self.pool.capacity / 4 {
                     self.pool.reserve(cx.gpu, count, pixels, triangles)?;

@@ -4,7 +4,7 @@
 
 use super::adaptive::check_replay_budget;
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
+use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
 use crate::error::Result;
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;

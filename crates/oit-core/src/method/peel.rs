@@ -3,11 +3,10 @@
 //! atomic min/max over (depth, triangle) keys, so coplanar fragments peel one by one
 //! (shaders/peel.wgsl, docs/methods.md).
 
-use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind};
+use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
 use crate::error::Result;
-use crate::pipeline;
-use crate::shader::{self, Const};
-use crate::targets::{read_buffer, storage_buffer};
+use crate::resources::{Counter, Layout, ShaderKey, StorageGroup};
+use crate::shader::Const;
 
 const LAYERS: ParamInfo = ParamInfo {
     name: "layers",
@@ -27,7 +26,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::Exact,
-    create: |_, _| Box::new(Peel::new(false)),
+    create: |_, _| Box::new(Peel { dual: false, buffers: None, peeled: None }),
 };
 
 pub const DUAL_DEPTH_PEELING: MethodInfo = MethodInfo {
@@ -42,7 +41,7 @@ pub const DUAL_DEPTH_PEELING: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::Exact,
-    create: |_, _| Box::new(Peel::new(true)),
+    create: |_, _| Box::new(Peel { dual: true, buffers: None, peeled: None }),
 };
 
 /// Words of per-pixel accumulation.
@@ -56,145 +55,47 @@ pub fn memory_bytes(pixels: u64) -> u64 {
 
 const MEMORY: Memory = Memory::Frame { formula: "W·H·100 + 4", bytes: |px, _| memory_bytes(px) };
 
-struct Pipelines {
-    init: wgpu::ComputePipeline,
-    peel: wgpu::RenderPipeline,
-    composite: wgpu::ComputePipeline,
-    resolve: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
-}
-
-struct Buffers {
-    pixels: u64,
-    group: wgpu::BindGroup,
-    peeled: wgpu::Buffer,
-    readback: wgpu::Buffer,
-    _keep: Vec<wgpu::Buffer>,
-}
-
 struct Peel {
     dual: bool,
-    pipelines: Option<Pipelines>,
-    buffers: Option<Buffers>,
-}
-
-impl Peel {
-    fn new(dual: bool) -> Self {
-        Self { dual, pipelines: None, buffers: None }
-    }
-
-    fn build(&self, cx: &FrameCtx<'_>) -> Pipelines {
-        let d = &cx.gpu.device;
-        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("peel"),
-            entries: &(0..4).map(pipeline::storage_entry).collect::<Vec<_>>(),
-        });
-        let module = shader::module(d, "peel.wgsl", &[Const::U32("DUAL", self.dual as u32)]);
-        let pl = pipeline::layout(d, &[cx.scene_layout, cx.targets_layout, &layout]);
-        let compute = |entry: &str| pipeline::compute(d, &pl, &module, entry);
-        Pipelines {
-            init: compute("cs_init"),
-            peel: pipeline::geometry(d, "peel", &module, &pl, "fs_peel", &[], pipeline::depth_test_only()),
-            composite: compute("cs_composite"),
-            resolve: pipeline::fullscreen(d, "peel resolve", &module, &pl, "fs_resolve"),
-            layout,
-        }
-    }
-
-    fn reserve(&mut self, cx: &FrameCtx<'_>, pixels: u64) -> Result<()> {
-        if self.buffers.as_ref().is_some_and(|b| b.pixels == pixels) {
-            return Ok(());
-        }
-        let d = &cx.gpu.device;
-        let name = if self.dual { "dual_depth_peeling" } else { "depth_peeling" };
-        cx.check_per_pixel(name, 4 * PEEL_WORDS.max(8))?;
-        let keys = storage_buffer(d, "peel keys", pixels * 32, wgpu::BufferUsages::empty());
-        let layers = storage_buffer(d, "peel layers", pixels * 32, wgpu::BufferUsages::empty());
-        let acc = storage_buffer(d, "peel accumulators", pixels * PEEL_WORDS * 4, wgpu::BufferUsages::empty());
-        let peeled = storage_buffer(d, "peeled count", 4, wgpu::BufferUsages::COPY_SRC);
-        let readback = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("peeled readback"),
-            size: 4,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let p = self.pipelines.as_ref().expect("built before reserve");
-        let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("peel"),
-            layout: &p.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: keys.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: layers.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: acc.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: peeled.as_entire_binding() },
-            ],
-        });
-        self.buffers = Some(Buffers { pixels, group, peeled, readback, _keep: vec![keys, layers, acc] });
-        Ok(())
-    }
+    buffers: Option<StorageGroup>,
+    peeled: Option<Counter>,
 }
 
 impl Method for Peel {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        if self.pipelines.is_none() {
-            self.pipelines = Some(self.build(cx));
-        }
-        let t = cx.targets;
-        let pixels = t.width as u64 * t.height as u64;
-        self.reserve(cx, pixels)?;
+        let pixels = cx.pixels();
+        let name = if self.dual { "dual_depth_peeling" } else { "depth_peeling" };
+        cx.check_per_pixel(name, 4 * PEEL_WORDS.max(8))?;
+        let peeled = self.peeled.get_or_insert_with(|| Counter::new(cx.gpu, "peeled count"));
+        let sizes = [("peel keys", pixels * 32), ("peel layers", pixels * 32), ("peel accumulators", pixels * PEEL_WORDS * 4)];
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[peeled]);
         let limit = cx.params.int("layers") as u64;
         let n = cx.max_depth_complexity as u64;
         let layers = if limit == 0 { n } else { limit.min(n) };
         // The first pass only finds; each later pass shades one layer (two when dual).
         let passes = if self.dual { layers.div_ceil(2) } else { layers } + 1;
-        let p = self.pipelines.as_ref().expect("built above");
-        let b = self.buffers.as_ref().expect("reserved above");
-        let geo = &cx.scene.transparent;
-        let groups = (t.width.div_ceil(8), t.height.div_ceil(8));
-        let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&b.peeled, 0, None);
+        let shader = ShaderKey::new("peel.wgsl", &[Const::U32("DUAL", self.dual as u32)]);
+        let own = Layout::Storage(4);
+        let (init, composite) = (cx.compute_pipeline(&shader, "cs_init", own), cx.compute_pipeline(&shader, "cs_composite", own));
+        let peel = cx.capture_pipeline(&shader, "fs_peel", own);
+        let mut enc = cx.encoder();
+        peeled.clear(&mut enc);
+        // One timed span from the first dispatch to the last composite, around every pass.
         let span = cx.timer.span("peel");
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("peel init"),
-                timestamp_writes: cx.timer.span_compute(span, true, false),
-            });
-            pass.set_pipeline(&p.init);
-            pass.set_bind_group(0, &geo.group, &[]);
-            pass.set_bind_group(1, &t.group, &[]);
-            pass.set_bind_group(2, &b.group, &[]);
-            pass.dispatch_workgroups(groups.0, groups.1, 1);
-        }
+        let compute = |cx: &mut FrameCtx<'_>, enc: &mut wgpu::CommandEncoder, pipeline, begin: bool, end: bool| {
+            let timestamps = cx.timer.span_compute(span, begin, end);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("peel"), timestamp_writes: timestamps });
+            cx.bind_dispatch(&mut pass, pipeline, &b.group);
+        };
+        compute(cx, &mut enc, &init, true, false);
         for i in 0..passes {
-            {
-                let mut pass = pipeline::capture_pass(&mut enc, "peel", &t.depth, None);
-                pass.set_pipeline(&p.peel);
-                pass.set_bind_group(1, &t.group, &[]);
-                pass.set_bind_group(2, &b.group, &[]);
-                geo.draw_all(&mut pass);
-            }
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("peel composite"),
-                timestamp_writes: cx.timer.span_compute(span, false, i + 1 == passes),
-            });
-            pass.set_pipeline(&p.composite);
-            pass.set_bind_group(0, &geo.group, &[]);
-            pass.set_bind_group(1, &t.group, &[]);
-            pass.set_bind_group(2, &b.group, &[]);
-            pass.dispatch_workgroups(groups.0, groups.1, 1);
+            cx.capture_untimed(&mut enc, "peel", &peel, &b.group);
+            compute(cx, &mut enc, &composite, false, i + 1 == passes);
         }
-        {
-            let mut pass = pipeline::resolve_pass(&mut enc, "peel resolve", &t.out, cx.timer.render_pass("resolve"));
-            pass.set_pipeline(&p.resolve);
-            pass.set_bind_group(0, &geo.group, &[]);
-            pass.set_bind_group(1, &t.group, &[]);
-            pass.set_bind_group(2, &b.group, &[]);
-            pass.draw(0..3, 0..1);
-        }
-        enc.copy_buffer_to_buffer(&b.peeled, 0, &b.readback, 0, 4);
-        cx.gpu.queue.submit([enc.finish()]);
-        let raw = read_buffer(cx.gpu, &b.readback, 4)?;
-        let peeled = u32::from_le_bytes(raw[..4].try_into().expect("4 bytes")) as u64;
+        cx.resolve(&mut enc, "resolve", &cx.resolve_pipeline(&shader, "fs_resolve", own, false), &b.group, false);
+        peeled.copy(&mut enc);
+        cx.submit(enc);
+        let peeled = peeled.read(cx.gpu)?;
         Ok(MethodReport {
             memory_bytes: memory_bytes(pixels),
             overflow_fragments: cx.fragments.saturating_sub(peeled),

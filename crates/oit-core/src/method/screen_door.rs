@@ -2,10 +2,10 @@
 //! geometry pass that draws the nearest fragment whose alpha beats its pixel's threshold,
 //! opaque (shaders/screen_door.wgsl).
 
-use super::{ErrorBound, FRAMES, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order};
+use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, FRAMES};
 use crate::error::Result;
 use crate::pipeline;
-use crate::shader;
+use crate::resources::{Layout, ShaderKey};
 use crate::targets::{texture, COLOR_FORMAT, DEPTH_FORMAT};
 
 pub const INFO: MethodInfo = MethodInfo {
@@ -20,7 +20,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·4", bytes: |px, _| memory_bytes(px) },
     error_bound: ErrorBound::None,
-    create: |_, _| Box::new(ScreenDoor { pipeline: None, depth: None }),
+    create: |_, _| Box::new(ScreenDoor { depth: None }),
 };
 
 /// Bytes screen_door allocates: its own depth buffer.
@@ -29,7 +29,6 @@ pub fn memory_bytes(pixels: u64) -> u64 {
 }
 
 struct ScreenDoor {
-    pipeline: Option<wgpu::RenderPipeline>,
     depth: Option<((u32, u32), wgpu::Texture, wgpu::TextureView)>,
 }
 
@@ -37,19 +36,15 @@ impl Method for ScreenDoor {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let d = &cx.gpu.device;
         let t = cx.targets;
-        if self.pipeline.is_none() {
-            let module = shader::module(d, "screen_door.wgsl", &[]);
-            let depth = wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            };
-            let layout = pipeline::layout(d, &[cx.scene_layout]);
-            self.pipeline =
-                Some(pipeline::geometry(d, "screen door", &module, &layout, "fs_door", &[Some(COLOR_FORMAT.into())], Some(depth)));
-        }
+        let depth = wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        };
+        let shader = ShaderKey::new("screen_door.wgsl", &[]);
+        let pipeline = cx.draw_pipeline(&shader, "fs_door", vec![Layout::Scene], vec![Some(COLOR_FORMAT.into())], Some(depth));
         let size = (t.width, t.height);
         if self.depth.as_ref().is_none_or(|(s, _, _)| *s != size) {
             let tex = texture(
@@ -69,7 +64,7 @@ impl Method for ScreenDoor {
         {
             let depth_ops = Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store });
             let mut pass = pipeline::over_base_pass(&mut enc, "screen door", t, depth_view, depth_ops, cx.timer.render_pass("dither"));
-            pass.set_pipeline(self.pipeline.as_ref().expect("built above"));
+            pass.set_pipeline(&pipeline);
             cx.scene.transparent.draw_all(&mut pass);
         }
         cx.gpu.queue.submit([enc.finish()]);

@@ -1,0 +1,123 @@
+//! Float accumulation targets shared by the blended methods (`wsum`, `wavg`, `wboit`,
+//! `stochastic`): premultiplied color summed into RGBA32F and a companion R32F target (a
+//! count, or revealage multiplied down), drawn by one blended geometry pass and read by a
+//! full-screen resolve.
+
+use super::FrameCtx;
+use crate::resources::Layout;
+
+pub(crate) const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+pub(crate) const AUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+pub(crate) const ADD: wgpu::BlendComponent =
+    wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
+
+/// dst * (1 - src): revealage, the product of (1 - alpha).
+pub(crate) const REVEAL: wgpu::BlendComponent = wgpu::BlendComponent {
+    src_factor: wgpu::BlendFactor::Zero,
+    dst_factor: wgpu::BlendFactor::OneMinusSrc,
+    operation: wgpu::BlendOperation::Add,
+};
+
+/// How the companion target blends and what it starts from.
+#[derive(Clone, Copy, PartialEq)]
+pub(crate) enum Aux {
+    /// Summed from zero (a count or an alpha sum).
+    Sum,
+    /// Multiplied down from one (revealage).
+    Reveal,
+}
+
+/// The two color targets of the accumulation pass.
+pub(crate) fn accumulation_targets(aux: Aux) -> Vec<Option<wgpu::ColorTargetState>> {
+    let aux_blend = if aux == Aux::Reveal { REVEAL } else { ADD };
+    vec![
+        Some(wgpu::ColorTargetState {
+            format: ACCUM_FORMAT,
+            blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }),
+            write_mask: wgpu::ColorWrites::ALL,
+        }),
+        Some(wgpu::ColorTargetState {
+            format: AUX_FORMAT,
+            blend: Some(wgpu::BlendState { color: aux_blend, alpha: aux_blend }),
+            write_mask: wgpu::ColorWrites::ALL,
+        }),
+    ]
+}
+
+/// Bytes of the two targets at `pixels` pixels.
+pub fn memory_bytes(pixels: u64) -> u64 {
+    pixels * (16 + 4)
+}
+
+/// The accumulation targets of one frame size, and the group a resolve reads them through.
+pub(crate) struct AccumTargets {
+    size: (u32, u32),
+    accum: wgpu::TextureView,
+    aux: wgpu::TextureView,
+    /// The two targets as textures at `bindings` (the layout `Layout::Textures(bindings)`).
+    pub group: wgpu::BindGroup,
+}
+
+fn target(device: &wgpu::Device, size: (u32, u32), format: wgpu::TextureFormat) -> wgpu::TextureView {
+    crate::targets::texture(
+        device,
+        "accumulation",
+        size.0,
+        size.1,
+        format,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    )
+    .create_view(&Default::default())
+}
+
+impl AccumTargets {
+    /// The targets in `slot`, made anew when the frame size changed; the resolve reads them at
+    /// `bindings` of group 2.
+    pub fn ensure<'s>(slot: &'s mut Option<AccumTargets>, cx: &FrameCtx<'_>, bindings: &'static [u32]) -> &'s AccumTargets {
+        let size = (cx.targets.width, cx.targets.height);
+        if slot.as_ref().is_none_or(|t| t.size != size) {
+            let d = &cx.gpu.device;
+            let (accum, aux) = (target(d, size, ACCUM_FORMAT), target(d, size, AUX_FORMAT));
+            let resources = [wgpu::BindingResource::TextureView(&accum), wgpu::BindingResource::TextureView(&aux)];
+            let group = cx.group(Layout::Textures(bindings), &resources);
+            *slot = Some(AccumTargets { size, accum, aux, group });
+        }
+        slot.as_ref().expect("made above")
+    }
+
+    /// Records the accumulation pass (timed as "accumulate"): `pipeline` over the transparent
+    /// geometry, tested against the opaque depth, with `groups` bound at 1, 2, ...
+    pub fn accumulate(
+        &self,
+        cx: &mut FrameCtx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        aux: Aux,
+        pipeline: &wgpu::RenderPipeline,
+        groups: &[&wgpu::BindGroup],
+    ) {
+        let aux_clear = if aux == Aux::Reveal { wgpu::Color::WHITE } else { wgpu::Color::TRANSPARENT };
+        let attach = |view, clear| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+            })
+        };
+        let (depth, scene) = (&cx.targets.depth, cx.scene);
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("accumulate"),
+            color_attachments: &[attach(&self.accum, wgpu::Color::TRANSPARENT), attach(&self.aux, aux_clear)],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: depth, depth_ops: None, stencil_ops: None }),
+            timestamp_writes: cx.timer.render_pass("accumulate"),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        for (i, g) in groups.iter().enumerate() {
+            pass.set_bind_group(1 + i as u32, *g, &[]);
+        }
+        scene.transparent.draw_all(&mut pass);
+    }
+}

@@ -1,0 +1,127 @@
+//! The k-TAB engine under `hybrid`, `ktab` and `auto` (Maule et al. 2013, Algorithm 1): store
+//! the nearest keys per pixel by atomic max, compute their visibility, shade core and tail in a
+//! second geometry pass, composite. Accumulation in fixed point, so that frames do not depend
+//! on fragment order (docs/methods.md, "hybrid"). Each pixel gets a uniform k or its own slots.
+
+use super::{FrameCtx, MethodReport};
+use crate::error::{OitError, Result};
+use crate::resources::{Counter, Layout, ShaderKey, StorageGroup};
+use crate::shader::Const;
+
+/// Words per pixel of the accumulators.
+pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_ACCUM_WORDS as u64;
+
+/// Bytes at W x H pixels with core size k: k-TAB and visibility (k words each), the
+/// accumulators, and the overflow counter.
+pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
+    pixels * (2 * k + ACCUM_WORDS) * 4 + 4
+}
+
+/// Bytes with each pixel's own slot count (`slots` in all): k-TAB and visibility (a word
+/// each per slot), the accumulators, the per-pixel offsets (pixels + 1 words) and the counter.
+pub fn memory_bytes_per_pixel(pixels: u64, slots: u64) -> u64 {
+    2 * slots * 4 + pixels * ACCUM_WORDS * 4 + (pixels + 1) * 4 + 4
+}
+
+/// How many k-TAB slots each pixel gets.
+pub(crate) enum Slots<'s> {
+    /// k for every pixel (the `k` parameter).
+    Uniform(u32),
+    /// Each pixel its own (row-major, one per pixel; auto's choice).
+    PerPixel(&'s [u32]),
+}
+
+/// Binding of the per-pixel slot offsets in the group (shaders/hybrid.wgsl).
+const OFFSETS: usize = 3;
+
+pub(crate) struct KTab {
+    /// Whether fragments behind the core form the tail (hybrid) or are discarded (ktab).
+    tail: bool,
+    buffers: Option<StorageGroup>,
+    overflow: Option<Counter>,
+}
+
+impl KTab {
+    pub(crate) fn new(tail: bool) -> Self {
+        Self { tail, buffers: None, overflow: None }
+    }
+
+    /// Refuses buffers past a binding, and returns the slots in all and whether they are per pixel.
+    fn plan(&self, cx: &FrameCtx<'_>, slots: &Slots<'_>) -> Result<(u64, bool)> {
+        let name = if self.tail { "hybrid" } else { "ktab" };
+        let pixels = cx.pixels();
+        match slots {
+            Slots::Uniform(k) => {
+                cx.check_per_pixel(&format!("{name} with k = {k}"), 4 * (*k as u64).max(ACCUM_WORDS))?;
+                Ok((pixels * *k as u64, false))
+            }
+            Slots::PerPixel(s) => {
+                cx.check_per_pixel(&format!("{name}'s accumulators"), 4 * ACCUM_WORDS)?;
+                let total: u64 = s.iter().map(|&k| k as u64).sum();
+                if total * 4 > cx.limits.max_binding_bytes {
+                    return Err(OitError::OutOfMemory(format!(
+                        "{name} with per-pixel slots needs {total} slots ({} bytes), past the {}-byte storage binding \
+                         limit: render a smaller frame or use a larger tolerance",
+                        total * 4,
+                        cx.limits.max_binding_bytes
+                    )));
+                }
+                Ok((total, true))
+            }
+        }
+    }
+
+    /// One frame with the k-TAB slots `slots` gives each pixel.
+    pub(crate) fn render_slots(&mut self, cx: &mut FrameCtx<'_>, slots: Slots<'_>) -> Result<MethodReport> {
+        let (total, per_pixel) = self.plan(cx, &slots)?;
+        let pixels = cx.pixels();
+        let overflow = self.overflow.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid overflow"));
+        let sizes = [
+            ("k-TAB", total.max(1) * 4),
+            ("core visibility", total.max(1) * 4),
+            ("hybrid accumulators", pixels * ACCUM_WORDS * 4),
+            ("slot offsets", if per_pixel { (pixels + 1) * 4 } else { 4 }),
+        ];
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[overflow]);
+        if let Slots::PerPixel(s) = slots {
+            write_offsets(cx, &b.buffers[OFFSETS], s);
+        }
+        let k = match slots {
+            Slots::Uniform(k) => k,
+            Slots::PerPixel(_) => 1,
+        };
+        let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", per_pixel as u32), Const::U32("TAIL", self.tail as u32)];
+        let shader = ShaderKey::new("hybrid.wgsl", &consts);
+        let own = Layout::Storage(5);
+        let mut enc = cx.encoder();
+        enc.clear_buffer(&b.buffers[0], 0, None);
+        enc.clear_buffer(&b.buffers[2], 0, None);
+        overflow.clear(&mut enc);
+        cx.capture(&mut enc, "store", &cx.capture_pipeline(&shader, "fs_store", own), &b.group);
+        cx.dispatch(&mut enc, "visibility", &cx.compute_pipeline(&shader, "cs_visibility", own), &b.group);
+        cx.capture(&mut enc, "shade", &cx.capture_pipeline(&shader, "fs_shade", own), &b.group);
+        cx.resolve(&mut enc, "final", &cx.resolve_pipeline(&shader, "fs_final", own, true), &b.group, true);
+        overflow.copy(&mut enc);
+        cx.submit(enc);
+        let overflow = overflow.read(cx.gpu)?;
+        let memory = if per_pixel { memory_bytes_per_pixel(pixels, total) } else { memory_bytes(pixels, k as u64) };
+        Ok(MethodReport {
+            memory_bytes: memory,
+            overflow_fragments: overflow,
+            extra: vec![("tail_fragments", overflow as f64)],
+            error_bound: true,
+        })
+    }
+}
+
+/// Each pixel's first slot (an exclusive prefix sum of its count) and the total at the end.
+fn write_offsets(cx: &FrameCtx<'_>, buffer: &wgpu::Buffer, slots: &[u32]) {
+    let mut offsets = Vec::with_capacity(slots.len() + 1);
+    let mut sum = 0u32;
+    for &k in slots {
+        offsets.push(sum);
+        sum += k;
+    }
+    offsets.push(sum);
+    cx.gpu.queue.write_buffer(buffer, 0, bytemuck::cast_slice(&offsets));
+}
