@@ -1,6 +1,7 @@
 """The viewer (crates/oit-viewer): scene files, `python -m oit view`, and `--screenshot` under
-Xvfb compared with the library's render of the same scene and camera. The screenshot tests
-are skipped without the binary (`make viewer`) or without `xvfb-run` (Debian's xvfb)."""
+Xvfb compared with the library's render of the same scene and camera. The tests that run the
+binary are skipped without it (`make viewer`), the screenshot tests also without `xvfb-run`
+(Debian's xvfb)."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ import oit
 from oit import cli, scenefile, scenes, view
 from oit.imageio import to_srgb8
 from oit.scenefile import LookAt
+from oit.scenes import MeshArrays
 
 
 def _viewer():
@@ -29,6 +31,7 @@ def _viewer():
 
 
 VIEWER = _viewer()
+needs_viewer = pytest.mark.skipif(VIEWER is None, reason="needs the oit-viewer binary (`make viewer`)")
 needs_screen = pytest.mark.skipif(VIEWER is None or shutil.which("xvfb-run") is None,
                                   reason="needs the oit-viewer binary (`make viewer`) and xvfb-run (apt-get install xvfb)")
 
@@ -54,12 +57,21 @@ def read_png(path: Path) -> np.ndarray:
     return rows[:, 1:].reshape(h, w, 4)
 
 
-def screenshot(tmp_path: Path, args, size=(480, 320), env=None) -> np.ndarray:
+def screenshot(tmp_path: Path, args, size=(480, 320), through_python=False) -> np.ndarray:
+    """Runs the viewer on `args` under Xvfb, or through Python with the built-in scene args[0]
+    (exported to a file that Python starts the same binary on), and reads its --crop-view
+    screenshot."""
     out = tmp_path / "shot.png"
     w, h = size
-    command = ["xvfb-run", "-a", "-s", f"-screen 0 {w + 64}x{h + 64}x24", str(VIEWER), *args, "--size", str(w), str(h),
-               "--hide-panel", "--screenshot", str(out), "--frames", "2", "--crop-view"]
-    done = subprocess.run(command, capture_output=True, text=True, timeout=180, env={**os.environ, **(env or {})})
+    shot = ["--size", str(w), str(h), "--screenshot", str(out), "--frames", "2"]
+    if through_python:
+        # view.run as `python -m oit view` calls it, with options the command does not pass on.
+        run = "import sys; from oit import view; sys.exit(view.run([], scene=sys.argv[1], extra=sys.argv[2:]))"
+        viewer = [sys.executable, "-c", run, *args, *shot, "--hide-panel", "--crop-view"]
+    else:
+        viewer = [str(VIEWER), *args, *shot, "--hide-panel", "--crop-view"]
+    command = ["xvfb-run", "-a", "-s", f"-screen 0 {w + 64}x{h + 64}x24", *viewer]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=180, env={**os.environ, "OIT_VIEWER": str(VIEWER)})
     assert done.returncode == 0, done.stdout + done.stderr
     return read_png(out)
 
@@ -96,6 +108,46 @@ def test_scene_file_round_trip(tmp_path):
         scenefile.save_scene(built.scene, path)
 
 
+# tests/data/two_quads.oitscene: one file that this test and crates/oit-viewer/src/scenefile.rs
+# (`the_shared_scene_file`) both read and check value by value. Written by save_scene from
+# the values below; every number is exact in f32.
+SHARED_FILE = Path(__file__).parent / "data" / "two_quads.oitscene"
+SHARED_NAMES = ["back (opaque)", "red quad", "triangle, α per vertex"]
+SHARED_CAMERA = LookAt(eye=(0.5, 0.25, 4.0), target=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0), fov_y=45.0, near=1.0, far=10.0)
+SHARED_SIZE = (64, 48)
+
+
+def shared_meshes() -> list[MeshArrays]:
+    def f32(rows):
+        return np.array(rows, np.float32)
+
+    quad = np.array([[0, 1, 2], [0, 2, 3]], np.uint32)
+    return [
+        MeshArrays(f32([[-1, -1, -0.5], [1, -1, -0.5], [1, 1, -0.5], [-1, 1, -0.5]]), quad, f32([[0.5, 0.5, 0.5, 1.0]] * 4),
+                   opaque=True),
+        MeshArrays(f32([[-0.25, -0.5, 0], [0.75, -0.5, 0], [0.75, 0.5, 0], [-0.25, 0.5, 0]]), quad,
+                   f32([[1.0, 0.25, 0.125, 0.5]] * 4)),
+        MeshArrays(f32([[-0.75, -0.25, 0.25], [0.25, -0.25, 0.25], [-0.25, 0.75, 0.25]]), np.array([[0, 1, 2]], np.uint32),
+                   f32([[1, 0, 0, 0.25], [0, 1, 0, 0.5], [0, 0, 1, 0.75]])),
+    ]
+
+
+def test_shared_scene_file(tmp_path):
+    """The checked-in file reads as the scene above, and writing it again gives its bytes."""
+    meshes, camera, size = scenefile.load_scene(SHARED_FILE)
+    assert size == SHARED_SIZE and camera == SHARED_CAMERA
+    expected = shared_meshes()
+    assert [m.opaque for m in meshes] == [True, False, False] and len(expected) == 3
+    for got, want in zip(meshes, expected):
+        for x, y in ((got.positions, want.positions), (got.colors, want.colors), (got.indices, want.indices)):
+            assert x.dtype == y.dtype and np.array_equal(x, y)
+    again = tmp_path / "again.oitscene"
+    scenefile.save_scene(meshes, again, camera=camera, size=size, names=SHARED_NAMES)
+    assert again.read_bytes() == SHARED_FILE.read_bytes()
+    scenefile.save_scene(expected, again, camera=SHARED_CAMERA, size=SHARED_SIZE, names=SHARED_NAMES)
+    assert again.read_bytes() == SHARED_FILE.read_bytes()
+
+
 def test_view_export_writes_the_builtin_scene(tmp_path):
     out = tmp_path / "stacks.oitscene"
     assert cli.main(["view", "--scene", "stacks", "--export", str(out)]) == 0
@@ -114,6 +166,14 @@ def test_view_without_the_binary_says_how_to_build_it(tmp_path, monkeypatch, cap
     assert "make viewer" in capsys.readouterr().err
 
 
+@needs_viewer
+def test_the_binary_sends_builtin_scenes_to_python():
+    """The viewer does not start Python: its --scene says which command to run."""
+    done = subprocess.run([str(VIEWER), "--scene", "glass"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert "run `python -m oit view --scene glass`" in done.stderr
+
+
 @needs_screen
 def test_screenshot_equals_the_library_render(tmp_path):
     """A look-at camera: the viewer re-aims it at the view's aspect as Camera.look_at does."""
@@ -130,10 +190,10 @@ def test_screenshot_equals_the_library_render(tmp_path):
 
 @needs_screen
 def test_builtin_scene_through_python_keeps_its_camera(tmp_path):
-    """--scene delegates to `python -m oit view --export`; the BuiltScene's matrix camera is
-    read back into a look-at, so a square view shows exactly the library's frame."""
+    """`python -m oit view --scene` (view.run) exports the scene and starts the viewer on the
+    file; the BuiltScene's matrix camera is read back into a look-at, so a square view shows
+    exactly the library's frame."""
     built = scenes.glass()
-    shot = screenshot(tmp_path, ["--scene", "glass", "--method", "abuffer"], size=(256, 256),
-                      env={"OIT_PYTHON": sys.executable})
+    shot = screenshot(tmp_path, ["glass", "--method", "abuffer"], size=(256, 256), through_python=True)
     frame = oit.Renderer(256, 256).render(built.scene, built.camera, method="abuffer")
     assert_matches(shot, frame.image)

@@ -2,7 +2,6 @@
 //! The engine renders only when something it depends on changed; the picture on screen is
 //! recomposed (CPU) when only the way of showing it changed.
 
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -12,120 +11,8 @@ use oit_core::{AntialiasMode, Camera, Frame, GpuContext, Mesh, ParamValue, Rende
 use crate::heatmap::{self, ErrorMap};
 use crate::orbit::ViewCamera;
 use crate::scenefile::SceneData;
+use crate::state::{Action, Compare, MeshControl, Settings, ViewMode, EXACT};
 use crate::{gpu, panels, screenshot, view};
-
-/// The method compare mode and the error view measure against.
-pub const EXACT: &str = "abuffer";
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ViewMode {
-    Image,
-    Complexity,
-    Error,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Compare {
-    Off,
-    Split,
-    Toggle,
-}
-
-/// What the user chose; everything here is plain data the panels edit.
-#[derive(Clone, Debug)]
-pub struct Settings {
-    pub method: String,
-    /// Every method's parameters, defaults filled in, kept when switching methods.
-    pub params: BTreeMap<String, Vec<(String, ParamValue)>>,
-    /// Linear RGB.
-    pub background: [f32; 3],
-    pub show_opaque: bool,
-    pub view: ViewMode,
-    pub compare: Compare,
-    /// Toggle mode: showing the exact frame.
-    pub show_exact: bool,
-    /// Split mode: where the exact half starts, as a fraction of the width.
-    pub split: f32,
-    /// Error at the top of the heatmap's colormap.
-    pub error_scale: f32,
-    /// Render at this fraction of the view's pixels (software adapters are slow).
-    pub render_scale: f32,
-    /// Samples a pixel (oit_core::antialias::SAMPLE_COUNTS).
-    pub antialias: u32,
-    /// Coverage masks instead of sample frames (abuffer at 4 samples).
-    pub coverage: bool,
-}
-
-impl Settings {
-    pub fn new(method: &str) -> Self {
-        let params = oit_core::methods()
-            .iter()
-            .map(|m| {
-                let p = m.resolve_params(&[]).expect("defaults are valid");
-                (m.name.to_string(), p.0.into_iter().map(|(k, v)| (k.to_string(), v)).collect())
-            })
-            .collect();
-        Self {
-            method: method.to_string(),
-            params,
-            background: [1.0; 3],
-            show_opaque: true,
-            view: ViewMode::Image,
-            compare: Compare::Off,
-            show_exact: false,
-            split: 0.5,
-            error_scale: 0.1,
-            render_scale: 1.0,
-            antialias: 1,
-            coverage: false,
-        }
-    }
-
-    pub fn method_params(&self, method: &str) -> Vec<(String, ParamValue)> {
-        self.params.get(method).cloned().unwrap_or_default()
-    }
-
-    /// Sets one parameter of the current method.
-    pub fn set_param(&mut self, name: &str, value: ParamValue) {
-        let list = self.params.entry(self.method.clone()).or_default();
-        match list.iter_mut().find(|(k, _)| k == name) {
-            Some(slot) => slot.1 = value,
-            None => list.push((name.to_string(), value)),
-        }
-    }
-
-    pub fn needs_exact(&self) -> bool {
-        self.compare != Compare::Off || self.view == ViewMode::Error
-    }
-}
-
-/// One mesh as loaded, and what the user does to it.
-#[derive(Clone, Debug)]
-pub struct MeshControl {
-    pub name: String,
-    pub original: Mesh,
-    pub visible: bool,
-    /// The mesh's alpha when all its vertices share one, else a factor on its alphas.
-    pub alpha: f32,
-    pub uniform_alpha: bool,
-}
-
-impl MeshControl {
-    fn new(name: String, mesh: Mesh) -> Self {
-        let first = mesh.colors.first().map_or(1.0, |c| c[3]);
-        let uniform_alpha = mesh.colors.iter().all(|c| c[3] == first);
-        Self { name, original: mesh, visible: true, alpha: if uniform_alpha { first } else { 1.0 }, uniform_alpha }
-    }
-
-    fn mesh(&self) -> Mesh {
-        let mut m = self.original.clone();
-        if !m.opaque {
-            let (a, uniform) = (self.alpha, self.uniform_alpha);
-            m.colors.iter_mut().for_each(|c| c[3] = if uniform { a } else { (c[3] * a).clamp(0.0, 1.0) });
-        }
-        m
-    }
-}
 
 /// Everything one engine render depends on.
 #[derive(Clone, Debug, PartialEq)]
@@ -444,18 +331,101 @@ impl ViewerApp {
 }
 
 impl ViewerApp {
+    /// Carries out what the panel and the view asked for, in order.
+    pub fn apply(&mut self, actions: impl IntoIterator<Item = Action>) {
+        for action in actions {
+            let s = &mut self.settings;
+            match action {
+                Action::SetMethod(m) => s.method = m,
+                Action::SetParam(name, value) => s.set_param(&name, value),
+                Action::SetView(v) => s.view = v,
+                Action::SetCompare(c) => s.compare = c,
+                Action::SetShowExact(b) => s.show_exact = b,
+                Action::FlipExact => {
+                    if s.compare == Compare::Toggle {
+                        s.show_exact = !s.show_exact;
+                    }
+                }
+                Action::SetSplit(x) => s.split = x,
+                Action::SetErrorScale(x) => s.error_scale = x,
+                Action::SetBackground(rgb) => s.background = rgb,
+                Action::SetAntialias(n) => s.antialias = n,
+                Action::SetCoverage(b) => s.coverage = b,
+                Action::SetRenderScale(x) => s.render_scale = x,
+                Action::SetShowOpaque(b) => {
+                    s.show_opaque = b;
+                    self.meshes_changed();
+                }
+                Action::SetMeshVisible(i, b) => {
+                    if let Some(m) = self.meshes.get_mut(i) {
+                        m.visible = b;
+                        self.meshes_changed();
+                    }
+                }
+                Action::SetMeshAlpha(i, a) => {
+                    if let Some(m) = self.meshes.get_mut(i) {
+                        m.alpha = a;
+                        self.meshes_changed();
+                    }
+                }
+                Action::Orbit { dx, dy } => self.camera.moved().rotate(dx, dy),
+                Action::Pan { dx, dy, height } => self.camera.moved().pan(dx, dy, height),
+                Action::Zoom(amount) => self.camera.moved().zoom(amount),
+                Action::ResetView => self.camera.reset(),
+                Action::Screenshot => self.request_screenshot(),
+                Action::TogglePanel => self.show_panel = !self.show_panel,
+            }
+        }
+    }
+
+    /// What the side panel shows.
+    fn panel_data(&self) -> panels::PanelData<'_> {
+        panels::PanelData {
+            title: &self.title,
+            adapter: self.gpu.as_ref().ok().map(|g| g.info.name.as_str()),
+            settings: &self.settings,
+            meshes: &self.meshes,
+            camera_at_home: self.camera.is_home(),
+            status: &self.status,
+            frame: self.frame.as_ref(),
+            triangles: self.triangle_count(),
+            error: self.error.as_ref(),
+        }
+    }
+
+    /// The central view: camera input, rendering at the view's pixel size, the picture.
+    fn central(&mut self, ui: &mut egui::Ui) {
+        let max = self.gpu.as_ref().map_or(8192, |g| g.limits.max_texture_dimension_2d);
+        let (response, layout) = view::layout(ui, self.settings.render_scale, max);
+        let actions = view::camera_input(ui, &response);
+        self.apply(actions);
+        if layout.has_area() && self.update_frames(layout.size) {
+            ui.ctx().request_repaint(); // the side panel shows the new stats next frame
+        }
+        self.view_rect = layout.image;
+        let texture = self.texture(ui.ctx()).map(TextureHandle::id);
+        let overlay = view::Overlay {
+            settings: &self.settings,
+            frame: self.frame.as_ref(),
+            exact_available: self.exact_frame().is_some(),
+            render_error: self.render_error.as_deref(),
+        };
+        view::paint(ui, &layout, texture, &overlay);
+    }
+
     /// One frame of the whole window.
     pub fn show(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.take_screenshot(&ctx);
         if self.show_panel {
             egui::Panel::left("settings").default_size(290.0).resizable(true).show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(ui, self));
+                let actions = egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(ui, &self.panel_data())).inner;
+                self.apply(actions);
             });
         }
-        egui::CentralPanel::no_frame().show(ui, |ui| view::central(ui, self));
+        egui::CentralPanel::no_frame().show(ui, |ui| self.central(ui));
         if !ctx.egui_wants_keyboard_input() {
-            view::shortcuts(&ctx, self);
+            self.apply(view::shortcuts(&ctx));
         }
     }
 }

@@ -1,21 +1,20 @@
-//! The command line: `oit-viewer [FILE ...] [--scene NAME] [--method NAME] ...`.
+//! The command line: `oit-viewer FILE ... [--method NAME] ...`. Built-in scenes are the Python
+//! package's: `python -m oit view --scene NAME` exports one and starts this viewer on the file.
 
 use std::path::PathBuf;
 
 use oit_core::ParamValue;
 
-use crate::app::{Compare, ViewMode};
+use crate::state::{Compare, ViewMode};
 
 pub const USAGE: &str = "\
-usage: oit-viewer [FILE ...] [--scene NAME] [--method NAME] [--param NAME=VALUE ...] [--alpha A]
+usage: oit-viewer FILE ... [--method NAME] [--param NAME=VALUE ...] [--alpha A]
                   [--background R G B] [--compare off|split|toggle] [--view image|complexity|error]
                   [--size W H] [--adapter NAME] [--hide-panel]
                   [--screenshot PATH [--frames N] [--crop-view]]
 
-FILE           .oitscene (from `python -m oit view --export`), .obj, .ply, .stl, .gltf or .glb
---scene NAME   a built-in scene of the Python package (hair, smoke, foliage, dragons, glass,
-               stacks), exported by `$OIT_PYTHON -m oit view --scene NAME --export ...`
-               (OIT_PYTHON defaults to python3)
+FILE           .oitscene (from `python -m oit view --scene NAME --export PATH`), .obj, .ply,
+               .stl, .gltf or .glb
 --method NAME  the method to start with (default: hybrid); --param sets its parameters
 --alpha A      alpha of every transparent mesh (mesh files default to their own or 0.4)
 --background   linear RGB in [0, 1] (default: 1 1 1)
@@ -25,12 +24,14 @@ FILE           .oitscene (from `python -m oit view --export`), .obj, .ply, .stl,
                --crop-view saves only the rendered view. Needs a display (xvfb-run works)
 
 mouse: drag to orbit, shift-drag or right-drag to pan, scroll to zoom, double-click or R to
-reset; Space flips the toggle compare mode; Tab hides the panel";
+reset; Space flips the toggle compare mode; Tab hides the panel
+
+The built-in scenes (hair, smoke, foliage, dragons, glass, stacks) are the Python package's:
+`python -m oit view --scene NAME` exports one to a scene file and starts this viewer on it";
 
 #[derive(Clone, Debug)]
 pub struct Options {
     pub files: Vec<PathBuf>,
-    pub scene: Option<String>,
     pub method: String,
     pub params: Vec<(String, ParamValue)>,
     pub alpha: Option<f32>,
@@ -49,7 +50,6 @@ impl Default for Options {
     fn default() -> Self {
         Self {
             files: vec![],
-            scene: None,
             method: "hybrid".into(),
             params: vec![],
             alpha: None,
@@ -98,7 +98,7 @@ pub fn parse(args: impl IntoIterator<Item = String>) -> Result<Option<Options>, 
     while let Some(a) = it.next() {
         match a.as_str() {
             "-h" | "--help" => return Ok(None),
-            "--scene" => o.scene = Some(it.next().ok_or("--scene needs a name")?),
+            "--scene" => return Err(scene_moved(it.next().as_deref())),
             "-m" | "--method" => o.method = it.next().ok_or("--method needs a name")?,
             "--param" => o.params.push(parse_param(&it.next().ok_or("--param needs NAME=VALUE")?)?),
             "--alpha" => o.alpha = Some(unit("--alpha", it.next())?),
@@ -137,10 +137,20 @@ pub fn parse(args: impl IntoIterator<Item = String>) -> Result<Option<Options>, 
             _ => o.files.push(PathBuf::from(a)),
         }
     }
-    if o.files.is_empty() && o.scene.is_none() {
-        return Err("name a file to open or a built-in scene with --scene".into());
+    if o.files.is_empty() {
+        return Err("name a file to open (for a built-in scene, run `python -m oit view --scene NAME`)".into());
     }
     Ok(Some(o))
+}
+
+/// The viewer does not build scenes: the Python package does, and starts the viewer on them.
+fn scene_moved(name: Option<&str>) -> String {
+    let name = name.unwrap_or("NAME");
+    format!(
+        "--scene: the built-in scenes are the Python package's; run `python -m oit view --scene {name}`, which \
+         exports the scene and starts this viewer on it (or `python -m oit view --scene {name} --export {name}.oitscene`, \
+         then `oit-viewer {name}.oitscene`)"
+    )
 }
 
 #[cfg(test)]
@@ -162,7 +172,8 @@ mod tests {
         assert_eq!((o.alpha, o.compare, o.frames), (Some(0.3), Compare::Split, 2));
         assert!(args("--help").unwrap().is_none());
         assert!(args("--alpha 2 a.obj").unwrap_err().contains("outside [0, 1]"));
-        assert!(args("").unwrap_err().contains("--scene"));
+        assert!(args("").unwrap_err().contains("python -m oit view --scene NAME"));
+        assert!(args("--scene glass --method hybrid").unwrap_err().contains("run `python -m oit view --scene glass`"));
         assert!(args("a.obj --bogus").unwrap_err().contains("unknown option"));
     }
 }

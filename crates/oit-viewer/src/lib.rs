@@ -10,10 +10,12 @@ pub mod orbit;
 pub mod panels;
 pub mod scenefile;
 pub mod screenshot;
+pub mod state;
 pub mod view;
 
-pub use app::{Compare, Settings, ViewMode, ViewerApp};
+pub use app::ViewerApp;
 pub use args::Options;
+pub use state::{Action, Compare, Settings, ViewMode};
 
 /// The settings the command line asks for, with the method and parameters checked.
 pub fn settings(o: &Options) -> Result<Settings, String> {
@@ -27,22 +29,4 @@ pub fn settings(o: &Options) -> Result<Settings, String> {
     s.compare = o.compare;
     s.view = o.view;
     Ok(s)
-}
-
-/// Exports a built-in scene of the Python package into a temporary scene file and reads it.
-pub fn builtin_scene(name: &str, alpha: Option<f32>) -> Result<scenefile::SceneData, String> {
-    let python = std::env::var("OIT_PYTHON").unwrap_or_else(|_| "python3".into());
-    let path = std::env::temp_dir().join(format!("oit-viewer-{}-{name}.oitscene", std::process::id()));
-    let help = format!("run `python -m oit view --scene {name}` with the Python that has oit installed, or point OIT_PYTHON at it");
-    let status = std::process::Command::new(&python)
-        .args(["-m", "oit", "view", "--scene", name, "--export"])
-        .arg(&path)
-        .status()
-        .map_err(|e| format!("could not run {python} to export the scene '{name}' ({e}): {help}"))?;
-    if !status.success() {
-        return Err(format!("`{python} -m oit view --scene {name} --export ...` failed ({status}): {help}"));
-    }
-    let data = load::load(&path, alpha);
-    std::fs::remove_file(&path).ok();
-    data
 }

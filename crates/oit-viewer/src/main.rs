@@ -26,20 +26,8 @@ fn main() {
         Err(e) => fail(&format!("{e}\n{}", args::USAGE), 2),
     };
     let settings = oit_viewer::settings(&o).unwrap_or_else(|e: String| fail(&e, 2));
-    let mut data = load::load_all(&o.files, o.alpha).unwrap_or_else(|e: String| -> oit_viewer::scenefile::SceneData {
-        if o.files.is_empty() {
-            Default::default()
-        } else {
-            fail(&e, 2)
-        }
-    });
-    if let Some(name) = &o.scene {
-        let mut builtin = oit_viewer::builtin_scene(name, o.alpha).unwrap_or_else(|e: String| fail(&e, 1));
-        builtin.meshes.append(&mut data.meshes);
-        data = builtin;
-    }
-    let mut title: Vec<String> = o.files.iter().filter_map(|f| f.file_name()).map(|f| f.to_string_lossy().into_owned()).collect();
-    title.extend(o.scene.iter().cloned());
+    let data = load::load_all(&o.files, o.alpha).unwrap_or_else(|e: String| fail(&e, 2));
+    let title: Vec<String> = o.files.iter().filter_map(|f| f.file_name()).map(|f| f.to_string_lossy().into_owned()).collect();
     let title = title.join(", ");
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default().with_inner_size(o.size).with_title(format!("oit viewer: {title}")),

@@ -1,34 +1,58 @@
 //! The side panel: method and parameters (from `oit_core::methods()`, so a new method shows
-//! up by itself), view and compare modes, background, meshes, and the frame's numbers.
+//! up by itself), view and compare modes, background, meshes, and the frame's numbers. It
+//! changes nothing itself: it returns the `Action`s the user asked for.
 
 use eframe::egui::{self, RichText};
-use oit_core::{MethodInfo, ParamInfo, ParamKind, ParamValue};
+use oit_core::{Frame, MethodInfo, ParamInfo, ParamKind, ParamValue};
 
-use crate::app::{Compare, ViewMode, ViewerApp, EXACT};
+use crate::heatmap::ErrorMap;
+use crate::state::{Action, Compare, MeshControl, Settings, ViewMode, EXACT};
 
-pub fn side_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
-    ui.heading(&app.title);
-    if let Ok(g) = &app.gpu {
-        ui.label(RichText::new(g.info.name.clone()).small().weak());
-    }
-    ui.separator();
-    method_section(ui, app);
-    ui.separator();
-    view_section(ui, app);
-    ui.separator();
-    stats_section(ui, app);
-    ui.separator();
-    meshes_section(ui, app);
+/// What the side panel shows.
+pub struct PanelData<'a> {
+    pub title: &'a str,
+    /// The adapter's name, when there is a device.
+    pub adapter: Option<&'a str>,
+    pub settings: &'a Settings,
+    pub meshes: &'a [MeshControl],
+    pub camera_at_home: bool,
+    pub status: &'a str,
+    pub frame: Option<&'a Frame>,
+    pub triangles: usize,
+    pub error: Option<&'a ErrorMap>,
 }
 
-fn method_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
-    let s = &mut app.settings;
+/// Draws the panel and returns what the user asked for. The widgets edit a copy of the
+/// settings, so that widgets further down show a change in the frame it was made.
+pub fn side_panel(ui: &mut egui::Ui, p: &PanelData<'_>) -> Vec<Action> {
+    let mut s = p.settings.clone();
+    let mut out = Vec::new();
+    ui.heading(p.title);
+    if let Some(name) = p.adapter {
+        ui.label(RichText::new(name).small().weak());
+    }
+    ui.separator();
+    method_section(ui, &mut s, &mut out);
+    ui.separator();
+    view_section(ui, &mut s, p, &mut out);
+    ui.separator();
+    stats_section(ui, &s, p);
+    ui.separator();
+    meshes_section(ui, &mut s, p.meshes, &mut out);
+    out
+}
+
+fn method_section(ui: &mut egui::Ui, s: &mut Settings, out: &mut Vec<Action>) {
+    let mut changed = false;
     egui::ComboBox::from_label("method").selected_text(s.method.clone()).show_ui(ui, |ui| {
         for m in oit_core::methods() {
             let text = if m.exact { format!("{} (exact)", m.name) } else { m.name.to_string() };
-            ui.selectable_value(&mut s.method, m.name.to_string(), text).on_hover_text(m.summary);
+            changed |= ui.selectable_value(&mut s.method, m.name.to_string(), text).on_hover_text(m.summary).changed();
         }
     });
+    if changed {
+        out.push(Action::SetMethod(s.method.clone()));
+    }
     let Some(info) = oit_core::methods().iter().find(|m| m.name == s.method) else { return };
     ui.label(RichText::new(info.summary).small());
     for p in info.params {
@@ -36,6 +60,7 @@ fn method_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
         let Some(v) = value.as_mut() else { continue };
         if param_widget(ui, info, p, v) {
             s.set_param(p.name, v.clone());
+            out.push(Action::SetParam(p.name.to_string(), v.clone()));
         }
     }
 }
@@ -76,8 +101,8 @@ fn param_widget(ui: &mut egui::Ui, method: &MethodInfo, p: &ParamInfo, v: &mut P
     changed
 }
 
-fn view_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
-    let s = &mut app.settings;
+fn view_section(ui: &mut egui::Ui, s: &mut Settings, p: &PanelData<'_>, out: &mut Vec<Action>) {
+    let old = s.clone();
     ui.horizontal(|ui| {
         ui.label("show");
         ui.selectable_value(&mut s.view, ViewMode::Image, "image");
@@ -115,7 +140,7 @@ fn view_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
     })
     .response
     .on_hover_text("antialiasing: one frame per sample position, averaged");
-    let coverage_ok = oit_core::COVERAGE_METHODS.contains(&s.method.as_str()) && s.antialias == oit_core::COVERAGE_SAMPLES;
+    let coverage_ok = oit_core::coverage_methods().contains(&s.method.as_str()) && s.antialias == oit_core::COVERAGE_SAMPLES;
     s.coverage &= coverage_ok;
     ui.add_enabled(coverage_ok, egui::Checkbox::new(&mut s.coverage, "coverage masks"))
         .on_hover_text("abuffer at 4 samples: one multisampled capture, a sample mask per fragment")
@@ -123,24 +148,43 @@ fn view_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
     ui.add(egui::Slider::new(&mut s.render_scale, 0.25..=1.0).text("render scale"))
         .on_hover_text("render at a fraction of the view's pixels: faster on software adapters");
     ui.horizontal(|ui| {
-        if ui.add_enabled(!app.camera.is_home(), egui::Button::new("reset view")).on_hover_text("R, or double-click the view").clicked() {
-            app.camera.reset();
+        if ui.add_enabled(!p.camera_at_home, egui::Button::new("reset view")).on_hover_text("R, or double-click the view").clicked() {
+            out.push(Action::ResetView);
         }
         if ui.button("screenshot").on_hover_text("saves the window as oit-viewer-<time>.png here").clicked() {
-            app.request_screenshot();
+            out.push(Action::Screenshot);
         }
     });
-    if !app.status.is_empty() {
-        ui.label(RichText::new(&app.status).small());
+    if !p.status.is_empty() {
+        ui.label(RichText::new(p.status).small());
     }
+    changes(&old, s, out);
+}
+
+/// The actions that take the view section's settings from `old` to `new`.
+fn changes(old: &Settings, new: &Settings, out: &mut Vec<Action>) {
+    let mut push = |differ: bool, action: Action| {
+        if differ {
+            out.push(action);
+        }
+    };
+    push(old.view != new.view, Action::SetView(new.view));
+    push(old.compare != new.compare, Action::SetCompare(new.compare));
+    push(old.split != new.split, Action::SetSplit(new.split));
+    push(old.show_exact != new.show_exact, Action::SetShowExact(new.show_exact));
+    push(old.error_scale != new.error_scale, Action::SetErrorScale(new.error_scale));
+    push(old.background != new.background, Action::SetBackground(new.background));
+    push(old.antialias != new.antialias, Action::SetAntialias(new.antialias));
+    push(old.coverage != new.coverage, Action::SetCoverage(new.coverage));
+    push(old.render_scale != new.render_scale, Action::SetRenderScale(new.render_scale));
 }
 
 fn mib(bytes: u64) -> String {
     format!("{:.2} MiB", bytes as f64 / (1u64 << 20) as f64)
 }
 
-fn stats_section(ui: &mut egui::Ui, app: &ViewerApp) {
-    let Some(f) = &app.frame else {
+fn stats_section(ui: &mut egui::Ui, s: &Settings, p: &PanelData<'_>) {
+    let Some(f) = p.frame else {
         ui.label("no frame yet");
         return;
     };
@@ -151,7 +195,7 @@ fn stats_section(ui: &mut egui::Ui, app: &ViewerApp) {
             ui.label(v);
             ui.end_row();
         };
-        row("frame", format!("{} x {}, {} triangles", f.width, f.height, app.triangle_count()));
+        row("frame", format!("{} x {}, {} triangles", f.width, f.height, p.triangles));
         row("GPU time", st.gpu_time_ms.map_or("n/a (no timestamp queries)".into(), |t| format!("{t:.2} ms")));
         row("wall time", format!("{:.1} ms", st.wall_time_ms));
         row("fragments", st.fragments.to_string());
@@ -162,7 +206,7 @@ fn stats_section(ui: &mut egui::Ui, app: &ViewerApp) {
         for (k, v) in &st.extra {
             row(k, format!("{v}"));
         }
-        if let Some(e) = app.error.as_ref().filter(|_| app.settings.needs_exact()) {
+        if let Some(e) = p.error.filter(|_| s.needs_exact()) {
             row("mean error", format!("{:.5}", e.mean));
             row("max error", format!("{:.5}", e.max));
         }
@@ -176,24 +220,26 @@ fn stats_section(ui: &mut egui::Ui, app: &ViewerApp) {
     }
 }
 
-fn meshes_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
-    let mut changed = false;
-    if app.meshes.iter().any(|m| m.original.opaque) {
-        changed |= ui.checkbox(&mut app.settings.show_opaque, "show opaque geometry").changed();
+fn meshes_section(ui: &mut egui::Ui, s: &mut Settings, meshes: &[MeshControl], out: &mut Vec<Action>) {
+    if meshes.iter().any(|m| m.original.opaque) && ui.checkbox(&mut s.show_opaque, "show opaque geometry").changed() {
+        out.push(Action::SetShowOpaque(s.show_opaque));
     }
-    egui::CollapsingHeader::new(format!("meshes ({})", app.meshes.len())).default_open(app.meshes.len() <= 8).show(ui, |ui| {
-        for (i, m) in app.meshes.iter_mut().enumerate() {
+    egui::CollapsingHeader::new(format!("meshes ({})", meshes.len())).default_open(meshes.len() <= 8).show(ui, |ui| {
+        for (i, m) in meshes.iter().enumerate() {
             ui.push_id(i, |ui| {
                 let label = if m.original.opaque { format!("{} (opaque)", m.name) } else { m.name.clone() };
-                changed |= ui.checkbox(&mut m.visible, label).changed();
+                let mut visible = m.visible;
+                if ui.checkbox(&mut visible, label).changed() {
+                    out.push(Action::SetMeshVisible(i, visible));
+                }
                 if !m.original.opaque {
                     let text = if m.uniform_alpha { "alpha" } else { "alpha ×" };
-                    changed |= ui.add(egui::Slider::new(&mut m.alpha, 0.0..=1.0).text(text)).changed();
+                    let mut alpha = m.alpha;
+                    if ui.add(egui::Slider::new(&mut alpha, 0.0..=1.0).text(text)).changed() {
+                        out.push(Action::SetMeshAlpha(i, alpha));
+                    }
                 }
             });
         }
     });
-    if changed {
-        app.meshes_changed();
-    }
 }

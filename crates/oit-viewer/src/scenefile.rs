@@ -175,6 +175,32 @@ mod tests {
         }
     }
 
+    /// tests/data/two_quads.oitscene, which tests/test_viewer.py (`test_shared_scene_file`)
+    /// reads too and checks against the same values; Python wrote it, and so does `encode`.
+    #[test]
+    fn the_shared_scene_file() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/two_quads.oitscene");
+        let bytes = std::fs::read(&path).unwrap();
+        let scene = read(&path).unwrap();
+        assert_eq!(scene.size, Some((64, 48)));
+        let look = CameraSpec::LookAt { eye: [0.5, 0.25, 4.0], target: [0.0; 3], up: [0.0, 1.0, 0.0], fov_y: 45.0, near: 1.0, far: 10.0 };
+        assert_eq!(scene.camera, Some(look));
+        let names: Vec<&str> = scene.meshes.iter().map(|m| m.name.as_str()).collect();
+        assert_eq!(names, ["back (opaque)", "red quad", "triangle, α per vertex"]);
+        let [back, quad, tri] = [0, 1, 2].map(|i| &scene.meshes[i].mesh);
+        assert_eq!((back.opaque, quad.opaque, tri.opaque), (true, false, false));
+        assert_eq!(back.positions, [[-1.0, -1.0, -0.5], [1.0, -1.0, -0.5], [1.0, 1.0, -0.5], [-1.0, 1.0, -0.5]]);
+        assert_eq!(back.colors, [[0.5, 0.5, 0.5, 1.0]; 4]);
+        assert_eq!(back.indices, [[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(quad.positions, [[-0.25, -0.5, 0.0], [0.75, -0.5, 0.0], [0.75, 0.5, 0.0], [-0.25, 0.5, 0.0]]);
+        assert_eq!(quad.colors, [[1.0, 0.25, 0.125, 0.5]; 4]);
+        assert_eq!(quad.indices, [[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(tri.positions, [[-0.75, -0.25, 0.25], [0.25, -0.25, 0.25], [-0.25, 0.75, 0.25]]);
+        assert_eq!(tri.colors, [[1.0, 0.0, 0.0, 0.25], [0.0, 1.0, 0.0, 0.5], [0.0, 0.0, 1.0, 0.75]]);
+        assert_eq!(tri.indices, [[0, 1, 2]]);
+        assert!(encode(&scene) == bytes, "the viewer writes the file's bytes back");
+    }
+
     #[test]
     fn bad_files_say_what_is_wrong() {
         assert!(parse(b"PLY").unwrap_err().contains("ends inside"));
