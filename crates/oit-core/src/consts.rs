@@ -1,9 +1,14 @@
 //! Numbers shared by Rust, WGSL and Python. Each is defined here once: `shader::compose`
 //! prepends every one of them to every shader, and `oit.constants()` exports them to Python
-//! (python/oit/models.py reads them there). `tests/shader_validation.rs` checks that naga sees
+//! (python/oit/models.py reads them there). Depends on nothing. `tests/shader_validation.rs` checks that naga sees
 //! the same values and that no shader defines one of its own.
 
-use crate::shader::Const;
+/// A compile-time constant injected in front of a shader.
+#[derive(Clone, Copy, Debug)]
+pub enum Const {
+    U32(&'static str, u32),
+    F32(&'static str, f32),
+}
 
 /// Words per pixel of hybrid's accumulators: core RGB (3), tail sums as 64-bit pairs (8), tail
 /// count, transmittance behind the core, nearest evicted key, two error-bound sums, and the tail

@@ -13,7 +13,7 @@ pub struct GpuContext {
     pub features: wgpu::Features,
     pub limits: wgpu::Limits,
     /// Modules, layouts and pipelines of this device, built at their first use.
-    pub cache: crate::resources::PipelineCache,
+    pub cache: crate::cache::PipelineCache,
 }
 
 const NO_ADAPTER_HELP: &str = "no GPU adapter found: install a Vulkan driver, or the software \

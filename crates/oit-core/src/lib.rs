@@ -2,11 +2,14 @@
 //! CPU float64 reference to measure them against. No Python, no windowing.
 
 pub mod antialias;
+pub mod bindings;
+pub mod cache;
 pub mod consts;
 pub mod context;
 pub mod error;
 pub mod gpu_types;
 pub mod method;
+mod passes;
 mod pipeline;
 pub mod reference;
 pub mod renderer;

@@ -6,15 +6,17 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use crate::antialias;
+use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
+use crate::cache::Layout;
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
 use crate::gpu_types::FrameUniform;
 use crate::method::{self, AntialiasMode, FrameCtx, Limits, Method, MethodInfo, ParamValue, Params};
+use crate::passes;
 use crate::pipeline;
-use crate::resources::Layout;
 use crate::scene::{Camera, Scene};
 use crate::shader;
-use crate::targets::{read_buffer, read_rows, SampleTargets, Targets, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::targets::{read_buffer, read_rows, SampleTargets, Targets};
 use crate::timer::PassTimer;
 use crate::upload::GpuScene;
 
@@ -77,8 +79,7 @@ impl Shared {
         let d = &gpu.device;
         let scene_layout = gpu.cache.layout(d, Layout::Scene);
         let targets_layout = gpu.cache.layout(d, Layout::Targets);
-        let counts_layout =
-            d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("census"), entries: &[pipeline::storage_entry(0)] });
+        let counts_layout = gpu.cache.layout(d, Layout::Storage(1));
         let opaque_module = shader::module(d, "opaque.wgsl", &[]);
         let opaque = pipeline::geometry(
             d,
@@ -222,7 +223,7 @@ impl Renderer {
         let offsets = antialias::sample_offsets(antialias)?;
         let info = method::lookup(method_name)?;
         let params = info.resolve_params(params)?;
-        info.check_features(&self.gpu)?;
+        method::check_features(info, &self.gpu)?;
         if background.iter().any(|c| !c.is_finite() || !(0.0..=1.0).contains(c)) {
             return Err(invalid!("background {background:?} must be three linear RGB values in [0, 1]"));
         }
@@ -435,7 +436,7 @@ impl Renderer {
                 Some(c) => (&c.census, &c.targets.group, &c.targets.raster_depth),
                 None => (&self.shared.census, &t.group, &t.depth),
             };
-            let mut pass = pipeline::capture_pass(&mut enc, "census", depth, None);
+            let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
             pass.set_pipeline(census);
             pass.set_bind_group(1, group, &[]);
             pass.set_bind_group(2, &t.counts_group, &[]);

@@ -3,12 +3,7 @@
 
 include!(concat!(env!("OUT_DIR"), "/shader_sources.rs"));
 
-/// A compile-time constant injected in front of a shader.
-#[derive(Clone, Copy, Debug)]
-pub enum Const {
-    U32(&'static str, u32),
-    F32(&'static str, f32),
-}
+pub use crate::consts::Const;
 
 /// Constants a shader needs when it is validated without a pipeline (tests, tools).
 pub const DEFAULT_CONSTS: &[Const] = &[

@@ -1,12 +1,8 @@
 //! Per-size frame resources shared by every method: the opaque color with coverage
 //! (`base`), the opaque depth, the output image, census counts, and their readbacks.
 
+use crate::bindings::{BOUND_FORMAT, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::context::GpuContext;
-
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Per-pixel error bound written by methods that derive one.
-pub const BOUND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// Bytes per row of a texture readback, padded to wgpu's 256-byte copy alignment.
 pub fn padded_row(width: u32, bytes_per_pixel: u32) -> u32 {
@@ -51,25 +47,6 @@ pub fn texture(
         format,
         usage,
         view_formats: &[],
-    })
-}
-
-pub fn targets_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    opaque_layout(device, "targets", wgpu::TextureViewDimension::D2)
-}
-
-/// Group 1 of storage-writing and resolve passes: the opaque depth (binding 0) and base
-/// color (binding 1), as single textures or, for coverage-mask frames, arrays of layers.
-fn opaque_layout(device: &wgpu::Device, label: &str, view_dimension: wgpu::TextureViewDimension) -> wgpu::BindGroupLayout {
-    let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false },
-        count: None,
-    };
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &[tex(0, wgpu::TextureSampleType::Depth), tex(1, wgpu::TextureSampleType::Float { filterable: false })],
     })
 }
 
@@ -212,12 +189,6 @@ pub fn read_rows(
         out.extend(bytemuck::pod_collect_to_vec::<u8, f32>(&raw[r * row as usize..r * row as usize + line]));
     }
     Ok(out)
-}
-
-/// Group 1 of a coverage-mask frame (shaders/common/targets_samples.wgsl): the opaque depth
-/// and base color of each sample position, as layers of 2D arrays.
-pub fn samples_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    opaque_layout(device, "sample targets", wgpu::TextureViewDimension::D2Array)
 }
 
 /// The targets of a coverage-mask frame at `samples` samples a pixel: per sample position the

@@ -3,8 +3,8 @@
 //! count, or revealage multiplied down), drawn by one blended geometry pass and read by a
 //! full-screen resolve.
 
-use super::FrameCtx;
-use crate::resources::Layout;
+use super::frame::FrameCtx;
+use crate::cache::Layout;
 
 pub(crate) const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub(crate) const AUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;

@@ -3,9 +3,11 @@
 //! full-screen pass that builds a visibility function of at most `nodes` steps in submission
 //! order and composites every fragment by it (shaders/adaptive.wgsl).
 
-use super::lists::{loop_limited, Aux, ListLayout, ListMethod, BATCH, LLVMPIPE_LOOP_LIMIT};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
-use crate::error::{OitError, Result};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::lists::{check_replay_budget, Aux, ListLayout, ListMethod};
+use super::params::{ParamInfo, ParamKind};
+use crate::error::Result;
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;
 
@@ -35,22 +37,6 @@ pub const INFO: MethodInfo = MethodInfo {
 };
 
 struct Adaptive(ListMethod);
-
-/// Refuses a frame whose deepest pixel the one-invocation replay of a submission-order
-/// method (adaptive, mlab) could not finish on llvmpipe: (n / BATCH + 1) heap sweeps of the
-/// list, then `per_fragment` loop iterations for each fragment.
-pub(crate) fn check_replay_budget(cx: &FrameCtx<'_>, method: &str, param: &str, value: u32, per_fragment: u64) -> Result<()> {
-    let n = cx.max_depth_complexity as u64;
-    let iterations = (n / BATCH as u64 + 1) * n * 6 + n * per_fragment;
-    if loop_limited(cx.gpu) && iterations > LLVMPIPE_LOOP_LIMIT {
-        return Err(OitError::Unsupported(format!(
-            "{method} with {param} = {value} on a pixel with {n} fragments needs about {iterations} loop iterations in one \
-             shader invocation, and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: use a hardware adapter, \
-             a smaller {param} or fewer layers"
-        )));
-    }
-    Ok(())
-}
 
 impl Method for Adaptive {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {

@@ -8,12 +8,15 @@
 //! slots once, and then the exact A-buffer is rendered. When some pixel has no k ≤ 32
 //! predicted to meet t, the A-buffer is rendered directly.
 
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
 use super::ktab::{KTab, Slots};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, Params, FRAMES};
+use super::params::{ParamInfo, ParamKind, Params};
+use crate::cache::ShaderKey;
 use crate::consts::{self, ALPHA_8BIT_ERROR, ROUNDING_TERM as ROUNDING};
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::resources::{Readback, ShaderKey, StorageGroup};
+use crate::resources::{Readback, StorageGroup};
 use crate::targets::read_rows;
 
 pub const INFO: MethodInfo = MethodInfo {
@@ -58,9 +61,9 @@ struct Auto {
 }
 
 impl Auto {
-    fn new(gpu: &GpuContext, limits: &super::Limits) -> Self {
+    fn new(gpu: &GpuContext, limits: &super::frame::Limits) -> Self {
         let hybrid = KTab::new(true);
-        let exact = super::lookup("abuffer").expect("registered").instantiate(gpu, limits);
+        let exact = super::abuffer::INFO.instantiate(gpu, limits);
         Self { hybrid, exact, estimate: None, readback: None }
     }
 

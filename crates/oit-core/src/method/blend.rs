@@ -1,11 +1,13 @@
 //! `unsorted` and `sorted`: fixed-function over-blending onto the opaque image, in
 //! submission order or per mesh back to front by centroid (docs/methods.md).
 
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, FRAMES};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use crate::bindings::COLOR_FORMAT;
+use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
+use crate::passes;
 use crate::pipeline;
-use crate::resources::{Layout, ShaderKey};
-use crate::targets::COLOR_FORMAT;
 
 pub const UNSORTED: MethodInfo = MethodInfo {
     name: "unsorted",
@@ -129,7 +131,7 @@ impl Method for Blend {
         let t = cx.targets;
         let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
         {
-            let mut pass = pipeline::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.timer.render_pass("blend"));
+            let mut pass = passes::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.timer.render_pass("blend"));
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &geo.group, &[]);
             for i in order {

@@ -2,9 +2,12 @@
 //! per pixel from a uniform split of its depth range, the nearest fragment of each bucket
 //! kept, the others dropped and counted (shaders/bucket_peeling.wgsl).
 
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::params::{ParamInfo, ParamKind};
+use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
-use crate::resources::{Counter, Layout, ShaderKey, StorageGroup};
+use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
 
 pub const INFO: MethodInfo = MethodInfo {

@@ -3,9 +3,10 @@
 //! colors, 96 bytes) is written once by a compute pass and the resolve shades each fragment
 //! from it (shaders/compact_abuffer.wgsl).
 
-use super::abuffer::{check_sweep_budget, STATE_WORDS};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::lists::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, FRAMES};
 use crate::error::Result;
 use crate::gpu_types::{CompactNode, PrimShading};
 

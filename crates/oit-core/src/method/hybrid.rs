@@ -1,8 +1,10 @@
 //! `hybrid` (Maule et al. 2013, Algorithm 1) and `ktab`, its core alone with the tail
 //! discarded: the k-TAB engine (ktab.rs) with the `k` parameter.
 
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
 use super::ktab::{memory_bytes, KTab, Slots};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
+use super::params::{ParamInfo, ParamKind};
 use crate::error::Result;
 
 const K_PARAM: ParamInfo = ParamInfo {

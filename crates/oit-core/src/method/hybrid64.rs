@@ -4,9 +4,12 @@
 //! result does not suffice); the word pushed off the table joins the tail in the same pass.
 //! One geometry pass and one full-screen resolve (shaders/hybrid64.wgsl).
 
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::params::{ParamInfo, ParamKind};
+use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
-use crate::resources::{Counter, Layout, ShaderKey, StorageGroup};
+use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
 
 pub const INFO: MethodInfo = MethodInfo {

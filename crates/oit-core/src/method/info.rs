@@ -3,24 +3,10 @@
 
 use std::collections::BTreeMap;
 
-use super::{Limits, Method};
+use super::frame::{Limits, Method};
+use super::params::{check, did_you_mean, ParamInfo, ParamKind, ParamValue, Params};
 use crate::context::GpuContext;
-use crate::error::{invalid, OitError, Result};
-
-/// A parameter's type, range and default.
-#[derive(Clone, Copy, Debug)]
-pub enum ParamKind {
-    Int { min: i64, max: i64, default: i64 },
-    Float { min: f64, max: f64, default: f64 },
-    Choice { choices: &'static [&'static str], default: &'static str },
-}
-
-#[derive(Clone, Copy, Debug)]
-pub struct ParamInfo {
-    pub name: &'static str,
-    pub kind: ParamKind,
-    pub doc: &'static str,
-}
+use crate::error::{invalid, Result};
 
 /// Everything known about a method before it renders: what `oit.methods()` reports, what the
 /// renderer checks before creating it, and what `oit.memory_bytes` answers. One declaration
@@ -150,65 +136,6 @@ pub fn feature_names(features: wgpu::Features) -> Vec<&'static str> {
     features.iter_names().map(|(n, _)| n).collect()
 }
 
-#[derive(Clone, Debug, PartialEq)]
-pub enum ParamValue {
-    Int(i64),
-    Float(f64),
-    Str(String),
-}
-
-/// Parameters after validation, every declared one present (defaults filled in).
-#[derive(Clone, Debug, Default)]
-pub struct Params(pub BTreeMap<&'static str, ParamValue>);
-
-impl Params {
-    pub fn int(&self, name: &str) -> i64 {
-        match self.0.get(name) {
-            Some(ParamValue::Int(v)) => *v,
-            other => panic!("parameter '{name}' is not an int: {other:?}"),
-        }
-    }
-    pub fn float(&self, name: &str) -> f64 {
-        match self.0.get(name) {
-            Some(ParamValue::Float(v)) => *v,
-            Some(ParamValue::Int(v)) => *v as f64,
-            other => panic!("parameter '{name}' is not a float: {other:?}"),
-        }
-    }
-    pub fn choice(&self, name: &str) -> &str {
-        match self.0.get(name) {
-            Some(ParamValue::Str(v)) => v,
-            other => panic!("parameter '{name}' is not a choice: {other:?}"),
-        }
-    }
-}
-
-/// Levenshtein distance, for "did you mean" hints.
-fn distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + (ca != *cb) as usize).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
-}
-
-pub(crate) fn did_you_mean<'a>(name: &str, options: impl Iterator<Item = &'a str>) -> String {
-    let lower = name.to_lowercase();
-    options
-        .map(|o| (distance(&lower, o), o))
-        .filter(|(d, _)| *d <= 2)
-        .min()
-        .map(|(_, o)| format!(" (did you mean '{o}'?)"))
-        .unwrap_or_default()
-}
-
 impl MethodInfo {
     /// Checks names, types and ranges of `given` and fills in defaults.
     pub fn resolve_params(&self, given: &[(String, ParamValue)]) -> Result<Params> {
@@ -236,22 +163,6 @@ impl MethodInfo {
         Ok(Params(out))
     }
 
-    /// Refuses an adapter that lacks a feature the method needs, naming it.
-    pub fn check_features(&self, gpu: &GpuContext) -> Result<()> {
-        let missing = self.features - gpu.features;
-        if missing.is_empty() {
-            return Ok(());
-        }
-        let works: Vec<&str> = super::methods().iter().filter(|m| gpu.features.contains(m.features)).map(|m| m.name).collect();
-        Err(OitError::Unsupported(format!(
-            "adapter '{}' lacks {} which '{}' needs; these methods work on it: {}",
-            gpu.info.name,
-            feature_names(missing).join(" and "),
-            self.name,
-            works.join(", ")
-        )))
-    }
-
     /// Bytes the method allocates at `pixels` pixels with `params`: None when that grows with
     /// the scene, or (auto) when it depends on the slots chosen per frame and `slots` is None.
     pub fn memory_bytes(&self, pixels: u64, params: &Params, slots: Option<u64>) -> Option<u64> {
@@ -264,47 +175,5 @@ impl MethodInfo {
 
     pub(crate) fn instantiate(&self, gpu: &GpuContext, limits: &Limits) -> Box<dyn Method> {
         (self.create)(gpu, limits)
-    }
-}
-
-fn check(method: &str, info: &ParamInfo, value: &ParamValue) -> Result<ParamValue> {
-    let name = info.name;
-    match (info.kind, value) {
-        (ParamKind::Int { min, max, .. }, ParamValue::Int(v)) => {
-            if *v < min || *v > max {
-                return Err(invalid!("{method}: {name} = {v} is out of range; use {min} <= {name} <= {max}"));
-            }
-            Ok(ParamValue::Int(*v))
-        }
-        (ParamKind::Float { min, max, .. }, ParamValue::Float(_) | ParamValue::Int(_)) => {
-            let v = match value {
-                ParamValue::Float(f) => *f,
-                ParamValue::Int(i) => *i as f64,
-                ParamValue::Str(_) => unreachable!(),
-            };
-            if !v.is_finite() || v < min || v > max {
-                return Err(invalid!("{method}: {name} = {v} is out of range; use {min} <= {name} <= {max}"));
-            }
-            Ok(ParamValue::Float(v))
-        }
-        (ParamKind::Choice { choices, .. }, ParamValue::Str(s)) => {
-            if !choices.contains(&s.as_str()) {
-                return Err(invalid!("{method}: {name} = '{s}' is not one of: {}", choices.join(", ")));
-            }
-            Ok(ParamValue::Str(s.clone()))
-        }
-        (kind, v) => {
-            let got = match v {
-                ParamValue::Int(i) => format!("the integer {i}"),
-                ParamValue::Float(f) => format!("the number {f}"),
-                ParamValue::Str(s) => format!("the string '{s}'"),
-            };
-            let want = match kind {
-                ParamKind::Int { min, max, .. } => format!("an integer in [{min}, {max}]"),
-                ParamKind::Float { min, max, .. } => format!("a number in [{min}, {max}]"),
-                ParamKind::Choice { choices, .. } => format!("one of {}", choices.join(", ")),
-            };
-            Err(invalid!("{method}: {name} must be {want}, got {got}"))
-        }
     }
 }

@@ -3,9 +3,10 @@
 //! second geometry pass, composite. Accumulation in fixed point, so that frames do not depend
 //! on fragment order (docs/methods.md, "hybrid"). Each pixel gets a uniform k or its own slots.
 
-use super::{FrameCtx, MethodReport};
+use super::frame::{FrameCtx, MethodReport};
+use crate::cache::{Layout, ShaderKey};
 use crate::error::{OitError, Result};
-use crate::resources::{Counter, Layout, ShaderKey, StorageGroup};
+use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
 
 /// Words per pixel of the accumulators.

@@ -3,11 +3,11 @@
 //! resolve. The pool follows the scene: it grows to the counted fragments and the frame is
 //! rendered again when the atomic counter says the pool overflowed (docs/methods.md).
 
-use super::{FrameCtx, Limits, MethodReport};
+use super::frame::{FrameCtx, Limits, MethodReport};
+use crate::cache::{Layout, ShaderKey};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::Alloc;
-use crate::resources::{Layout, ShaderKey};
 use crate::scan::Scan;
 use crate::shader::Const;
 use crate::targets::{read_buffer, storage_buffer};
@@ -359,4 +359,49 @@ impl ListMethod {
             regrown += 1.0;
         }
     }
+}
+
+/// Words of per-pixel sweep state at one sample a pixel (STATE_WORDS in
+/// shaders/common/sweep.wgsl: 8 + 4 per sample).
+pub(crate) const STATE_WORDS: u64 = state_words(1);
+
+pub(crate) const fn state_words(samples: u32) -> u64 {
+    8 + 4 * samples as u64
+}
+
+/// Loop iterations of one sweep over a list of n fragments, at worst: one per node and
+/// log2(BATCH) heap steps per node kept, then the batch's heap sort.
+pub fn sweep_iterations(n: u64) -> u64 {
+    let log = BATCH.ilog2() as u64;
+    n * (1 + log) + BATCH as u64 * (log + 1)
+}
+
+/// Refuses a frame whose deepest pixel one sweep could not walk on llvmpipe.
+pub(crate) fn check_sweep_budget(cx: &FrameCtx<'_>) -> Result<()> {
+    let n = cx.max_depth_complexity as u64;
+    if loop_limited(cx.gpu) && sweep_iterations(n) > LLVMPIPE_LOOP_LIMIT {
+        return Err(OitError::Unsupported(format!(
+            "a pixel has {n} transparent fragments; on llvmpipe one resolve sweep handles at most about {} \
+             (the driver ends a shader's loops after {LLVMPIPE_LOOP_LIMIT} iterations): use a hardware adapter, \
+             fewer layers, or a bounded method such as hybrid",
+            (LLVMPIPE_LOOP_LIMIT - BATCH as u64 * 6) / 6
+        )));
+    }
+    Ok(())
+}
+
+/// Refuses a frame whose deepest pixel the one-invocation replay of a submission-order
+/// method (adaptive, mlab) could not finish on llvmpipe: (n / BATCH + 1) heap sweeps of the
+/// list, then `per_fragment` loop iterations for each fragment.
+pub(crate) fn check_replay_budget(cx: &FrameCtx<'_>, method: &str, param: &str, value: u32, per_fragment: u64) -> Result<()> {
+    let n = cx.max_depth_complexity as u64;
+    let iterations = (n / BATCH as u64 + 1) * n * 6 + n * per_fragment;
+    if loop_limited(cx.gpu) && iterations > LLVMPIPE_LOOP_LIMIT {
+        return Err(OitError::Unsupported(format!(
+            "{method} with {param} = {value} on a pixel with {n} fragments needs about {iterations} loop iterations in one \
+             shader invocation, and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: use a hardware adapter, \
+             a smaller {param} or fewer layers"
+        )));
+    }
+    Ok(())
 }

@@ -2,9 +2,11 @@
 //! order over captured lists because WebGPU has no pixel synchronization; memory is that of
 //! the lists, unbounded (shaders/mlab.wgsl).
 
-use super::adaptive::check_replay_budget;
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::lists::check_replay_budget;
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
+use super::params::{ParamInfo, ParamKind};
 use crate::error::Result;
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;

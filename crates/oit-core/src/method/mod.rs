@@ -8,29 +8,29 @@ mod auto;
 mod blend;
 mod bucket_peeling;
 mod compact_abuffer;
-pub mod hybrid;
+mod frame;
+mod hybrid;
 mod hybrid64;
 mod info;
 mod ktab;
 pub(crate) mod lists;
 mod mlab;
 mod pall;
-pub mod peel;
+mod params;
+mod peel;
 mod sbuffer;
 mod screen_door;
 mod stochastic;
 mod weighted;
 
+pub use frame::MethodReport;
+pub(crate) use frame::{check_per_pixel, FrameCtx, Limits, Method};
 pub use info::*;
+pub use params::{ParamInfo, ParamKind, ParamValue, Params};
 
 use crate::context::GpuContext;
-use crate::error::{invalid, Result};
-use crate::pipeline;
-use crate::resources::{resolve_targets, ComputeDesc, Draw, Layout, RenderDesc, ShaderKey};
-use crate::scene::Camera;
-use crate::targets::{SampleTargets, Targets};
-use crate::timer::PassTimer;
-use crate::upload::GpuScene;
+use crate::error::{invalid, OitError, Result};
+use params::did_you_mean;
 
 const REGISTRY: &[MethodInfo] = &[
     abuffer::INFO,
@@ -79,271 +79,19 @@ pub fn memory_bytes(name: &str, width: u32, height: u32, params: &[(String, Para
     Ok(info.memory_bytes(width as u64 * height as u64, &params, slots))
 }
 
-/// Limits a method sizes its buffers by: the adapter's, or lower ones a caller asks for
-/// (tests use a small binding limit to exercise buffer splitting on small scenes).
-#[derive(Clone, Copy, Debug)]
-pub struct Limits {
-    pub max_binding_bytes: u64,
-}
-
-/// Everything a method needs to record one frame. The opaque pass and the census have run;
-/// the method writes its final image into `targets.out`.
-pub(crate) struct FrameCtx<'a> {
-    pub gpu: &'a GpuContext,
-    pub scene: &'a GpuScene,
-    pub camera: &'a Camera,
-    pub targets: &'a Targets,
-    pub timer: &'a mut PassTimer,
-    pub params: &'a Params,
-    /// Transparent fragments per pixel (row-major), from this frame's census.
-    pub depth_complexity: &'a [u32],
-    /// Largest transparent fragment count of a pixel, from this frame's census.
-    pub max_depth_complexity: u32,
-    /// Transparent fragments of the frame, from the census.
-    pub fragments: u64,
-    /// The frame uniform (`gpu_types::FrameUniform`), for methods that set its `seed`.
-    pub frame_uniform: &'a wgpu::Buffer,
-    /// Limits to size buffers by (the adapter's, or lower ones the caller asked for).
-    pub limits: Limits,
-    /// A coverage-mask frame's per-sample targets (only methods that take coverage masks
-    /// see one).
-    pub coverage: Option<&'a SampleTargets>,
-}
-
-impl<'a> FrameCtx<'a> {
-    /// Group 1 of storage-writing and resolve passes: the frame's targets, or the per-sample
-    /// ones of a coverage-mask frame.
-    pub fn targets_group(&self) -> &'a wgpu::BindGroup {
-        self.coverage.map_or(&self.targets.group, |c| &c.group)
-    }
-
-    /// The depth attachment geometry passes draw against (read-only).
-    pub fn raster_depth(&self) -> &'a wgpu::TextureView {
-        self.coverage.map_or(&self.targets.depth, |c| &c.raster_depth)
-    }
-}
-
-impl<'a> FrameCtx<'a> {
-    pub fn pixels(&self) -> u64 {
-        self.targets.width as u64 * self.targets.height as u64
-    }
-
-    /// The layout of group 1 in this frame: the opaque targets, or their per-sample layers.
-    fn targets_key(&self) -> Layout {
-        if self.coverage.is_some() {
-            Layout::SampleTargets
-        } else {
-            Layout::Targets
-        }
-    }
-
-    /// A geometry pipeline of `shader`'s fragment entry `fs` that writes storage only (group 2:
-    /// `own`), tested against the opaque depth; in a coverage-mask frame, multisampled.
-    pub fn capture_pipeline(&self, shader: &ShaderKey, fs: &'static str, own: Layout) -> wgpu::RenderPipeline {
-        let draw = match self.coverage {
-            Some(c) => Draw::Geometry { depth: pipeline::raster_only(), samples: c.samples },
-            None => Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
-        };
-        let groups = vec![Layout::Scene, self.targets_key(), own];
-        self.gpu.cache.render(&self.gpu.device, &RenderDesc { shader: shader.clone(), entry: fs, groups, draw, targets: vec![] })
-    }
-
-    /// A geometry pipeline of `fs` with its own groups, color targets and depth state.
-    pub fn draw_pipeline(
-        &self,
-        shader: &ShaderKey,
-        fs: &'static str,
-        groups: Vec<Layout>,
-        targets: Vec<Option<wgpu::ColorTargetState>>,
-        depth: Option<wgpu::DepthStencilState>,
-    ) -> wgpu::RenderPipeline {
-        let draw = Draw::Geometry { depth, samples: 1 };
-        self.gpu.cache.render(&self.gpu.device, &RenderDesc { shader: shader.clone(), entry: fs, groups, draw, targets })
-    }
-
-    /// A full-screen resolve of `fs` into the output (and the error bound, with `bound`).
-    pub fn resolve_pipeline(&self, shader: &ShaderKey, fs: &'static str, own: Layout, bound: bool) -> wgpu::RenderPipeline {
-        let groups = vec![Layout::Scene, self.targets_key(), own];
-        let desc = RenderDesc { shader: shader.clone(), entry: fs, groups, draw: Draw::Fullscreen, targets: resolve_targets(bound) };
-        self.gpu.cache.render(&self.gpu.device, &desc)
-    }
-
-    /// A compute pipeline of `entry` over the shared groups and `own`.
-    pub fn compute_pipeline(&self, shader: &ShaderKey, entry: &'static str, own: Layout) -> wgpu::ComputePipeline {
-        let groups = vec![Layout::Scene, self.targets_key(), own];
-        self.gpu.cache.compute(&self.gpu.device, &ComputeDesc { shader: shader.clone(), entry, groups })
-    }
-
-    /// A bind group of `layout` over `resources` at bindings 0, 1, ... (or the layout's own).
-    pub fn group(&self, layout: Layout, resources: &[wgpu::BindingResource<'_>]) -> wgpu::BindGroup {
-        let bindings: Vec<u32> = match layout {
-            Layout::Textures(b) => b.to_vec(),
-            _ => (0..resources.len() as u32).collect(),
-        };
-        let entries: Vec<wgpu::BindGroupEntry> =
-            bindings.iter().zip(resources).map(|(&binding, r)| wgpu::BindGroupEntry { binding, resource: r.clone() }).collect();
-        let layout = self.gpu.cache.layout(&self.gpu.device, layout);
-        self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &layout, entries: &entries })
-    }
-
-    /// Records a geometry pass of `pipeline` over the transparent geometry (timed as `label`),
-    /// with the frame's targets at group 1 and `own` at group 2.
-    pub fn capture(&mut self, enc: &mut wgpu::CommandEncoder, label: &'static str, pipeline: &wgpu::RenderPipeline, own: &wgpu::BindGroup) {
-        let (depth, targets, scene) = (self.raster_depth(), self.targets_group(), self.scene);
-        capture_pass(enc, label, depth, targets, scene, self.timer.render_pass(label), pipeline, own);
-    }
-
-    /// [`FrameCtx::capture`] inside a span the caller times (per-layer passes).
-    pub fn capture_untimed(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        label: &'static str,
-        pipeline: &wgpu::RenderPipeline,
-        own: &wgpu::BindGroup,
-    ) {
-        capture_pass(enc, label, self.raster_depth(), self.targets_group(), self.scene, None, pipeline, own);
-    }
-
-    /// Binds the shared groups, `own` and `pipeline` to `pass` and dispatches one invocation
-    /// per pixel (8 x 8 workgroups).
-    pub fn bind_dispatch(&self, pass: &mut wgpu::ComputePass<'_>, pipeline: &wgpu::ComputePipeline, own: &wgpu::BindGroup) {
-        per_pixel_dispatch(pass, self.scene, self.targets_group(), (self.targets.width, self.targets.height), pipeline, own);
-    }
-
-    /// Records a full-screen pass of `pipeline` into the output (and the error bound, with
-    /// `bound`), with the shared groups and `own` bound.
-    pub fn resolve(
-        &mut self,
-        enc: &mut wgpu::CommandEncoder,
-        label: &'static str,
-        pipeline: &wgpu::RenderPipeline,
-        own: &wgpu::BindGroup,
-        bound: bool,
-    ) {
-        let (t, targets, scene) = (self.targets, self.targets_group(), self.scene);
-        let timestamps = self.timer.render_pass(label);
-        let mut pass = if bound {
-            pipeline::resolve_with_bound(enc, label, t, timestamps)
-        } else {
-            pipeline::resolve_pass(enc, label, &t.out, timestamps)
-        };
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &scene.transparent.group, &[]);
-        pass.set_bind_group(1, targets, &[]);
-        pass.set_bind_group(2, own, &[]);
-        pass.draw(0..3, 0..1);
-    }
-
-    /// Records a compute pass of `pipeline`, one invocation per pixel (8 x 8 workgroups).
-    pub fn dispatch(
-        &mut self,
-        enc: &mut wgpu::CommandEncoder,
-        label: &'static str,
-        pipeline: &wgpu::ComputePipeline,
-        own: &wgpu::BindGroup,
-    ) {
-        let (t, targets, scene) = (self.targets, self.targets_group(), self.scene);
-        let timestamp_writes = self.timer.compute_pass(label);
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
-        per_pixel_dispatch(&mut pass, scene, targets, (t.width, t.height), pipeline, own);
-    }
-
-    pub fn encoder(&self) -> wgpu::CommandEncoder {
-        self.gpu.device.create_command_encoder(&Default::default())
-    }
-
-    pub fn submit(&self, enc: wgpu::CommandEncoder) {
-        self.gpu.queue.submit([enc.finish()]);
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn capture_pass(
-    enc: &mut wgpu::CommandEncoder,
-    label: &str,
-    depth: &wgpu::TextureView,
-    targets: &wgpu::BindGroup,
-    scene: &GpuScene,
-    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    pipeline: &wgpu::RenderPipeline,
-    own: &wgpu::BindGroup,
-) {
-    let mut pass = pipeline::capture_pass(enc, label, depth, timestamps);
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(1, targets, &[]);
-    pass.set_bind_group(2, own, &[]);
-    scene.transparent.draw_all(&mut pass);
-}
-
-fn per_pixel_dispatch(
-    pass: &mut wgpu::ComputePass<'_>,
-    scene: &GpuScene,
-    targets: &wgpu::BindGroup,
-    size: (u32, u32),
-    pipeline: &wgpu::ComputePipeline,
-    own: &wgpu::BindGroup,
-) {
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, &scene.transparent.group, &[]);
-    pass.set_bind_group(1, targets, &[]);
-    pass.set_bind_group(2, own, &[]);
-    pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
-}
-
-impl FrameCtx<'_> {
-    /// The same frame for another method's parameters (methods that delegate, e.g. auto).
-    pub fn with_params<'b>(&'b mut self, params: &'b Params) -> FrameCtx<'b> {
-        FrameCtx {
-            gpu: self.gpu,
-            scene: self.scene,
-            camera: self.camera,
-            targets: self.targets,
-            timer: &mut *self.timer,
-            params,
-            depth_complexity: self.depth_complexity,
-            max_depth_complexity: self.max_depth_complexity,
-            fragments: self.fragments,
-            frame_uniform: self.frame_uniform,
-            limits: self.limits,
-            coverage: self.coverage,
-        }
-    }
-
-    /// Refuses a frame whose per-pixel buffer of `bytes_per_pixel` would pass one storage
-    /// binding, naming the largest frame that fits.
-    pub fn check_per_pixel(&self, what: &str, bytes_per_pixel: u64) -> Result<()> {
-        check_per_pixel(self.limits.max_binding_bytes, self.targets.width, self.targets.height, what, bytes_per_pixel)
-    }
-}
-
-/// See [`FrameCtx::check_per_pixel`].
-pub(crate) fn check_per_pixel(limit: u64, width: u32, height: u32, what: &str, bytes_per_pixel: u64) -> Result<()> {
-    let pixels = width as u64 * height as u64;
-    if pixels * bytes_per_pixel <= limit {
+/// Refuses an adapter that lacks a feature `info`'s method needs, naming the features and the
+/// methods that work on it.
+pub fn check_features(info: &MethodInfo, gpu: &GpuContext) -> Result<()> {
+    let missing = info.features - gpu.features;
+    if missing.is_empty() {
         return Ok(());
     }
-    let fits = limit / bytes_per_pixel.max(1);
-    let side = (fits as f64).sqrt() as u64;
-    Err(crate::error::OitError::OutOfMemory(format!(
-        "{what} needs {} bytes at {width} x {height}, past the {limit}-byte storage binding limit: render at most \
-         {fits} pixels (e.g. {side} x {side})",
-        pixels * bytes_per_pixel
+    let works: Vec<&str> = methods().iter().filter(|m| gpu.features.contains(m.features)).map(|m| m.name).collect();
+    Err(OitError::Unsupported(format!(
+        "adapter '{}' lacks {} which '{}' needs; these methods work on it: {}",
+        gpu.info.name,
+        feature_names(missing).join(" and "),
+        info.name,
+        works.join(", ")
     )))
-}
-
-/// What a method reports about its frame, beyond what the renderer measures.
-#[derive(Debug, Default)]
-pub struct MethodReport {
-    /// GPU memory the method itself allocated (buffers kept for this frame).
-    pub memory_bytes: u64,
-    /// Fragments a bounded structure could not hold.
-    pub overflow_fragments: u64,
-    /// Method-specific numbers (e.g. how often the node pool grew).
-    pub extra: Vec<(&'static str, f64)>,
-    /// Whether the method wrote a per-pixel error bound into `targets.bound`.
-    pub error_bound: bool,
-}
-
-pub(crate) trait Method: Send {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport>;
 }

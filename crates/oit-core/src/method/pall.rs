@@ -3,9 +3,10 @@
 //! conservative bound of its fragments); fragments then link nodes of their triangle's
 //! block without a global atomic. Resolved exactly like `abuffer` (shaders/pall.wgsl).
 
-use super::abuffer::{check_sweep_budget, STATE_WORDS};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::lists::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, FRAMES};
 use crate::error::Result;
 use crate::gpu_types::{PallBlock, PoolNode};
 

@@ -3,9 +3,12 @@
 //! atomic min/max over (depth, triangle) keys, so coplanar fragments peel one by one
 //! (shaders/peel.wgsl, docs/methods.md).
 
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::params::{ParamInfo, ParamKind};
+use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
-use crate::resources::{Counter, Layout, ShaderKey, StorageGroup};
+use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
 
 const LAYERS: ParamInfo = ParamInfo {

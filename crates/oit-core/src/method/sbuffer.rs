@@ -3,9 +3,10 @@
 //! contiguous per-pixel ranges (compute), capture into them, and resolve like `abuffer`.
 //! The pool holds exactly the counted fragments (shaders/sbuffer.wgsl).
 
-use super::abuffer::{check_sweep_budget, STATE_WORDS};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::lists::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, FRAMES};
 use crate::error::Result;
 use crate::gpu_types::PoolNode;
 

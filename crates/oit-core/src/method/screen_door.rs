@@ -2,11 +2,13 @@
 //! geometry pass that draws the nearest fragment whose alpha beats its pixel's threshold,
 //! opaque (shaders/screen_door.wgsl).
 
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, FRAMES};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
+use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
-use crate::pipeline;
-use crate::resources::{Layout, ShaderKey};
-use crate::targets::{texture, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::passes;
+use crate::targets::texture;
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "screen_door",
@@ -63,7 +65,7 @@ impl Method for ScreenDoor {
         enc.copy_texture_to_texture(t.depth_texture.as_image_copy(), depth_tex.as_image_copy(), depth_tex.size());
         {
             let depth_ops = Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store });
-            let mut pass = pipeline::over_base_pass(&mut enc, "screen door", t, depth_view, depth_ops, cx.timer.render_pass("dither"));
+            let mut pass = passes::over_base_pass(&mut enc, "screen door", t, depth_view, depth_ops, cx.timer.render_pass("dither"));
             pass.set_pipeline(&pipeline);
             cx.scene.transparent.draw_all(&mut pass);
         }

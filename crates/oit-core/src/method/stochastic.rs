@@ -3,11 +3,14 @@
 //! an accumulation pass and a resolve (shaders/stochastic.wgsl). Deterministic for a seed.
 
 use super::accum::{accumulation_targets, AccumTargets, Aux};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::params::{ParamInfo, ParamKind};
+use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
 use crate::gpu_types::FrameUniform;
 use crate::pipeline;
-use crate::resources::{Layout, ShaderKey, StorageGroup};
+use crate::resources::StorageGroup;
 use crate::shader::Const;
 
 pub const INFO: MethodInfo = MethodInfo {

@@ -2,10 +2,12 @@
 //! multiplicative) blending into two float targets, then a full-screen resolve.
 
 use super::accum::{accumulation_targets, memory_bytes, AccumTargets, Aux};
-use super::{ErrorBound, FrameCtx, Memory, Method, MethodInfo, MethodReport, Order, ParamInfo, ParamKind, FRAMES};
+use super::frame::{FrameCtx, Method, MethodReport};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::params::{ParamInfo, ParamKind};
+use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
 use crate::pipeline;
-use crate::resources::{Layout, ShaderKey};
 use crate::shader::Const;
 
 #[derive(Clone, Copy, PartialEq)]
