@@ -2,6 +2,9 @@
 VENV ?= .venv
 PY := $(VENV)/bin/python
 export CARGO_TARGET_DIR ?= $(HOME)/.cache/oit/target
+# The Vulkan loader's window-system code complains without one (headless machines, CI), as
+# python/oit/__init__.py also arranges for Python.
+export XDG_RUNTIME_DIR ?= $(shell d=/tmp/oit-runtime-$$(id -u); mkdir -p -m 700 $$d; echo $$d)
 
 .PHONY: setup demo lint test test-rust test-python test-bench bench viewer test-viewer
 

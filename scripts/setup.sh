@@ -29,15 +29,19 @@ apt_install() {
   fi
 }
 
-have_vulkan_driver() {
-  ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json 2>/dev/null | grep -q .
+# No pipes into `grep -q` here: under pipefail, the writer's SIGPIPE would read as "missing".
+have_file() {
+  compgen -G "$1" >/dev/null
 }
-if ! have_vulkan_driver || ! ldconfig -p 2>/dev/null | grep -q libvulkan.so.1; then
+have_lib() {
+  ldconfig -p 2>/dev/null | grep -c "$1" >/dev/null
+}
+if ! { have_file "/usr/share/vulkan/icd.d/*.json" || have_file "/etc/vulkan/icd.d/*.json"; } || ! have_lib libvulkan.so.1; then
   apt_install "Vulkan loader and driver" mesa-vulkan-drivers libvulkan1
 fi
 # VTK (the peers extra) opens its offscreen window through EGL (oit.peers); Mesa's EGL renders
 # with llvmpipe where there is no GPU.
-if ! ls /usr/share/glvnd/egl_vendor.d/*.json 2>/dev/null | grep -q . || ! ldconfig -p 2>/dev/null | grep -q libEGL.so.1; then
+if ! have_file "/usr/share/glvnd/egl_vendor.d/*.json" || ! have_lib libEGL.so.1; then
   apt_install "EGL driver" libegl1 libegl-mesa0 libgl1-mesa-dri
 fi
 # `make lint` runs clippy and rustfmt.

@@ -58,16 +58,15 @@ def read_png(path: Path) -> np.ndarray:
 
 
 def screenshot(tmp_path: Path, args, size=(480, 320), through_python=False) -> np.ndarray:
-    """Runs the viewer on `args` under Xvfb, or through Python with the built-in scene args[0]
-    (exported to a file that Python starts the same binary on), and reads its --crop-view
-    screenshot."""
+    """Runs the viewer on `args` under Xvfb, or through `python -m oit view` with the built-in
+    scene args[0] (exported to a file that Python starts the same binary on), and reads its
+    --crop-view screenshot."""
     out = tmp_path / "shot.png"
     w, h = size
     shot = ["--size", str(w), str(h), "--screenshot", str(out), "--frames", "2"]
     if through_python:
-        # view.run as `python -m oit view` calls it, with options the command does not pass on.
-        run = "import sys; from oit import view; sys.exit(view.run([], scene=sys.argv[1], extra=sys.argv[2:]))"
-        viewer = [sys.executable, "-c", run, *args, *shot, "--hide-panel", "--crop-view"]
+        # `python -m oit view --scene NAME ...`, the viewer-only options after `--`.
+        viewer = [sys.executable, "-m", "oit", "view", "--scene", *args, *shot, "--", "--hide-panel", "--crop-view"]
     else:
         viewer = [str(VIEWER), *args, *shot, "--hide-panel", "--crop-view"]
     command = ["xvfb-run", "-a", "-s", f"-screen 0 {w + 64}x{h + 64}x24", *viewer]

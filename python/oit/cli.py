@@ -212,7 +212,7 @@ def _view(args: argparse.Namespace) -> int:
             extra += [flag, *map(str, value if isinstance(value, list) else [value])]
     for p in args.param:
         extra += ["--param", p]
-    return view.run(args.files, scene=args.scene, extra=extra)
+    return view.run(args.files, scene=args.scene, extra=[*extra, *args.passthrough])
 
 
 Subcommand = tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]
@@ -238,7 +238,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # `view ... -- ARGS`: ARGS go to the viewer binary as they are.
+    passthrough: list[str] = []
+    if argv[:1] == ["view"] and "--" in argv:
+        cut = argv.index("--")
+        argv, passthrough = argv[:cut], argv[cut + 1:]
     args = parser.parse_args(argv)
+    args.passthrough = passthrough
     try:
         return args.run(args)
     except (ValueError, MemoryError, RuntimeError, OSError) as e:
