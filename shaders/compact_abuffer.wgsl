@@ -27,8 +27,8 @@ struct PrimShading {
 
 @compute @workgroup_size(64)
 fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let t = triangle_of(gid);
-    if t >= frame.triangle_count {
+    let t = triangle_of(gid); // within the chunk
+    if t >= chunk.triangles {
         return;
     }
     var s: PrimShading;
@@ -36,7 +36,7 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
         s.clip[k] = clip_vertex(t, k);
         s.color[k] = colors[indices[3u * t + k]];
     }
-    shading[t] = s;
+    shading[chunk.first_triangle + t] = s;
 }
 
 @fragment
@@ -50,8 +50,8 @@ fn fs_capture(in: VsOut) {
 // The node keeps only depth and triangle: its color is interpolated here, at the pixel center.
 fn node_frag(node: Node, link: u32, px: u32) -> Frag {
     let s = shading[node.prim];
-    let ndc = vec2<f32>((f32(px % frame.size.x) + 0.5) * 2.0 / f32(frame.size.x) - 1.0,
-                        1.0 - (f32(px / frame.size.x) + 0.5) * 2.0 / f32(frame.size.y));
+    let at = vec2<f32>(pixel_position(px)) + 0.5;
+    let ndc = vec2<f32>(at.x * 2.0 / f32(frame.size.x) - 1.0, 1.0 - at.y * 2.0 / f32(frame.size.y));
     let b = barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
     let color = clamp(b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2], vec4<f32>(0.0), vec4<f32>(1.0));
     return Frag(node.depth, color, link);

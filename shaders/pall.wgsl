@@ -32,8 +32,8 @@ struct Block {
 
 @compute @workgroup_size(64)
 fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let t = triangle_of(gid);
-    if t >= frame.triangle_count {
+    let t = triangle_of(gid); // within the chunk
+    if t >= chunk.triangles {
         return;
     }
     let b = pixel_box(clip_vertex(t, 0u), clip_vertex(t, 1u), clip_vertex(t, 2u));
@@ -43,7 +43,7 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let start = atomicAdd(&alloc.count, extent.x * extent.y);
     let lo = vec2<u32>(max(b.lo, vec2<i32>(0)));
-    blocks[t] = Block(start, lo.x | (lo.y << 16u), extent.x | (extent.y << 16u), 0u);
+    blocks[chunk.first_triangle + t] = Block(start, lo.x | (lo.y << 16u), extent.x | (extent.y << 16u), 0u);
 }
 
 @fragment

@@ -114,22 +114,28 @@ def test_node_pool_split_across_bindings_gives_the_same_image(renderer):
     assert np.array_equal(split.image, whole.image)
 
 
-def test_node_pool_too_small_raises_memory_error(renderer):
-    # 768-byte bindings hold the 4 x 4 sweep state and 32 nodes each, 128 in all;
-    # 4 x 4 pixels x 9 layers = 144.
+def test_a_node_pool_too_small_for_the_frame_tiles_it(renderer):
+    # 768-byte bindings hold 32 nodes each, 128 in all; 4 x 4 pixels x 9 layers = 144 go in
+    # tiles (docs/methods.md, "Tiles"), with the image of the whole frame.
     r = renderer(4, 4, max_binding_bytes=768)
     scene = build_scene([layer(0.1 * (i + 1), (1, 0, 0, 0.5)) for i in range(9)])
-    with pytest.raises(MemoryError, match=r"144 transparent fragments.*at most 128.*render at a smaller size"):
-        r.render(scene, IDENTITY)
-    # Within the limit, the same renderer works.
+    tiled = r.render(scene, IDENTITY)
+    assert tiled.stats["tiles"] > 1
+    assert np.array_equal(tiled.image, renderer(4, 4).render(scene, IDENTITY).image)
+    # Only a pixel deeper than a whole pool is refused, by name.
+    deep = build_scene([layer(0.9 * (i + 1) / 130, (1, 0, 0, 0.5)) for i in range(130)])
+    with pytest.raises(MemoryError, match=r"pixel \(0, 0\) has 130 transparent fragments, more than one tile can hold"):
+        r.render(deep, IDENTITY)
     ok = r.render(build_scene([layer(0.5, (1, 0, 0, 0.5))]), IDENTITY)
     assert ok.stats["fragments"] == 16
 
 
-def test_per_pixel_buffers_past_a_lowered_limit_name_what_fits(renderer):
-    # 16 x 16 pixels of 48-byte sweep state do not fit 256-byte bindings: 5 pixels do.
-    with pytest.raises(MemoryError, match=r"at most 5 pixels \(e.g. 2 x 2\)"):
-        renderer(16, 16, max_binding_bytes=256).render(build_scene([layer(0.5, (1, 0, 0, 0.5))]), IDENTITY)
+def test_per_pixel_buffers_past_a_lowered_limit_go_in_tiles(renderer):
+    # 16 x 16 pixels of 48-byte sweep state do not fit 256-byte bindings: tiles of a few pixels do.
+    scene = build_scene([layer(0.5, (1, 0, 0, 0.5))])
+    tiled = renderer(16, 16, max_binding_bytes=256).render(scene, IDENTITY)
+    assert tiled.stats["tiles"] >= 16 * 16 // 5
+    assert np.array_equal(tiled.image, renderer(16, 16).render(scene, IDENTITY).image)
 
 
 @pytest.mark.parametrize("method", METHODS)

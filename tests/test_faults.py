@@ -126,10 +126,10 @@ NODE_POOL = [n for n in NAMES if n not in BOUNDED and any("capture" in p for p i
 
 @pytest.mark.parametrize("name", NODE_POOL)
 def test_renderer_is_usable_after_a_memory_error(renderer, name):
-    # 1024-byte bindings: 4 x 4 pixels x 24 layers fit no node pool, 1 layer does
-    # (test_numerics_frame_size.py checks the numbers).
+    # 1024-byte bindings: a pixel of 400 layers fits no node pool, whatever the tiles, 1 layer
+    # does (test_numerics_frame_size.py checks the numbers).
     r = renderer(4, 4, max_binding_bytes=1024)
-    deep = full_screen_layers([(z, (1.0, 0.0, 0.0, 0.5)) for z in np.linspace(0.1, 0.9, 24)])
+    deep = full_screen_layers([(z, (1.0, 0.0, 0.0, 0.5)) for z in np.linspace(0.1, 0.9, 400)])
     with pytest.raises(MemoryError):
         r.render(deep, IDENTITY, name, **params_for(name))
     shallow = full_screen_layers([(0.5, (0.0, 1.0, 0.0, 0.5))])

@@ -272,6 +272,9 @@ class Stats(TypedDict, total=False):
     wall_time_ms: float
     antialias: int
     antialias_mode: str
+    geometry_chunks: int  # chunks the transparent geometry was uploaded in (1 unless it passes a binding)
+    tiles: int  # screen tiles the frame was rendered in (1: untiled), summed over antialiasing samples
+    peak_memory_bytes: int  # the most held at once: the method's largest tile, the shared targets, the scene
     adapter: str
     error_bound_max: float  # the largest of frame.error_bound, where the method derives one
     # Method-specific: the node pool's `pool_nodes`, `pool_regrown`, `resolve_sweeps` (list
@@ -297,9 +300,13 @@ class Frame:
 
 class Renderer:
     """Renders scenes at one size. `adapter` (or the OIT_ADAPTER variable) picks an adapter by
-    a substring of its name; otherwise a hardware adapter is preferred over a software one."""
+    a substring of its name; otherwise a hardware adapter is preferred over a software one.
+    `memory_budget` (bytes) bounds what a method allocates for a frame: where its storage would
+    pass the budget or a storage binding, the frame is rendered in screen tiles
+    (`frame.stats["tiles"]`), with the same image (docs/methods.md, "Tiles")."""
 
-    def __init__(self, width: int, height: int, adapter: str | None = None, max_binding_bytes: int | None = None) -> None:
+    def __init__(self, width: int, height: int, adapter: str | None = None, max_binding_bytes: int | None = None,
+                 memory_budget: int | None = None) -> None:
         for name, v in (("width", width), ("height", height)):
             if _int(v, name) <= 0:
                 raise ValueError(f"{name} must be positive, got {v}")
@@ -310,12 +317,16 @@ class Renderer:
             if _int(max_binding_bytes, "max_binding_bytes", "an int (bytes) or None") <= 0:
                 raise ValueError(f"max_binding_bytes must be positive, got {max_binding_bytes}")
             max_binding_bytes = min(int(max_binding_bytes), _I64_MAX)  # the core caps it at the adapter's
+        if memory_budget is not None:
+            if _int(memory_budget, "memory_budget", "an int (bytes) or None") <= 0:
+                raise ValueError(f"memory_budget must be positive, got {memory_budget}")
+            memory_budget = min(int(memory_budget), _I64_MAX)
         self.width, self.height = int(width), int(height)
         # Sizes past u32 are past every adapter's largest texture: let the core say which
         # size is the largest, about the size asked for.
         w, h = min(self.width, _U32_MAX), min(self.height, _U32_MAX)
         try:
-            self._native = _oit.Renderer(w, h, adapter, max_binding_bytes)
+            self._native = _oit.Renderer(w, h, adapter, max_binding_bytes, memory_budget)
         except MemoryError as e:
             if (w, h) == (self.width, self.height):
                 raise

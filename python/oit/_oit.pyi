@@ -35,6 +35,12 @@ class _MemoryInfo(TypedDict):
     kind: Literal["frame", "scene", "slots"]
     formula: str
 
+class _TilingInfo(TypedDict, total=False):
+    kind: Literal["formula", "census", "whole"]
+    per_pixel: int  # census only: bytes a pixel, a stored fragment, a transparent triangle
+    per_fragment: int
+    per_triangle: int
+
 class _MethodInfo(TypedDict):
     name: str
     summary: str
@@ -48,6 +54,7 @@ class _MethodInfo(TypedDict):
     antialias_modes: list[Literal["frames", "coverage"]]
     memory: _MemoryInfo
     error_bound: Literal["exact", "per_pixel", "none"]
+    tiling: _TilingInfo
 
 @final
 class Scene:
@@ -72,7 +79,14 @@ class Scene:
 
 @final
 class Renderer:
-    def __init__(self, width: int, height: int, adapter: str | None = None, max_binding_bytes: int | None = None) -> None: ...
+    def __init__(
+        self,
+        width: int,
+        height: int,
+        adapter: str | None = None,
+        max_binding_bytes: int | None = None,
+        memory_budget: int | None = None,
+    ) -> None: ...
     @property
     def adapter_info(self) -> _AdapterInfo: ...
     def render(

@@ -6,6 +6,10 @@ struct FrameUniform {
     size: vec2<u32>,
     triangle_count: u32,
     seed: u32,
+    // The screen tile this pass renders (the whole frame unless the renderer tiles): per-pixel
+    // storage is indexed within it, and passes are scissored to it.
+    tile_origin: vec2<u32>,
+    tile_size: vec2<u32>,
 }
 
 @group(0) @binding(0) var<uniform> frame: FrameUniform;
@@ -13,11 +17,20 @@ struct FrameUniform {
 @group(0) @binding(1) var<storage, read> positions: array<f32>;
 @group(0) @binding(2) var<storage, read> colors: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> indices: array<u32>;
+// Geometry is uploaded in chunks that each fit a binding: this chunk's first triangle in the
+// submission order of the whole scene, and its triangle count. Indices are local to the chunk.
+struct Chunk {
+    first_triangle: u32,
+    triangles: u32,
+    pad0: u32,
+    pad1: u32,
+}
+@group(0) @binding(4) var<uniform> chunk: Chunk;
 
 struct VsOut {
     @builtin(position) @invariant clip: vec4<f32>,
     @location(0) color: vec4<f32>,
-    // Global triangle index in submission order (non-indexed draw: vertex_index / 3).
+    // Global triangle index in submission order (the chunk's first, plus vertex_index / 3).
     @location(1) @interpolate(flat) prim: u32,
     // Clip w, interpolated: the view distance under a perspective camera (1 for orthographic).
     @location(2) view_w: f32,
@@ -30,21 +43,28 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     var out: VsOut;
     out.clip = frame.view_proj * vec4<f32>(p, 1.0);
     out.color = colors[v];
-    out.prim = vi / 3u;
+    out.prim = chunk.first_triangle + vi / 3u;
     out.view_w = out.clip.w;
     return out;
 }
 
+// Index of a fragment's pixel in per-pixel storage: row-major within the tile.
 fn pixel_index(pos: vec4<f32>) -> u32 {
-    return u32(pos.y) * frame.size.x + u32(pos.x);
+    let p = vec2<u32>(pos.xy) - frame.tile_origin;
+    return p.y * frame.tile_size.x + p.x;
 }
 
-// Pixel index of a compute invocation laid over the frame; `OUTSIDE` past its edges.
+// The frame position of pixel index `px` (the inverse of pixel_index).
+fn pixel_position(px: u32) -> vec2<u32> {
+    return frame.tile_origin + vec2<u32>(px % frame.tile_size.x, px / frame.tile_size.x);
+}
+
+// Pixel index of a compute invocation laid over the tile; `OUTSIDE` past its edges.
 const OUTSIDE: u32 = 0xffffffffu;
 
 fn compute_pixel(gid: vec3<u32>) -> u32 {
-    if gid.x >= frame.size.x || gid.y >= frame.size.y {
+    if gid.x >= frame.tile_size.x || gid.y >= frame.tile_size.y {
         return OUTSIDE;
     }
-    return gid.y * frame.size.x + gid.x;
+    return gid.y * frame.tile_size.x + gid.x;
 }

@@ -12,8 +12,8 @@ fn clip_vertex(t: u32, corner: u32) -> vec4<f32> {
     return frame.view_proj * vec4<f32>(p, 1.0);
 }
 
-// Inclusive pixel range [lo, hi] whose centers a triangle can cover, clamped to the frame;
-// the whole frame when a vertex is behind the eye (w <= 0). Empty when hi < lo.
+// Inclusive pixel range [lo, hi] whose centers a triangle can cover, clamped to the tile; the
+// whole tile when a vertex is behind the eye (w <= 0). Empty when hi < lo.
 struct PixelBox {
     lo: vec2<i32>,
     hi: vec2<i32>,
@@ -21,9 +21,10 @@ struct PixelBox {
 
 fn pixel_box(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>) -> PixelBox {
     let size = vec2<f32>(frame.size);
-    let last = vec2<i32>(frame.size) - 1;
+    let first = vec2<i32>(frame.tile_origin);
+    let last = vec2<i32>(frame.tile_origin + frame.tile_size) - 1;
     if c0.w <= 0.0 || c1.w <= 0.0 || c2.w <= 0.0 {
-        return PixelBox(vec2<i32>(0), last);
+        return PixelBox(first, last);
     }
     // NDC to pixels: x right, y down; a center (i + 0.5) is covered only inside the box.
     let p0 = vec2<f32>(c0.x / c0.w + 1.0, 1.0 - c0.y / c0.w) * 0.5 * size;
@@ -33,7 +34,7 @@ fn pixel_box(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>) -> PixelBox {
     // vertex snapping (1/256 pixel) and float rounding.
     let lo = min(min(p0, p1), p2) - 0.0625;
     let hi = max(max(p0, p1), p2) + 0.0625;
-    let a = max(vec2<i32>(ceil(lo - 0.5)), vec2<i32>(0));
+    let a = max(vec2<i32>(ceil(lo - 0.5)), first);
     let b = min(vec2<i32>(floor(hi - 0.5)), last);
     return PixelBox(a, b);
 }

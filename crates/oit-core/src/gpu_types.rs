@@ -12,6 +12,9 @@ pub struct FrameUniform {
     pub size: [u32; 2],
     pub triangle_count: u32,
     pub seed: u32,
+    /// The screen tile a pass renders: per-pixel storage is indexed within it.
+    pub tile_origin: [u32; 2],
+    pub tile_size: [u32; 2],
 }
 
 /// Mirrors `Node` in `shaders/abuffer.wgsl`: depth, next index, straight RGBA.

@@ -18,12 +18,15 @@ mod scan;
 pub mod scene;
 pub mod shader;
 mod targets;
+pub mod tiles;
 mod timer;
 mod upload;
 
 pub use context::GpuContext;
 pub use error::{OitError, Result};
-pub use method::{memory_bytes, methods, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, ParamInfo, ParamKind, ParamValue, Params};
+pub use method::{
+    memory_bytes, methods, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, ParamInfo, ParamKind, ParamValue, Params, Tiling,
+};
 pub use reference::{reference, reference_antialiased, ReferenceImage};
 pub use renderer::{coverage_methods, shared_context, Frame, Renderer, Stats, COVERAGE_SAMPLES};
 pub use scene::{Camera, Mesh, Scene};

@@ -46,23 +46,25 @@ pub fn over_base_pass<'e>(
     })
 }
 
-fn cleared(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+/// A resolve's target, kept as it is: the pass writes every pixel of its tile, and the tiles
+/// rendered before it stay.
+fn kept(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
     Some(wgpu::RenderPassColorAttachment {
         view,
         depth_slice: None,
         resolve_target: None,
-        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+        ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
     })
 }
 
-/// A pass that writes `target` entirely (full-screen resolves).
+/// A pass that writes `target` over the tile it is scissored to (full-screen resolves).
 pub fn resolve_pass<'e>(
     enc: &'e mut wgpu::CommandEncoder,
     label: &str,
     target: &'e wgpu::TextureView,
     timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
 ) -> wgpu::RenderPass<'e> {
-    resolve_targets(enc, label, &[cleared(target)], timestamps)
+    resolve_targets(enc, label, &[kept(target)], timestamps)
 }
 
 /// A full-screen resolve that also writes the per-pixel error bound.
@@ -72,7 +74,7 @@ pub fn resolve_with_bound<'e>(
     targets: &'e crate::targets::Targets,
     timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
 ) -> wgpu::RenderPass<'e> {
-    resolve_targets(enc, label, &[cleared(&targets.out), cleared(&targets.bound)], timestamps)
+    resolve_targets(enc, label, &[kept(&targets.out), kept(&targets.bound)], timestamps)
 }
 
 fn resolve_targets<'e>(

@@ -11,12 +11,13 @@ use crate::cache::Layout;
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
 use crate::gpu_types::FrameUniform;
-use crate::method::{self, AntialiasMode, FrameCtx, Limits, Method, MethodInfo, ParamValue, Params};
+use crate::method::{self, AntialiasMode, FrameCtx, Limits, Method, MethodInfo, MethodReport, ParamValue, Params, Tiling};
 use crate::passes;
 use crate::pipeline;
 use crate::scene::{Camera, Scene};
 use crate::shader;
 use crate::targets::{read_buffer, read_rows, SampleTargets, Targets};
+use crate::tiles::{self, Footprint, Tile};
 use crate::timer::PassTimer;
 use crate::upload::GpuScene;
 
@@ -41,6 +42,13 @@ pub struct Stats {
     /// Samples a pixel (1: no antialiasing).
     pub antialias: u32,
     pub antialias_mode: AntialiasMode,
+    /// Screen tiles the frame was rendered in (1: untiled); summed over antialiasing samples.
+    pub tiles: u32,
+    /// Chunks the transparent geometry was uploaded in (1 unless it passes a binding).
+    pub geometry_chunks: u32,
+    /// The most GPU memory the frame held at once: the method's largest tile, the shared
+    /// targets and the scene.
+    pub peak_memory_bytes: u64,
 }
 
 /// Methods that take coverage masks (`AntialiasMode::Coverage` in their `antialias_modes`).
@@ -127,6 +135,9 @@ pub struct Renderer {
     methods: HashMap<&'static str, Box<dyn Method>>,
     timer: PassTimer,
     limits: Limits,
+    /// Bytes a method may allocate for a frame (tiles keep it within); None: what the adapter's
+    /// bindings allow.
+    memory_budget: Option<u64>,
     /// Made at the first coverage-mask frame.
     coverage: Option<Coverage>,
 }
@@ -164,7 +175,19 @@ impl Renderer {
         gpu.take_error()?;
         let timer = PassTimer::new(&gpu);
         let limits = Limits { max_binding_bytes: gpu.max_binding_bytes() };
-        Ok(Self { gpu, width, height, shared, targets, scene: None, methods: HashMap::new(), timer, limits, coverage: None })
+        Ok(Self {
+            gpu,
+            width,
+            height,
+            shared,
+            targets,
+            scene: None,
+            methods: HashMap::new(),
+            timer,
+            limits,
+            memory_budget: None,
+            coverage: None,
+        })
     }
 
     /// Sizes method buffers as if the adapter bound at most `bytes` per storage binding
@@ -175,6 +198,17 @@ impl Renderer {
         }
         self.limits.max_binding_bytes = bytes.min(self.gpu.max_binding_bytes());
         self.methods.clear();
+        self.scene = None; // uploaded again, in chunks that fit the new limit
+        Ok(())
+    }
+
+    /// Keeps each method's own allocations for a frame within `bytes` (None: what the adapter's
+    /// bindings allow), rendering in screen tiles where needed (docs/methods.md, "Tiles").
+    pub fn set_memory_budget(&mut self, bytes: Option<u64>) -> Result<()> {
+        if bytes.is_some_and(|b| b < 1024) {
+            return Err(invalid!("memory_budget must be at least 1024 bytes, got {}", bytes.unwrap_or(0)));
+        }
+        self.memory_budget = bytes;
         Ok(())
     }
 
@@ -273,6 +307,10 @@ impl Renderer {
             stats.overflow_fragments += s.overflow_fragments;
             stats.max_depth_complexity = stats.max_depth_complexity.max(s.max_depth_complexity);
             stats.memory_bytes = stats.memory_bytes.max(s.memory_bytes);
+            stats.peak_memory_bytes = stats.peak_memory_bytes.max(s.peak_memory_bytes);
+            if i > 0 {
+                stats.tiles += s.tiles;
+            }
             stats.gpu_time_ms = stats.gpu_time_ms.zip(s.gpu_time_ms).map(|(a, b)| a + b);
             if i > 0 {
                 stats.pass_times_ms.extend(s.pass_times_ms);
@@ -318,35 +356,91 @@ impl Renderer {
         let fragments: u64 = depth_complexity.iter().map(|&c| c as u64).sum();
 
         let limits = self.limits;
-        let method = self.methods.entry(info.name).or_insert_with(|| info.instantiate(&gpu, &limits));
-        self.timer.reset();
-        let mut cx = FrameCtx {
-            gpu: &gpu,
-            scene: gpu_scene,
-            camera,
-            targets: &self.targets,
-            timer: &mut self.timer,
-            params,
-            depth_complexity: &depth_complexity,
-            max_depth_complexity,
-            fragments,
-            frame_uniform: &self.shared.uniform,
-            limits: self.limits,
-            coverage: cov.map(|c| &c.targets),
+        // Out of the map while it renders, so that the loop can set each tile's uniform.
+        let mut method = self.methods.remove(info.name).unwrap_or_else(|| info.instantiate(&gpu, &limits));
+        // Tiles planned from the census; a method whose storage proves larger than planned (pall's
+        // pool follows its triangles' bounding boxes, not the fragments) is planned again with
+        // the budget divided by how far it went over.
+        let mut squeeze = 1.0f64;
+        let (tiles, report, pass_times) = loop {
+            let tiles = self.plan_tiles(info, params, &depth_complexity, coverage, squeeze)?;
+            let mut report = MethodReport::default();
+            let mut pass_times: Option<Vec<(&'static str, f64)>> = None;
+            for tile in &tiles {
+                let counts = if tiles.len() == 1 { depth_complexity.clone() } else { tile.crop(&depth_complexity, self.width) };
+                self.set_uniform(camera, gpu_scene, background, *tile);
+                self.timer.reset();
+                let mut cx = FrameCtx {
+                    gpu: &gpu,
+                    scene: gpu_scene,
+                    camera,
+                    targets: &self.targets,
+                    timer: &mut self.timer,
+                    params,
+                    tile: *tile,
+                    max_depth_complexity: counts.iter().copied().max().unwrap_or(0),
+                    fragments: counts.iter().map(|&c| c as u64).sum(),
+                    depth_complexity: &counts,
+                    frame_uniform: &self.shared.uniform,
+                    limits: self.limits,
+                    coverage: cov.map(|c| &c.targets),
+                };
+                let r = method.render(&mut cx)?;
+                if let Some(short) = r.pool_short {
+                    report.pool_short = Some(report.pool_short.unwrap_or(1.0).max(short));
+                    break;
+                }
+                if let Some(t) = self.timer.read(&gpu)? {
+                    pass_times.get_or_insert_with(Vec::new).extend(t);
+                }
+                report.memory_bytes = report.memory_bytes.max(r.memory_bytes);
+                report.overflow_fragments += r.overflow_fragments;
+                report.error_bound |= r.error_bound;
+                for (k, v) in r.extra {
+                    match report.extra.iter_mut().find(|(name, _)| *name == k) {
+                        // Counts add up over tiles; auto's k and the like keep their largest.
+                        Some((_, total)) if k.ends_with("_k") || k == "auto_exact" || k == "resolve_sweeps" => *total = total.max(v),
+                        Some((_, total)) => *total += v,
+                        None => report.extra.push((k, v)),
+                    }
+                }
+            }
+            if let Some(short) = report.pool_short {
+                if squeeze < 1e6 {
+                    squeeze *= 1.25 * short;
+                    continue;
+                }
+            }
+            match self.memory_budget {
+                Some(budget) if report.memory_bytes > budget && squeeze < 1e6 => {
+                    squeeze *= 1.25 * report.memory_bytes as f64 / budget as f64;
+                }
+                Some(budget) if report.memory_bytes > budget => {
+                    self.methods.insert(info.name, method);
+                    return Err(OitError::OutOfMemory(format!(
+                        "'{}' needed {} bytes in its smallest tiles, past the memory_budget of {budget} bytes: raise \
+                         memory_budget or use a bounded method (e.g. hybrid)",
+                        info.name, report.memory_bytes
+                    )));
+                }
+                _ => break (tiles, report, pass_times),
+            }
         };
-        let report = method.render(&mut cx)?;
-        let pass_times = self.timer.read(&gpu)?;
+        self.methods.insert(info.name, method);
+        self.set_camera(camera, gpu_scene, background);
         let t = &self.targets;
         let image = read_rows(&gpu, &t.out_texture, &t.image_readback, 16)?;
         let error_bound = if report.error_bound { Some(read_rows(&gpu, &t.bound_texture, &t.bound_readback, 4)?) } else { None };
+        let target_bytes = self.targets.bytes() + cov.map_or(0, |c| c.targets.bytes());
+        let scene_bytes = gpu_scene.transparent.bytes + gpu_scene.opaque.bytes;
         let stats = Stats {
             method: info.name.to_string(),
             params: params.clone(),
             fragments,
             max_depth_complexity,
             memory_bytes: report.memory_bytes,
-            target_bytes: self.targets.bytes() + cov.map_or(0, |c| c.targets.bytes()),
-            scene_bytes: gpu_scene.transparent.bytes + gpu_scene.opaque.bytes,
+            target_bytes,
+            scene_bytes,
             gpu_time_ms: pass_times.as_ref().map(|p| p.iter().map(|(_, t)| t).sum()),
             pass_times_ms: pass_times.unwrap_or_default(),
             overflow_fragments: report.overflow_fragments,
@@ -354,14 +448,79 @@ impl Renderer {
             extra: report.extra,
             antialias: 1,
             antialias_mode: AntialiasMode::Frames,
+            tiles: tiles.len() as u32,
+            geometry_chunks: gpu_scene.transparent.chunks.len() as u32,
+            peak_memory_bytes: report.memory_bytes + target_bytes + scene_bytes,
         };
         Ok(Frame { width: self.width, height: self.height, image, depth_complexity, error_bound, stats })
+    }
+
+    /// The screen tiles `info`'s method renders this frame in: one unless its storage would pass
+    /// a binding or the memory budget (docs/methods.md, "Tiles").
+    fn plan_tiles(&self, info: &MethodInfo, params: &Params, counts: &[u32], coverage: bool, squeeze: f64) -> Result<Vec<Tile>> {
+        let (w, h) = (self.width, self.height);
+        let budget = self.memory_budget.unwrap_or(u64::MAX);
+        // What tiles can make smaller, divided by `squeeze` when a first plan proved too loose.
+        let variable = |rest: u64| if rest == u64::MAX { rest } else { (rest as f64 / squeeze) as u64 };
+        let binding = self.limits.max_binding_bytes;
+        let fp = match info.tiling {
+            Tiling::Whole => {
+                let bytes = info.memory_bytes(w as u64 * h as u64, params, None).unwrap_or(0);
+                if bytes > budget {
+                    return Err(OitError::OutOfMemory(format!(
+                        "'{}' keeps {bytes} bytes of render targets for a {w} x {h} frame, past the memory_budget of {budget} \
+                         bytes, and renders in one piece: raise memory_budget or use a method that tiles (e.g. hybrid)",
+                        info.name
+                    )));
+                }
+                return Ok(vec![Tile::frame(w, h)]);
+            }
+            Tiling::Formula => {
+                let one = info.memory_bytes(1, params, None).unwrap_or(0);
+                let per_pixel = info.memory_bytes(2, params, None).unwrap_or(0) - one;
+                // Every buffer of the method within one binding: at most all of a tile's bytes.
+                let fits = binding / per_pixel.max(1);
+                Footprint {
+                    per_pixel,
+                    per_fragment: 0,
+                    budget: variable(budget.saturating_sub(one - per_pixel)),
+                    max_pixels: fits,
+                    max_fragments: u64::MAX,
+                }
+            }
+            Tiling::Storage { per_pixel, per_fragment, per_triangle } => {
+                // A coverage-mask frame keeps sweep state per sample and a mask per node.
+                let (per_pixel, per_fragment) = if coverage {
+                    (4 + 4 * crate::method::lists::state_words(COVERAGE_SAMPLES), per_fragment + 8)
+                } else {
+                    (per_pixel, per_fragment)
+                };
+                let pool = crate::method::lists::POOL_BINDINGS * (binding / per_fragment);
+                let fixed = per_triangle * self.scene.as_ref().map_or(0, |(_, s)| s.transparent.triangles as u64);
+                if fixed >= budget {
+                    return Err(OitError::OutOfMemory(format!(
+                        "'{}' keeps {per_triangle} bytes for each transparent triangle, {fixed} bytes in all, which no tile \
+                         can make smaller and which pass the memory_budget of {budget} bytes: raise memory_budget or use \
+                         abuffer or sbuffer, which keep nothing per triangle",
+                        info.name
+                    )));
+                }
+                Footprint {
+                    per_pixel,
+                    per_fragment,
+                    budget: variable(budget - fixed),
+                    max_pixels: binding / per_pixel,
+                    max_fragments: (pool as f64 / squeeze) as u64,
+                }
+            }
+        };
+        tiles::plan(w, h, counts, &fp)
     }
 
     fn upload(&mut self, scene: &Scene) -> Result<()> {
         if self.scene.as_ref().map(|(k, _)| *k) != Some(scene.key()) {
             self.scene = None; // free the old buffers first
-            let s = GpuScene::new(&self.gpu, scene, &self.shared.scene_layout, &self.shared.uniform)?;
+            let s = GpuScene::new(&self.gpu, scene, &self.shared.scene_layout, &self.shared.uniform, self.limits.max_binding_bytes)?;
             self.scene = Some((scene.key(), s));
         }
         Ok(())
@@ -369,12 +528,19 @@ impl Renderer {
 
     /// Writes the frame uniform for `camera`.
     fn set_camera(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3]) {
+        self.set_uniform(camera, scene, bg, Tile::frame(self.width, self.height));
+    }
+
+    /// Writes the frame uniform for `camera` and the screen tile `tile`.
+    fn set_uniform(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3], tile: Tile) {
         let uniform = FrameUniform {
             view_proj: camera.matrix_f32().to_cols_array_2d(),
             background: [bg[0], bg[1], bg[2], 0.0],
             size: [self.width, self.height],
             triangle_count: scene.transparent.triangles,
             seed: 0,
+            tile_origin: [tile.x, tile.y],
+            tile_size: [tile.width, tile.height],
         };
         self.gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
     }

@@ -75,7 +75,7 @@ impl Targets {
         let depth_texture = texture(d, "depth", width, height, DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
         let out_texture =
             texture(d, "out", width, height, COLOR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST);
-        let bound_texture = texture(d, "error bound", width, height, BOUND_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
+        let bound_texture = texture(d, "error bound", width, height, BOUND_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC | U::COPY_DST);
         let bound = bound_texture.create_view(&Default::default());
         let base = base_texture.create_view(&Default::default());
         let depth = depth_texture.create_view(&Default::default());

@@ -176,6 +176,9 @@ fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, 
     d.set_item("wall_time_ms", s.wall_time_ms)?;
     d.set_item("antialias", s.antialias)?;
     d.set_item("antialias_mode", s.antialias_mode.name())?;
+    d.set_item("tiles", s.tiles)?;
+    d.set_item("geometry_chunks", s.geometry_chunks)?;
+    d.set_item("peak_memory_bytes", s.peak_memory_bytes)?;
     let extra = PyDict::new(py);
     for (k, v) in &s.extra {
         extra.set_item(*k, v)?;
@@ -187,8 +190,15 @@ fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, 
 #[pymethods]
 impl Renderer {
     #[new]
-    #[pyo3(signature = (width, height, adapter=None, max_binding_bytes=None))]
-    fn new(py: Python<'_>, width: i64, height: i64, adapter: Option<String>, max_binding_bytes: Option<i64>) -> Res<Self> {
+    #[pyo3(signature = (width, height, adapter=None, max_binding_bytes=None, memory_budget=None))]
+    fn new(
+        py: Python<'_>,
+        width: i64,
+        height: i64,
+        adapter: Option<String>,
+        max_binding_bytes: Option<i64>,
+        memory_budget: Option<i64>,
+    ) -> Res<Self> {
         if width <= 0 || height <= 0 || width > u32::MAX as i64 || height > u32::MAX as i64 {
             return Err(OitError::InvalidInput(format!("width and height must be positive integers, got {width} x {height}")).into());
         }
@@ -199,6 +209,10 @@ impl Renderer {
             if let Some(b) = max_binding_bytes {
                 let b = u64::try_from(b).map_err(|_| OitError::InvalidInput(format!("max_binding_bytes must be positive, got {b}")))?;
                 inner.set_max_binding_bytes(b)?;
+            }
+            if let Some(b) = memory_budget {
+                let b = u64::try_from(b).map_err(|_| OitError::InvalidInput(format!("memory_budget must be positive, got {b}")))?;
+                inner.set_memory_budget(Some(b))?;
             }
             Ok(Self { inner: Mutex::new(inner), context })
         })
@@ -285,6 +299,14 @@ fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         memory.set_item("formula", m.memory.formula())?;
         d.set_item("memory", memory)?;
         d.set_item("error_bound", m.error_bound.name())?;
+        let tiling = PyDict::new(py);
+        tiling.set_item("kind", m.tiling.name())?;
+        if let oit_core::Tiling::Storage { per_pixel, per_fragment, per_triangle } = m.tiling {
+            tiling.set_item("per_pixel", per_pixel)?;
+            tiling.set_item("per_fragment", per_fragment)?;
+            tiling.set_item("per_triangle", per_triangle)?;
+        }
+        d.set_item("tiling", tiling)?;
         let params = PyList::empty(py);
         for p in m.params {
             let pd = PyDict::new(py);

@@ -2,7 +2,7 @@
 //! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
 use super::frame::{FrameCtx, Limits, Method, MethodReport};
-use super::info::{AntialiasMode, ErrorBound, Memory, MethodInfo, Order};
+use super::info::{AntialiasMode, ErrorBound, Memory, MethodInfo, Order, Tiling};
 use super::lists::{check_sweep_budget, state_words, Aux, ListLayout, ListMethod, STATE_WORDS};
 use crate::context::GpuContext;
 use crate::error::Result;
@@ -20,6 +20,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: &[AntialiasMode::Frames, AntialiasMode::Coverage],
     memory: Memory::Scene { formula: "24 B/fragment + 52 B/pixel (the node pool grows with the scene)" },
     error_bound: ErrorBound::Exact,
+    tiling: Tiling::Storage { per_pixel: 52, per_fragment: 24, per_triangle: 0 },
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 

@@ -9,7 +9,7 @@
 //! predicted to meet t, the A-buffer is rendered directly.
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::ktab::{KTab, Slots};
 use super::params::{ParamInfo, ParamKind, Params};
 use crate::cache::ShaderKey;
@@ -42,6 +42,7 @@ pub const INFO: MethodInfo = MethodInfo {
         bytes: memory_bytes,
     },
     error_bound: ErrorBound::PerPixel,
+    tiling: Tiling::Storage { per_pixel: 96, per_fragment: 24, per_triangle: 0 },
     create: |gpu, limits| Box::new(Auto::new(gpu, limits)),
 };
 
@@ -178,8 +179,8 @@ fn widen(slots: &[u32], counts: &[u32], bound: &[f32], tolerance: f64) -> Option
 impl Method for Auto {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let tolerance = cx.params.float("tolerance");
-        let t = cx.targets;
-        let pixels = t.width as u64 * t.height as u64;
+        let (t, tile) = (cx.targets, cx.tile);
+        let pixels = cx.pixels();
         let counts = cx.depth_complexity;
         let sums = self.measure(cx)?;
         let predicted = choose_slots(counts, &sums, tolerance);
@@ -191,7 +192,7 @@ impl Method for Auto {
         while let Some(current) = slots.take() {
             attempts += 1;
             let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current))?;
-            let bound = read_rows(cx.gpu, &t.bound_texture, &t.bound_readback, 4)?;
+            let bound = tile.crop(&read_rows(cx.gpu, &t.bound_texture, &t.bound_readback, 4)?, t.width);
             let worst = bound.iter().copied().fold(0.0f32, f32::max) as f64;
             hybrid_bytes = report.memory_bytes;
             if worst <= tolerance {
@@ -215,24 +216,19 @@ impl Method for Auto {
         let mut report = self.exact.render(&mut cx.with_params(&Params::default()))?;
         // Exact up to float32 compositing: (n + 2) roundings of at most 2^-24 each, doubled.
         let rounding = (cx.max_depth_complexity as f64 + 2.0) * ROUNDING;
-        let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("auto bound"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &cx.targets.bound,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r: rounding, g: 0.0, b: 0.0, a: 0.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        cx.gpu.queue.submit([enc.finish()]);
+        // The tile's bound, written from here (the exact resolve writes none).
+        let fill = vec![rounding as f32; tile.pixels() as usize];
+        cx.gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &t.bound_texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: tile.x, y: tile.y, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&fill),
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * tile.width), rows_per_image: None },
+            wgpu::Extent3d { width: tile.width, height: tile.height, depth_or_array_layers: 1 },
+        );
         report.error_bound = true;
         report.memory_bytes += pixels * WORDS * 4 + hybrid_bytes;
         report.extra.extend([

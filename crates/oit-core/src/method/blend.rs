@@ -2,7 +2,7 @@
 //! submission order or per mesh back to front by centroid (docs/methods.md).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use crate::bindings::COLOR_FORMAT;
 use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
@@ -21,6 +21,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(Blend { kind: Kind::Unsorted }),
 };
 
@@ -36,6 +37,7 @@ pub const SORTED: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(Blend { kind: Kind::Sorted }),
 };
 
@@ -51,6 +53,7 @@ pub const ADDITIVE: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(Blend { kind: Kind::Additive }),
 };
 
@@ -66,6 +69,7 @@ pub const FILTER: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(Blend { kind: Kind::Filter }),
 };
 
@@ -133,12 +137,9 @@ impl Method for Blend {
         {
             let mut pass = passes::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.timer.render_pass("blend"));
             pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &geo.group, &[]);
             for i in order {
                 let m = geo.meshes[i];
-                if m.triangles > 0 {
-                    pass.draw(3 * m.first_triangle..3 * (m.first_triangle + m.triangles), 0..1);
-                }
+                geo.draw_range(&mut pass, m.first_triangle, m.triangles);
             }
         }
         cx.gpu.queue.submit([enc.finish()]);

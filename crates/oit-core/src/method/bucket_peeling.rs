@@ -3,7 +3,7 @@
 //! kept, the others dropped and counted (shaders/bucket_peeling.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
@@ -22,6 +22,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·(8 + 24·buckets) + 4", bytes: |px, p| memory_bytes(px, p.int("buckets") as u64) },
     error_bound: ErrorBound::None,
+    tiling: Tiling::Formula,
     create: |_, _| Box::new(Buckets { buffers: None, dropped: None }),
 };
 

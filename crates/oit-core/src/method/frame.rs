@@ -10,6 +10,7 @@ use crate::passes;
 use crate::pipeline;
 use crate::scene::Camera;
 use crate::targets::{SampleTargets, Targets};
+use crate::tiles::Tile;
 use crate::timer::PassTimer;
 use crate::upload::GpuScene;
 
@@ -29,11 +30,14 @@ pub(crate) struct FrameCtx<'a> {
     pub targets: &'a Targets,
     pub timer: &'a mut PassTimer,
     pub params: &'a Params,
-    /// Transparent fragments per pixel (row-major), from this frame's census.
+    /// The screen tile this render covers (the whole frame unless the renderer tiles): the
+    /// method's per-pixel storage is for its pixels, and its passes are scissored to it.
+    pub tile: Tile,
+    /// Transparent fragments per pixel of the tile (row-major), from this frame's census.
     pub depth_complexity: &'a [u32],
-    /// Largest transparent fragment count of a pixel, from this frame's census.
+    /// Largest transparent fragment count of a pixel of the tile, from the census.
     pub max_depth_complexity: u32,
-    /// Transparent fragments of the frame, from the census.
+    /// Transparent fragments of the tile, from the census.
     pub fragments: u64,
     /// The frame uniform (`gpu_types::FrameUniform`), for methods that set its `seed`.
     pub frame_uniform: &'a wgpu::Buffer,
@@ -59,7 +63,7 @@ impl<'a> FrameCtx<'a> {
 
 impl<'a> FrameCtx<'a> {
     pub fn pixels(&self) -> u64 {
-        self.targets.width as u64 * self.targets.height as u64
+        self.tile.pixels()
     }
 
     /// The layout of group 1 in this frame: the opaque targets, or their per-sample layers.
@@ -124,7 +128,7 @@ impl<'a> FrameCtx<'a> {
     /// with the frame's targets at group 1 and `own` at group 2.
     pub fn capture(&mut self, enc: &mut wgpu::CommandEncoder, label: &'static str, pipeline: &wgpu::RenderPipeline, own: &wgpu::BindGroup) {
         let (depth, targets, scene) = (self.raster_depth(), self.targets_group(), self.scene);
-        capture_pass(enc, label, depth, targets, scene, self.timer.render_pass(label), pipeline, own);
+        capture_pass(enc, label, depth, targets, scene, self.tile, self.timer.render_pass(label), pipeline, own);
     }
 
     /// [`FrameCtx::capture`] inside a span the caller times (per-layer passes).
@@ -135,13 +139,13 @@ impl<'a> FrameCtx<'a> {
         pipeline: &wgpu::RenderPipeline,
         own: &wgpu::BindGroup,
     ) {
-        capture_pass(enc, label, self.raster_depth(), self.targets_group(), self.scene, None, pipeline, own);
+        capture_pass(enc, label, self.raster_depth(), self.targets_group(), self.scene, self.tile, None, pipeline, own);
     }
 
     /// Binds the shared groups, `own` and `pipeline` to `pass` and dispatches one invocation
     /// per pixel (8 x 8 workgroups).
     pub fn bind_dispatch(&self, pass: &mut wgpu::ComputePass<'_>, pipeline: &wgpu::ComputePipeline, own: &wgpu::BindGroup) {
-        per_pixel_dispatch(pass, self.scene, self.targets_group(), (self.targets.width, self.targets.height), pipeline, own);
+        per_pixel_dispatch(pass, self.scene, self.targets_group(), self.tile, pipeline, own);
     }
 
     /// Records a full-screen pass of `pipeline` into the output (and the error bound, with
@@ -154,15 +158,16 @@ impl<'a> FrameCtx<'a> {
         own: &wgpu::BindGroup,
         bound: bool,
     ) {
-        let (t, targets, scene) = (self.targets, self.targets_group(), self.scene);
+        let (t, targets, scene, tile) = (self.targets, self.targets_group(), self.scene, self.tile);
         let timestamps = self.timer.render_pass(label);
         let mut pass = if bound {
             passes::resolve_with_bound(enc, label, t, timestamps)
         } else {
             passes::resolve_pass(enc, label, &t.out, timestamps)
         };
+        tile.scissor(&mut pass);
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &scene.transparent.group, &[]);
+        pass.set_bind_group(0, scene.transparent.group(), &[]);
         pass.set_bind_group(1, targets, &[]);
         pass.set_bind_group(2, own, &[]);
         pass.draw(0..3, 0..1);
@@ -176,10 +181,10 @@ impl<'a> FrameCtx<'a> {
         pipeline: &wgpu::ComputePipeline,
         own: &wgpu::BindGroup,
     ) {
-        let (t, targets, scene) = (self.targets, self.targets_group(), self.scene);
+        let (tile, targets, scene) = (self.tile, self.targets_group(), self.scene);
         let timestamp_writes = self.timer.compute_pass(label);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
-        per_pixel_dispatch(&mut pass, scene, targets, (t.width, t.height), pipeline, own);
+        per_pixel_dispatch(&mut pass, scene, targets, tile, pipeline, own);
     }
 
     pub fn encoder(&self) -> wgpu::CommandEncoder {
@@ -198,11 +203,13 @@ fn capture_pass(
     depth: &wgpu::TextureView,
     targets: &wgpu::BindGroup,
     scene: &GpuScene,
+    tile: Tile,
     timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     pipeline: &wgpu::RenderPipeline,
     own: &wgpu::BindGroup,
 ) {
     let mut pass = passes::capture_pass(enc, label, depth, timestamps);
+    tile.scissor(&mut pass);
     pass.set_pipeline(pipeline);
     pass.set_bind_group(1, targets, &[]);
     pass.set_bind_group(2, own, &[]);
@@ -213,15 +220,15 @@ fn per_pixel_dispatch(
     pass: &mut wgpu::ComputePass<'_>,
     scene: &GpuScene,
     targets: &wgpu::BindGroup,
-    size: (u32, u32),
+    tile: Tile,
     pipeline: &wgpu::ComputePipeline,
     own: &wgpu::BindGroup,
 ) {
     pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, &scene.transparent.group, &[]);
+    pass.set_bind_group(0, scene.transparent.group(), &[]);
     pass.set_bind_group(1, targets, &[]);
     pass.set_bind_group(2, own, &[]);
-    pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+    pass.dispatch_workgroups(tile.width.div_ceil(8), tile.height.div_ceil(8), 1);
 }
 
 impl FrameCtx<'_> {
@@ -234,6 +241,7 @@ impl FrameCtx<'_> {
             targets: self.targets,
             timer: &mut *self.timer,
             params,
+            tile: self.tile,
             depth_complexity: self.depth_complexity,
             max_depth_complexity: self.max_depth_complexity,
             fragments: self.fragments,
@@ -243,10 +251,10 @@ impl FrameCtx<'_> {
         }
     }
 
-    /// Refuses a frame whose per-pixel buffer of `bytes_per_pixel` would pass one storage
-    /// binding, naming the largest frame that fits.
+    /// Refuses a tile whose per-pixel buffer of `bytes_per_pixel` would pass one storage
+    /// binding, naming the largest that fits.
     pub fn check_per_pixel(&self, what: &str, bytes_per_pixel: u64) -> Result<()> {
-        check_per_pixel(self.limits.max_binding_bytes, self.targets.width, self.targets.height, what, bytes_per_pixel)
+        check_per_pixel(self.limits.max_binding_bytes, self.tile.width, self.tile.height, what, bytes_per_pixel)
     }
 }
 
@@ -276,6 +284,9 @@ pub struct MethodReport {
     pub extra: Vec<(&'static str, f64)>,
     /// Whether the method wrote a per-pixel error bound into `targets.bound`.
     pub error_bound: bool,
+    /// The tile needed this many times the nodes its pool can hold: nothing was rendered, and
+    /// the renderer plans smaller tiles.
+    pub pool_short: Option<f64>,
 }
 
 pub(crate) trait Method: Send {

@@ -2,7 +2,7 @@
 //! discarded: the k-TAB engine (ktab.rs) with the `k` parameter.
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::ktab::{memory_bytes, KTab, Slots};
 use super::params::{ParamInfo, ParamKind};
 use crate::error::Result;
@@ -25,6 +25,7 @@ pub const HYBRID: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::PerPixel,
+    tiling: Tiling::Formula,
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
 };
 
@@ -40,6 +41,7 @@ pub const KTAB: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::PerPixel,
+    tiling: Tiling::Formula,
     create: |_, _| Box::new(Hybrid(KTab::new(false))),
 };
 

@@ -5,7 +5,7 @@
 //! One geometry pass and one full-screen resolve (shaders/hybrid64.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
@@ -28,6 +28,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·(8k + 36) + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) },
     error_bound: ErrorBound::PerPixel,
+    tiling: Tiling::Formula,
     create: |_, _| Box::new(Hybrid64 { buffers: None, tail: None }),
 };
 
@@ -69,6 +70,7 @@ impl Method for Hybrid64 {
             overflow_fragments: tail,
             extra: vec![("tail_fragments", tail as f64)],
             error_bound: true,
+            ..Default::default()
         })
     }
 }

@@ -29,6 +29,8 @@ pub struct MethodInfo {
     pub memory: Memory,
     /// What bounds its error against the exact composite.
     pub error_bound: ErrorBound,
+    /// How a frame too large for its bindings or the memory budget is split into screen tiles.
+    pub tiling: Tiling,
     pub(crate) create: fn(&GpuContext, &Limits) -> Box<dyn Method>,
 }
 
@@ -106,6 +108,30 @@ impl Memory {
             Memory::Frame { .. } => "frame",
             Memory::Scene { .. } => "scene",
             Memory::Slots { .. } => "slots",
+        }
+    }
+}
+
+/// How the renderer plans a method's screen tiles (tiles.rs, docs/methods.md "Tiles").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tiling {
+    /// By its memory formula (`Memory::Frame`): bytes grow with the tile's pixels.
+    Formula,
+    /// From the census: `per_pixel` bytes a pixel and `per_fragment` bytes a stored fragment
+    /// (a node of its pool), the pool spread over `lists::POOL_BINDINGS` bindings, and
+    /// `per_triangle` bytes of each transparent triangle, whatever the tile.
+    Storage { per_pixel: u64, per_fragment: u64, per_triangle: u64 },
+    /// In one piece: it keeps nothing per pixel, or keeps it in render targets, which are not
+    /// bound as storage (their bytes still count against a memory budget).
+    Whole,
+}
+
+impl Tiling {
+    pub fn name(self) -> &'static str {
+        match self {
+            Tiling::Formula => "formula",
+            Tiling::Storage { .. } => "census",
+            Tiling::Whole => "whole",
         }
     }
 }

@@ -111,6 +111,7 @@ impl KTab {
             overflow_fragments: overflow,
             extra: vec![("tail_fragments", overflow as f64)],
             error_bound: true,
+            ..Default::default()
         })
     }
 }

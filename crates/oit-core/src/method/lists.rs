@@ -97,7 +97,9 @@ impl NodePool {
 
     /// Makes room for `nodes` nodes, `pixels` heads and `triangles` per-triangle records,
     /// reallocating only when needed.
-    pub fn reserve(&mut self, gpu: &GpuContext, nodes: u64, pixels: u64, triangles: u64) -> Result<()> {
+    /// With `exact`, the pool is made exactly `nodes` large (a tile of a budgeted frame);
+    /// otherwise it keeps a larger capacity unless less than a quarter would be used.
+    pub fn reserve(&mut self, gpu: &GpuContext, nodes: u64, pixels: u64, triangles: u64, exact: bool) -> Result<()> {
         if nodes > self.max_nodes() {
             return Err(OitError::OutOfMemory(format!(
                 "the frame has {nodes} transparent fragments but the node pool holds at most {} on this adapter \
@@ -133,7 +135,7 @@ impl NodePool {
             changed = true;
         }
         // Grow to what was counted; shrink when less than a quarter is used.
-        if nodes > self.capacity || nodes < self.capacity / 4 {
+        if nodes > self.capacity || nodes < self.capacity / 4 || (exact && nodes.max(1) != self.capacity) {
             self.capacity = nodes.max(1);
             self.pools = (0..POOL_BINDINGS)
                 .map(|b| {
@@ -280,17 +282,24 @@ impl ListMethod {
 
     pub fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let p = self.pipelines(cx);
-        let t = cx.targets;
-        let pixels = t.width as u64 * t.height as u64;
+        let tile = cx.tile;
+        let pixels = cx.pixels();
         cx.check_per_pixel(
             &format!("{} (its per-pixel heads and sweep state)", self.shader.trim_end_matches(".wgsl")),
             4 * self.pool.state_words.max(1),
         )?;
-        let initial = if self.pool.capacity == 0 { pixels.min(self.pool.max_nodes()) } else { self.pool.capacity };
+        // A tile of a larger frame gets a pool of its counted fragments, so that tiles planned
+        // within a memory budget stay in it; a whole frame keeps the pool it has while it fits.
+        let tiled = tile != crate::tiles::Tile::frame(cx.targets.width, cx.targets.height);
+        let initial = match (tiled, self.pool.capacity) {
+            (true, _) => cx.fragments.clamp(1, self.pool.max_nodes()),
+            (false, 0) => pixels.min(self.pool.max_nodes()),
+            (false, c) => c,
+        };
         // A list of n fragments takes floor(n / BATCH) + 1 sweeps (the last one finds it empty).
         let sweeps = cx.max_depth_complexity / BATCH + 1;
         let triangles = cx.scene.transparent.triangles as u64;
-        self.pool.reserve(cx.gpu, initial, pixels, triangles)?;
+        self.pool.reserve(cx.gpu, initial, pixels, triangles, tiled)?;
         if self.aux == Aux::PixelOffsets && self.scan.as_ref().is_none_or(|(p, _)| *p != pixels) {
             self.scan = Some((pixels, Scan::new(cx.gpu, &self.pool.aux, pixels + 1)));
         }
@@ -307,11 +316,14 @@ impl ListMethod {
                     timestamp_writes: cx.timer.compute_pass("allocate"),
                 });
                 pass.set_pipeline(allocate);
-                pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
                 pass.set_bind_group(1, targets_group, &[]);
                 pass.set_bind_group(2, group, &[]);
-                let groups = (triangles as u32).div_ceil(64);
-                pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+                // One invocation a triangle, chunk after chunk (shaders/common/setup.wgsl).
+                for chunk in &cx.scene.transparent.chunks {
+                    pass.set_bind_group(0, &chunk.group, &[]);
+                    let groups = chunk.triangles.div_ceil(64);
+                    pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+                }
             }
             if let (Some(count), Some((_, scan))) = (&p.count, &self.scan) {
                 self.count_and_scan(cx, &mut enc, count, scan, pixels);
@@ -324,11 +336,11 @@ impl ListMethod {
                     timestamp_writes: cx.timer.compute_pass("sweeps"),
                 });
                 pass.set_pipeline(sweep);
-                pass.set_bind_group(0, &cx.scene.transparent.group, &[]);
+                pass.set_bind_group(0, cx.scene.transparent.group(), &[]);
                 pass.set_bind_group(1, targets_group, &[]);
                 pass.set_bind_group(2, group, &[]);
                 for _ in 0..sweeps {
-                    pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+                    pass.dispatch_workgroups(tile.width.div_ceil(8), tile.height.div_ceil(8), 1);
                 }
             }
             cx.resolve(&mut enc, "resolve", &p.resolve, group, false);
@@ -346,7 +358,7 @@ impl ListMethod {
                 let memory = self.pool.bytes() + self.scan.as_ref().map_or(0, |(_, s)| s.bytes);
                 // Shrink for the next frame when this one used little of the pool.
                 if count < self.pool.capacity / 4 {
-                    self.pool.reserve(cx.gpu, count, pixels, triangles)?;
+                    self.pool.reserve(cx.gpu, count, pixels, triangles, tiled)?;
                 }
                 let extra = vec![
                     ("pool_regrown", regrown),
@@ -355,7 +367,12 @@ impl ListMethod {
                 ];
                 return Ok(MethodReport { memory_bytes: memory, extra, ..Default::default() });
             }
-            self.pool.reserve(cx.gpu, count, pixels, triangles)?;
+            if count > self.pool.max_nodes() && cx.tile.pixels() > 1 {
+                // More nodes than the census planned for (pall's bounding boxes): the renderer
+                // plans smaller tiles. A single pixel past the pool is refused by reserve.
+                return Ok(MethodReport { pool_short: Some(count as f64 / self.pool.max_nodes() as f64), ..Default::default() });
+            }
+            self.pool.reserve(cx.gpu, count, pixels, triangles, tiled)?;
             regrown += 1.0;
         }
     }

@@ -3,7 +3,7 @@
 //! the lists, unbounded (shaders/mlab.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::lists::check_replay_budget;
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::params::{ParamInfo, ParamKind};
@@ -23,6 +23,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Scene { formula: "32 B/fragment + 4 B/pixel (grows with the scene)" },
     error_bound: ErrorBound::None,
+    tiling: Tiling::Storage { per_pixel: 4, per_fragment: 32, per_triangle: 0 },
     create: |gpu, limits| {
         Box::new(Mlab(ListMethod::new(
             gpu,

@@ -4,7 +4,7 @@
 //! block without a global atomic. Resolved exactly like `abuffer` (shaders/pall.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::lists::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
 use crate::error::Result;
@@ -22,6 +22,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Scene { formula: "24 B/node of the triangles' bounds + 52 B/pixel + 16 B/triangle" },
     error_bound: ErrorBound::Exact,
+    tiling: Tiling::Storage { per_pixel: 52, per_fragment: 24, per_triangle: 16 },
     create: |gpu, limits| {
         Box::new(Pall(ListMethod::new(
             gpu,

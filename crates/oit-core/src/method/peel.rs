@@ -4,7 +4,7 @@
 //! (shaders/peel.wgsl, docs/methods.md).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
@@ -29,6 +29,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::Exact,
+    tiling: Tiling::Formula,
     create: |_, _| Box::new(Peel { dual: false, buffers: None, peeled: None }),
 };
 
@@ -44,6 +45,7 @@ pub const DUAL_DEPTH_PEELING: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::Exact,
+    tiling: Tiling::Formula,
     create: |_, _| Box::new(Peel { dual: true, buffers: None, peeled: None }),
 };
 

@@ -4,7 +4,7 @@
 //! The pool holds exactly the counted fragments (shaders/sbuffer.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::lists::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
 use crate::error::Result;
@@ -22,6 +22,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Scene { formula: "24 B/fragment + 56 B/pixel + scan sums" },
     error_bound: ErrorBound::Exact,
+    tiling: Tiling::Storage { per_pixel: 60, per_fragment: 24, per_triangle: 0 },
     create: |gpu, limits| {
         Box::new(SBuffer(ListMethod::new(
             gpu,

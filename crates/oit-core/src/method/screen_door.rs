@@ -3,7 +3,7 @@
 //! opaque (shaders/screen_door.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
@@ -22,6 +22,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·4", bytes: |px, _| memory_bytes(px) },
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(ScreenDoor { depth: None }),
 };
 

@@ -4,7 +4,7 @@
 
 use super::accum::{accumulation_targets, AccumTargets, Aux};
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
@@ -36,6 +36,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·(4·samples + 20)", bytes: |px, p| memory_bytes(px, p.int("samples") as u64) },
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(Stochastic { samples: None, targets: None }),
 };
 

@@ -3,7 +3,7 @@
 
 use super::accum::{accumulation_targets, memory_bytes, AccumTargets, Aux};
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
@@ -29,6 +29,7 @@ pub const WSUM: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(Weighted::new(Kind::Sum)),
 };
 
@@ -44,6 +45,7 @@ pub const WAVG: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(Weighted::new(Kind::Average)),
 };
 
@@ -66,6 +68,7 @@ pub const WBOIT: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::None,
+    tiling: Tiling::Whole,
     create: |_, _| Box::new(Weighted::new(Kind::Blended)),
 };
 

@@ -1,0 +1,160 @@
+//! Screen tiles: a frame whose method storage would pass a storage binding or the memory budget
+//! is rendered as several tiles of the same projection, each pass scissored to its tile and the
+//! method's per-pixel storage indexed within it (shaders/common/scene.wgsl, `pixel_index`), so a
+//! tile rasterizes exactly the fragments it has in the whole frame. Tiles are planned from the
+//! census: bands of whole rows while they fit, a row cut into runs of pixels where one row does
+//! not (docs/methods.md, "Tiles").
+
+use crate::error::{OitError, Result};
+
+/// A rectangle of pixels: columns x .. x + width, rows y .. y + height.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tile {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Tile {
+    pub fn frame(width: u32, height: u32) -> Self {
+        Self { x: 0, y: 0, width, height }
+    }
+
+    pub fn pixels(&self) -> u64 {
+        self.width as u64 * self.height as u64
+    }
+
+    /// Restricts `pass` to the tile.
+    pub fn scissor(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_scissor_rect(self.x, self.y, self.width, self.height);
+    }
+
+    /// The values of `frame` (row-major, `frame_width` a row) that lie in the tile, row-major.
+    pub fn crop<T: Copy>(&self, frame: &[T], frame_width: u32) -> Vec<T> {
+        let (w, x) = (frame_width as usize, self.x as usize);
+        (self.y as usize..(self.y + self.height) as usize)
+            .flat_map(|r| frame[r * w + x..r * w + x + self.width as usize].iter().copied())
+            .collect()
+    }
+}
+
+/// What one tile may hold: `per_pixel` bytes for each of its pixels and `per_fragment` bytes for
+/// each of its fragments, at most `budget` bytes in all, and at most `max_pixels` pixels and
+/// `max_fragments` fragments (what the method's bindings hold).
+#[derive(Clone, Copy, Debug)]
+pub struct Footprint {
+    pub per_pixel: u64,
+    pub per_fragment: u64,
+    pub budget: u64,
+    pub max_pixels: u64,
+    pub max_fragments: u64,
+}
+
+impl Footprint {
+    fn fits(&self, pixels: u64, fragments: u64) -> bool {
+        pixels <= self.max_pixels
+            && fragments <= self.max_fragments
+            && pixels.saturating_mul(self.per_pixel).saturating_add(fragments.saturating_mul(self.per_fragment)) <= self.budget
+    }
+}
+
+/// The tiles of a `width` x `height` frame whose pixels have `counts` fragments (row-major),
+/// each within `fp`: bands of whole rows, greedily as tall as fit; a row that does not fit alone
+/// is cut into runs of pixels. Fails only where one pixel alone does not fit.
+pub fn plan(width: u32, height: u32, counts: &[u32], fp: &Footprint) -> Result<Vec<Tile>> {
+    let row_fragments: Vec<u64> = counts.chunks(width as usize).map(|r| r.iter().map(|&c| c as u64).sum()).collect();
+    if fp.fits(width as u64 * height as u64, row_fragments.iter().sum()) {
+        return Ok(vec![Tile::frame(width, height)]);
+    }
+    let mut tiles = Vec::new();
+    let mut y = 0;
+    while y < height {
+        let (mut rows, mut fragments) = (0u32, 0u64);
+        while y + rows < height && fp.fits((rows as u64 + 1) * width as u64, fragments + row_fragments[(y + rows) as usize]) {
+            fragments += row_fragments[(y + rows) as usize];
+            rows += 1;
+        }
+        if rows > 0 {
+            tiles.push(Tile { x: 0, y, width, height: rows });
+            y += rows;
+            continue;
+        }
+        // One row does not fit: runs of pixels along it.
+        let row = &counts[(y * width) as usize..((y + 1) * width) as usize];
+        let mut x = 0;
+        while x < width {
+            let (mut n, mut fragments) = (0u32, 0u64);
+            while x + n < width && fp.fits(n as u64 + 1, fragments + row[(x + n) as usize] as u64) {
+                fragments += row[(x + n) as usize] as u64;
+                n += 1;
+            }
+            if n == 0 {
+                let c = row[x as usize] as u64;
+                return Err(OitError::OutOfMemory(format!(
+                    "pixel ({x}, {y}) has {c} transparent fragments, more than one tile can hold ({} bytes of storage, at most \
+                     {} fragments a tile on this adapter and budget): raise memory_budget or use a bounded method (e.g. hybrid)",
+                    fp.per_pixel + c * fp.per_fragment,
+                    fp.max_fragments.min(fp.budget.saturating_sub(fp.per_pixel) / fp.per_fragment.max(1))
+                )));
+            }
+            tiles.push(Tile { x, y, width: n, height: 1 });
+            x += n;
+        }
+        y += 1;
+    }
+    Ok(tiles)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fp(per_pixel: u64, per_fragment: u64, budget: u64) -> Footprint {
+        Footprint { per_pixel, per_fragment, budget, max_pixels: u64::MAX, max_fragments: u64::MAX }
+    }
+
+    fn covers_once(tiles: &[Tile], w: u32, h: u32) {
+        let mut seen = vec![0u8; (w * h) as usize];
+        for t in tiles {
+            for y in t.y..t.y + t.height {
+                for x in t.x..t.x + t.width {
+                    seen[(y * w + x) as usize] += 1;
+                }
+            }
+        }
+        assert!(seen.iter().all(|&s| s == 1), "{tiles:?}");
+    }
+
+    #[test]
+    fn one_tile_when_the_frame_fits() {
+        assert_eq!(plan(4, 3, &[1; 12], &fp(10, 10, 1000)).unwrap(), vec![Tile::frame(4, 3)]);
+    }
+
+    #[test]
+    fn bands_of_rows_then_runs_of_pixels() {
+        // 4 x 3, 10 bytes a pixel: two rows fit in 80 bytes, one row of 40 plus fragments may not.
+        let tiles = plan(4, 3, &[0; 12], &fp(10, 0, 80)).unwrap();
+        assert_eq!(tiles, vec![Tile { x: 0, y: 0, width: 4, height: 2 }, Tile { x: 0, y: 2, width: 4, height: 1 }]);
+        let counts = [0, 0, 0, 0, 9, 1, 1, 9, 0, 0, 0, 0];
+        let tiles = plan(4, 3, &counts, &fp(1, 10, 100)).unwrap();
+        covers_once(&tiles, 4, 3);
+        for t in &tiles {
+            let f: u64 = t.crop(&counts, 4).iter().map(|&c| c as u64).sum();
+            assert!(t.pixels() + 10 * f <= 100, "{t:?}");
+        }
+        assert!(tiles.iter().any(|t| t.height == 1 && t.width < 4));
+    }
+
+    #[test]
+    fn a_pixel_past_a_whole_tile_is_refused_by_name() {
+        let e = plan(2, 1, &[3, 500], &fp(1, 10, 1000)).unwrap_err().to_string();
+        assert!(e.contains("pixel (1, 0) has 500 transparent fragments"), "{e}");
+    }
+
+    #[test]
+    fn crop_takes_the_tile_row_major() {
+        let frame: Vec<u32> = (0..12).collect();
+        assert_eq!(Tile { x: 1, y: 1, width: 2, height: 2 }.crop(&frame, 4), vec![5, 6, 9, 10]);
+    }
+}
