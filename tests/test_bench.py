@@ -11,7 +11,7 @@ import pytest
 
 import oit
 from oit import cli, geometry, peers, plots, scenes
-from oit.bench import auto, harness, results, temporal
+from oit.bench import auto, harness, results, scale, temporal
 from oit.imageio import linear_to_srgb
 
 TINY = dict(scenes=["glass"], methods=["abuffer", "unsorted", "sorted", "hybrid", "wboit"], sizes=[32], repeat=1,
@@ -328,3 +328,98 @@ def test_auto_over_its_tolerance_is_flagged(monkeypatch, tmp_path, capsys):
     with open(tmp_path / "auto.csv") as f:
         (row,) = list(csv.DictReader(f))
     assert row["within_t"] == "False" and float(row["auto_max_abs"]) > 0.0627
+
+
+# ---- cost as the work grows (--scale)
+
+SCALE_TINY = dict(methods=["unsorted", "abuffer", "hybrid"], sizes=[(16, 16), (24, 16)], strands=[40, 80], layers=[2, 4],
+                  repeat=1, quick=True, show_progress=False)
+
+
+@pytest.fixture(scope="module")
+def scaled():
+    return scale.scale(**SCALE_TINY)
+
+
+def test_scale_rows_are_consistent(scaled, tmp_path):
+    rows = scaled.rows
+    per_strand = scale.HAIR_TRIANGLES_PER_STRAND
+    for sweep, xs in (("resolution", [256, 384]), ("triangles", [40 * per_strand, 80 * per_strand]), ("depth", [2, 4])):
+        mine = [r for r in rows if r["sweep"] == sweep]
+        assert sorted({r["x"] for r in mine}) == xs
+        for x in xs:  # every method at every point, abuffer (the reference) first
+            assert [r["method"] for r in mine if r["x"] == x] == ["abuffer", "unsorted", "hybrid"]
+    for r in rows:
+        assert r["status"] == "ok" and r["message"] == "", r
+        assert r["tiles"] >= 1 and r["chunks"] >= 1 and r["fragments"] > 0 and r["peak_mib"] >= r["memory_mib"] >= 0
+        assert r["wall_ms"] > 0 and (r["mean_err"] == 0 if r["method"] == "abuffer" else r["mean_err"] >= 0)
+        if r["sweep"] == "depth":
+            assert r["max_depth"] == r["x"] and r["size"] == "8x8"  # a stack of x layers in every pixel
+        elif r["sweep"] == "triangles":
+            assert r["triangles"] == r["x"]
+    assert {r["size"] for r in rows if r["sweep"] == "resolution"} == {"16x16", "24x16"}
+    fits = scale.slopes(rows)
+    assert [(f["sweep"], f["method"]) for f in fits] == [(s, m) for s in scale.SWEEPS for m in ("abuffer", "unsorted", "hybrid")]
+    for f in fits:
+        assert f["points"] == 2 and math.isfinite(f["slope"]) and math.isfinite(f["wall_slope"]), f
+    if plots.matplotlib_missing() is None:
+        paths = plots.write_scale(rows, fits, str(tmp_path))
+        assert [p.rsplit("/", 1)[1] for p in paths] == [f"scale-{s}.png" for s in scale.SWEEPS]
+        assert all((tmp_path / f"scale-{s}.png").stat().st_size > 0 for s in scale.SWEEPS)
+
+
+def test_scale_failed_and_skipped_methods(monkeypatch):
+    real_render, real_info = oit.Renderer.render, oit.Renderer.adapter_info
+
+    def render(self, scene, camera, method="abuffer", **kw):
+        if method == "hybrid" and len(scene_sizes) == 1:
+            raise MemoryError("hybrid needs 9 GiB\nsecond line")
+        return real_render(self, scene, camera, method, **kw)
+
+    scene_sizes = []  # the points seen so far: hybrid fails at the first only
+    real_stacks = scenes.stacks
+    monkeypatch.setattr(scenes, "stacks", lambda **kw: scene_sizes.append(kw) or real_stacks(**kw))
+    monkeypatch.setattr(oit.Renderer, "render", render)
+    info = {**real_info.fget(oit.Renderer(1, 1))}
+    info["methods"] = [m for m in info["methods"] if m != "hybrid64"]
+    monkeypatch.setattr(oit.Renderer, "adapter_info", property(lambda self: info))
+    result = scale.scale(["depth"], ["abuffer", "hybrid", "hybrid64"], layers=[2, 4, 8], repeat=1, quick=True,
+                         show_progress=False)
+    assert {r["method"] for r in result.rows} == {"abuffer", "hybrid"}
+    assert any("hybrid64 skipped" in n for n in result.notes)
+    failed = [r for r in result.rows if r["status"] != "ok"]
+    assert [(r["method"], r["x"], r["message"]) for r in failed] == [("hybrid", 2, "hybrid needs 9 GiB")]
+    assert math.isnan(failed[0]["gpu_ms"])
+    fits = {f["method"]: f for f in scale.slopes(result.rows)}
+    assert fits["hybrid"]["points"] == 2 and math.isfinite(fits["hybrid"]["slope"])
+    assert "failed: hybrid needs 9 GiB" in harness.markdown(result.rows, scale.SCALE_COLUMNS)
+
+
+def test_fit_slope_and_sizes():
+    xs = [10.0, 100.0, 1000.0]
+    assert scale.fit_slope(xs, [3 * x ** 2 for x in xs]) == pytest.approx(2.0)
+    assert scale.fit_slope(xs, [5.0, math.nan, 50.0]) == pytest.approx(0.5)  # failed points drop out
+    assert math.isnan(scale.fit_slope(xs, [5.0, math.nan, 0.0])) and math.isnan(scale.fit_slope([], []))
+    assert scale.parse_size("512") == (512, 512) and scale.parse_size("1920x1080") == (1920, 1080)
+    with pytest.raises(ValueError, match="WxH"):
+        scale.parse_size("big")
+    with pytest.raises(ValueError, match=r"unknown method.*hybird"):
+        scale.scale(methods=["hybird"], quick=True, show_progress=False)
+
+
+def test_cli_scale_writes_tables_and_no_plots(tmp_path):
+    out = tmp_path / "bench"
+    code = cli.main(["bench", "--scale", "--quick", "--no-plots", "--methods", "abuffer", "unsorted", "--scale-sweeps",
+                     "depth", "resolution", "--scale-sizes", "16", "24x16", "--scale-layers", "2", "4", "--out", str(out)])
+    assert code == 0
+    with open(out / "scale.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [(r["sweep"], r["size"], r["method"]) for r in rows] == [
+        (s, size, m) for s, size in (("resolution", "16x16"), ("resolution", "24x16"), ("depth", "8x8"), ("depth", "8x8"))
+        for m in ("abuffer", "unsorted")]
+    with open(out / "scale-slopes.csv") as f:
+        fits = list(csv.DictReader(f))
+    assert len(fits) == 4 and all(math.isfinite(float(f["slope"])) for f in fits)
+    table = (out / "scale.md").read_text()
+    assert table.startswith("Adapter: ") and "## Slopes" in table and "slope: the least-squares slope" in table
+    assert not list(out.glob("*.png"))

@@ -101,5 +101,5 @@ def test_no_module_imports_one_that_imports_it_back():
 def test_the_bench_harness_is_at_the_bottom():
     graph = import_graph()
     assert not {m for m in graph["oit.bench.harness"] if m.startswith("oit.bench")}
-    for experiment in ("results", "figure7", "temporal", "auto", "antialias"):
+    for experiment in ("results", "figure7", "temporal", "auto", "antialias", "scale"):
         assert {m for m in graph[f"oit.bench.{experiment}"] if m.startswith("oit.bench")} == {"oit.bench.harness"}, experiment

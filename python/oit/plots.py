@@ -1,7 +1,8 @@
 """Plots of a bench run (matplotlib, an optional dependency: `pip install matplotlib`):
 per scene and size, the speed-accuracy trade (mean error against GPU time, wall time and
 memory, with the Pareto front marked) and an image sheet (each method's picture above its
-error heatmap, beside the exact A-buffer)."""
+error heatmap, beside the exact A-buffer); the experiments' figures (temporal stability, and
+time against the work on log-log axes for --scale)."""
 
 from __future__ import annotations
 
@@ -198,3 +199,47 @@ def temporal(rows: list[dict], path: str, columns: int = 3) -> None:
     fig.tight_layout(rect=(0, 0, 1, 0.97))
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def scale(rows: list[dict], fits: list[dict], path: str, title: str) -> None:
+    """One sweep of oit.bench.scale on log-log axes: GPU time against the swept quantity (wall
+    time where no row has a GPU time: an adapter without timestamps), one line per method,
+    labeled with its fitted slope (`fits`, oit.bench.scale.slopes); failed points are left out."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    key = "gpu_ms" if any(0 < r["gpu_ms"] < math.inf for r in ok) else "wall_ms"
+    slope = {f["method"]: f["slope" if key == "gpu_ms" else "wall_slope"] for f in fits}
+    fig, ax = plt.subplots(figsize=(6.5, 4.8))
+    for method in dict.fromkeys(r["method"] for r in rows):
+        pts = sorted((r["x"], r[key]) for r in ok if r["method"] == method and 0 < r[key] < math.inf)
+        s = slope.get(method, math.nan)
+        label = f"{method} (slope {s:.2f})" if math.isfinite(s) else method
+        if pts:
+            ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", markersize=4, label=label)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(rows[0]["x_name"] if rows else "x")
+    ax.set_ylabel("GPU time (ms)" if key == "gpu_ms" else "wall time per frame (ms)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def write_scale(rows: list[dict], fits: list[dict], out: str) -> list[str]:
+    """scale-<sweep>.png in `out` for each sweep of oit.bench.scale's rows; returns the paths."""
+    paths = []
+    for sweep in dict.fromkeys(r["sweep"] for r in rows):
+        mine = [r for r in rows if r["sweep"] == sweep]
+        adapter = next((r["adapter"] for r in mine if r["adapter"]), "")
+        path = os.path.join(out, f"scale-{sweep}.png")
+        scale(mine, [f for f in fits if f["sweep"] == sweep], path,
+              f"{sweep} sweep ({mine[0]['scene']}): time against {mine[0]['x_name']}, on {adapter}")
+        paths.append(path)
+    return paths

@@ -1,5 +1,5 @@
 """The bench's command line (`python -m oit bench`, also `python -m oit.bench`): the main sweep
-(oit.bench.results) or, instead of it, the experiments (--temporal, --auto, --antialias), and
+(oit.bench.results) or, instead of it, the experiments (--temporal, --auto, --antialias, --scale), and
 the tables and plots they write into --out."""
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from .auto import AUTO_COLUMNS, AUTO_MAX_K, AUTO_TOLERANCES, auto_vs_fixed
 from .figure7 import figure7_table
 from .harness import QUICK_SIZE, write_tables
 from .results import COLUMNS, run
+from .scale import SCALE_METHODS, SWEEPS, parse_size, scale, write_scale
 from .temporal import TEMPORAL_COLUMNS, TEMPORAL_FRAMES, TEMPORAL_STEP_DEG, temporal
 
 
@@ -48,6 +49,25 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                          f"{', '.join(AA_METHODS)}) at --aa-samples samples a pixel against one (antialias.csv, .md)")
     ap.add_argument("--aa-samples", type=int, nargs="+", default=list(AA_SAMPLES),
                     help="--antialias: samples a pixel to measure (default: %(default)s; 1 is always added)")
+    ap.add_argument("--scale", action="store_true",
+                    help="instead of the method sweep: cost as the work grows (the hybrid paper's Figures 8 to 10), "
+                         f"{', '.join(SCALE_METHODS)} against frame size, triangles and layers (scale.csv, scale.md, "
+                         "scale-slopes.csv, scale-<sweep>.png)")
+    ap.add_argument("--scale-sweeps", nargs="+", default=list(SWEEPS), choices=SWEEPS,
+                    help="--scale: the sweeps to run (default: %(default)s)")
+    ap.add_argument("--scale-sizes", type=_size, nargs="+", default=None, metavar="N|WxH",
+                    help="--scale: frame sizes of the resolution sweep (default: 256 512 1024 1920x1080 3840x2160)")
+    ap.add_argument("--scale-strands", type=int, nargs="+", default=None,
+                    help="--scale: hair strands of the triangle sweep, 32 triangles each (default: 6000 25000 100000 400000)")
+    ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
+                    help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        return parse_size(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def _plots_missing(a: argparse.Namespace) -> bool:
@@ -64,7 +84,15 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
-    if a.temporal or a.auto or a.antialias:
+    if a.temporal or a.auto or a.antialias or a.scale:
+        if a.scale:
+            result = scale(a.scale_sweeps, a.methods, a.scale_sizes, a.scale_strands, a.scale_layers, repeat, a.quick)
+            fits = write_scale(a.out, result)
+            if not _plots_missing(a):
+                from .. import plots
+
+                for path in plots.write_scale(result.rows, fits, a.out):
+                    print(f"wrote {path}")
         if a.antialias:
             result = antialias(a.scenes, a.methods, a.sizes, tuple(a.aa_samples), repeat, a.quick)
             write_tables(a.out, "antialias", result, AA_COLUMNS)
