@@ -379,6 +379,7 @@ impl Renderer {
                     params,
                     tile: *tile,
                     max_depth_complexity: counts.iter().copied().max().unwrap_or(0),
+                    frame_max_depth_complexity: max_depth_complexity,
                     fragments: counts.iter().map(|&c| c as u64).sum(),
                     depth_complexity: &counts,
                     frame_uniform: &self.shared.uniform,

@@ -37,6 +37,8 @@ pub(crate) struct FrameCtx<'a> {
     pub depth_complexity: &'a [u32],
     /// Largest transparent fragment count of a pixel of the tile, from the census.
     pub max_depth_complexity: u32,
+    /// Largest of the whole frame: checks that refuse a frame do so at its first tile.
+    pub frame_max_depth_complexity: u32,
     /// Transparent fragments of the tile, from the census.
     pub fragments: u64,
     /// The frame uniform (`gpu_types::FrameUniform`), for methods that set its `seed`.
@@ -244,6 +246,7 @@ impl FrameCtx<'_> {
             tile: self.tile,
             depth_complexity: self.depth_complexity,
             max_depth_complexity: self.max_depth_complexity,
+            frame_max_depth_complexity: self.frame_max_depth_complexity,
             fragments: self.fragments,
             frame_uniform: self.frame_uniform,
             limits: self.limits,

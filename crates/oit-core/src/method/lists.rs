@@ -395,7 +395,7 @@ pub fn sweep_iterations(n: u64) -> u64 {
 
 /// Refuses a frame whose deepest pixel one sweep could not walk on llvmpipe.
 pub(crate) fn check_sweep_budget(cx: &FrameCtx<'_>) -> Result<()> {
-    let n = cx.max_depth_complexity as u64;
+    let n = cx.frame_max_depth_complexity as u64;
     if loop_limited(cx.gpu) && sweep_iterations(n) > LLVMPIPE_LOOP_LIMIT {
         return Err(OitError::Unsupported(format!(
             "a pixel has {n} transparent fragments; on llvmpipe one resolve sweep handles at most about {} \
@@ -411,7 +411,7 @@ pub(crate) fn check_sweep_budget(cx: &FrameCtx<'_>) -> Result<()> {
 /// method (adaptive, mlab) could not finish on llvmpipe: (n / BATCH + 1) heap sweeps of the
 /// list, then `per_fragment` loop iterations for each fragment.
 pub(crate) fn check_replay_budget(cx: &FrameCtx<'_>, method: &str, param: &str, value: u32, per_fragment: u64) -> Result<()> {
-    let n = cx.max_depth_complexity as u64;
+    let n = cx.frame_max_depth_complexity as u64;
     let iterations = (n / BATCH as u64 + 1) * n * 6 + n * per_fragment;
     if loop_limited(cx.gpu) && iterations > LLVMPIPE_LOOP_LIMIT {
         return Err(OitError::Unsupported(format!(
