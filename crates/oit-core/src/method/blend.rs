@@ -28,49 +28,28 @@ pub const UNSORTED: MethodInfo = MethodInfo {
 pub const SORTED: MethodInfo = MethodInfo {
     name: "sorted",
     summary: "per-mesh back-to-front sort by centroid, then over-blending (wrong for interpenetrating meshes)",
-    exact: false,
-    bounded_memory: true,
     passes: &["sort meshes (CPU)", "blend"],
-    params: &[],
-    features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Submission,
-    antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
-    error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
     create: |_, _| Box::new(Blend { kind: Kind::Sorted }),
+    ..UNSORTED
 };
 
 pub const ADDITIVE: MethodInfo = MethodInfo {
     name: "additive",
     summary: "additive blending (RTR 5.5): C = sum(alpha c) + background; brightens, never attenuates",
-    exact: false,
-    bounded_memory: true,
     passes: &["blend"],
-    params: &[],
-    features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Rounding,
-    antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
-    error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
     create: |_, _| Box::new(Blend { kind: Kind::Additive }),
+    ..UNSORTED
 };
 
 pub const FILTER: MethodInfo = MethodInfo {
     name: "filter",
     summary: "colored transmission (RTR 5.5): the scene behind multiplied by each surface's 1 - alpha (1 - c)",
-    exact: false,
-    bounded_memory: true,
     passes: &["blend"],
-    params: &[],
-    features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Rounding,
-    antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
-    error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
     create: |_, _| Box::new(Blend { kind: Kind::Filter }),
+    ..UNSORTED
 };
 
 #[derive(Clone, Copy, PartialEq)]

@@ -32,17 +32,9 @@ pub const HYBRID: MethodInfo = MethodInfo {
 pub const KTAB: MethodInfo = MethodInfo {
     name: "ktab",
     summary: "k-TAB: the k nearest fragments composited exactly, the others discarded (hybrid's core alone)",
-    exact: false,
-    bounded_memory: true,
     passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core (geometry)", "final composite (full screen)"],
-    params: &[K_PARAM],
-    features: wgpu::Features::empty(),
-    order: Order::Bitwise,
-    antialias_modes: FRAMES,
-    memory: MEMORY,
-    error_bound: ErrorBound::PerPixel,
-    tiling: Tiling::Formula,
     create: |_, _| Box::new(Hybrid(KTab::new(false))),
+    ..HYBRID
 };
 
 const MEMORY: Memory = Memory::Frame { formula: "W·H·(2k + 18)·4 + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) };

@@ -36,17 +36,9 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
 pub const DUAL_DEPTH_PEELING: MethodInfo = MethodInfo {
     name: "dual_depth_peeling",
     summary: "dual depth peeling (Bavoil & Myers 2008): nearest and farthest layers per pass, exact",
-    exact: true,
-    bounded_memory: true,
     passes: &["per two layers: peel (geometry) and composite (compute)", "resolve (full screen)"],
-    params: &[LAYERS],
-    features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
-    order: Order::BitwiseExceptTies,
-    antialias_modes: FRAMES,
-    memory: MEMORY,
-    error_bound: ErrorBound::Exact,
-    tiling: Tiling::Formula,
     create: |_, _| Box::new(Peel { dual: true, buffers: None, peeled: None }),
+    ..DEPTH_PEELING
 };
 
 /// Words of per-pixel accumulation.

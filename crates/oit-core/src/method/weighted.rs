@@ -36,17 +36,9 @@ pub const WSUM: MethodInfo = MethodInfo {
 pub const WAVG: MethodInfo = MethodInfo {
     name: "wavg",
     summary: "weighted average (Bavoil & Myers 2008): average color, transmittance (1 - mean alpha)^n",
-    exact: false,
-    bounded_memory: true,
-    passes: &["accumulate (geometry, blended)", "resolve (full screen)"],
     params: &[],
-    features: wgpu::Features::FLOAT32_BLENDABLE,
-    order: Order::Rounding,
-    antialias_modes: FRAMES,
-    memory: MEMORY,
-    error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
     create: |_, _| Box::new(Weighted::new(Kind::Average)),
+    ..WSUM
 };
 
 /// Weight functions of McGuire & Bavoil 2013 by equation number.
@@ -55,21 +47,13 @@ pub const WBOIT_WEIGHTS: &[&str] = &["eq10", "eq7", "eq8", "eq9"];
 pub const WBOIT: MethodInfo = MethodInfo {
     name: "wboit",
     summary: "weighted blended OIT (McGuire & Bavoil 2013): depth-weighted average, exact total coverage",
-    exact: false,
-    bounded_memory: true,
-    passes: &["accumulate (geometry, blended)", "resolve (full screen)"],
     params: &[ParamInfo {
         name: "weight",
         kind: ParamKind::Choice { choices: WBOIT_WEIGHTS, default: "eq10" },
         doc: "weight function (paper's eq. 7-10); eq7-9 use the view distance, eq10 the window depth",
     }],
-    features: wgpu::Features::FLOAT32_BLENDABLE,
-    order: Order::Rounding,
-    antialias_modes: FRAMES,
-    memory: MEMORY,
-    error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
     create: |_, _| Box::new(Weighted::new(Kind::Blended)),
+    ..WSUM
 };
 
 const MEMORY: Memory = Memory::Frame { formula: "W·H·20", bytes: |px, _| memory_bytes(px) };
