@@ -191,36 +191,65 @@ fn trace_frame(tris: &mut [Tri], bvh: Option<&Bvh2>, camera: &Camera, width: u32
     let mut ambiguous = vec![false; pixels];
     let mut complexity = vec![0u32; pixels];
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(height as usize);
-    let rows_per = (height as usize).div_ceil(threads);
+    // Bands of a few rows handed out one at a time: the deep middle of a frame does not leave
+    // one thread working alone.
+    const ROWS_PER_JOB: usize = 4;
+    let rows_done = std::sync::atomic::AtomicUsize::new(0);
+    let band = ROWS_PER_JOB * width as usize;
+    let jobs =
+        std::sync::Mutex::new(image.chunks_mut(4 * band).zip(ambiguous.chunks_mut(band)).zip(complexity.chunks_mut(band)).enumerate());
     std::thread::scope(|s| {
-        let chunks = image
-            .chunks_mut(rows_per * width as usize * 4)
-            .zip(ambiguous.chunks_mut(rows_per * width as usize))
-            .zip(complexity.chunks_mut(rows_per * width as usize));
-        for (i, ((img, amb), cx)) in chunks.enumerate() {
-            let inv = &inv;
-            s.spawn(move || {
-                let row0 = i * rows_per;
-                for (k, px) in amb.iter_mut().enumerate() {
-                    let (row, col) = (row0 + k / width as usize, k % width as usize);
-                    let (x, y) = ((col as f64 + 0.5) * 2.0 / wf - 1.0, 1.0 - (row as f64 + 0.5) * 2.0 / hf);
-                    let center = DVec2::new(col as f64 + 0.5, row as f64 + 0.5);
-                    let (o, end) = camera.unproject_segment(inv, x, y);
-                    let d = end - o;
-                    let mut hits: Vec<Hit> = Vec::new();
-                    let mut edge = false;
-                    if let Some(bvh) = bvh {
-                        trace(bvh, tris, o, d, center, &vp, &mut hits, &mut edge);
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                let (inv, rows_done, jobs) = (&inv, &rows_done, &jobs);
+                s.spawn(move || loop {
+                    let next = jobs.lock().unwrap_or_else(|p| p.into_inner()).next();
+                    let Some((i, ((img, amb), cx))) = next else { break };
+                    let row0 = i * ROWS_PER_JOB;
+                    for (k, px) in amb.iter_mut().enumerate() {
+                        let (row, col) = (row0 + k / width as usize, k % width as usize);
+                        let (x, y) = ((col as f64 + 0.5) * 2.0 / wf - 1.0, 1.0 - (row as f64 + 0.5) * 2.0 / hf);
+                        let center = DVec2::new(col as f64 + 0.5, row as f64 + 0.5);
+                        let (o, end) = camera.unproject_segment(inv, x, y);
+                        let d = end - o;
+                        let mut hits: Vec<Hit> = Vec::new();
+                        let mut edge = false;
+                        if let Some(bvh) = bvh {
+                            trace(bvh, tris, o, d, center, &vp, &mut hits, &mut edge);
+                        }
+                        let (rgba, n, tie) = composite(&mut hits, background);
+                        img[4 * k..4 * k + 4].copy_from_slice(&rgba);
+                        *px = edge || tie;
+                        cx[k] = n;
                     }
-                    let (rgba, n, tie) = composite(&mut hits, background);
-                    img[4 * k..4 * k + 4].copy_from_slice(&rgba);
-                    *px = edge || tie;
-                    cx[k] = n;
-                }
-            });
-        }
+                    rows_done.fetch_add(amb.len() / width as usize, std::sync::atomic::Ordering::Relaxed);
+                })
+            })
+            .collect();
+        report_progress(&workers, &rows_done, height as usize);
     });
     ReferenceImage { width, height, image, ambiguous, depth_complexity: complexity }
+}
+
+/// On a long run (past PROGRESS_AFTER), a line on stderr every PROGRESS_EVERY with the share of
+/// rows done, until the workers finish.
+fn report_progress<T>(workers: &[std::thread::ScopedJoinHandle<'_, T>], rows_done: &std::sync::atomic::AtomicUsize, rows: usize) {
+    const PROGRESS_AFTER: std::time::Duration = std::time::Duration::from_secs(5);
+    const PROGRESS_EVERY: std::time::Duration = std::time::Duration::from_secs(5);
+    let start = std::time::Instant::now();
+    let mut next = PROGRESS_AFTER;
+    while !workers.iter().all(|w| w.is_finished()) {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        if start.elapsed() >= next {
+            let done = rows_done.load(std::sync::atomic::Ordering::Relaxed);
+            eprintln!(
+                "oit reference: {done} of {rows} rows ({:.0} %), {:.0} s",
+                100.0 * done as f64 / rows as f64,
+                start.elapsed().as_secs_f64()
+            );
+            next += PROGRESS_EVERY;
+        }
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
