@@ -308,11 +308,9 @@ impl Renderer {
             stats.max_depth_complexity = stats.max_depth_complexity.max(s.max_depth_complexity);
             stats.memory_bytes = stats.memory_bytes.max(s.memory_bytes);
             stats.peak_memory_bytes = stats.peak_memory_bytes.max(s.peak_memory_bytes);
-            if i > 0 {
-                stats.tiles += s.tiles;
-            }
             stats.gpu_time_ms = stats.gpu_time_ms.zip(s.gpu_time_ms).map(|(a, b)| a + b);
             if i > 0 {
+                stats.tiles += s.tiles;
                 stats.pass_times_ms.extend(s.pass_times_ms);
             }
             stats.extra = s.extra;
@@ -367,7 +365,10 @@ impl Renderer {
             let mut report = MethodReport::default();
             let mut pass_times: Option<Vec<(&'static str, f64)>> = None;
             for tile in &tiles {
-                let counts = if tiles.len() == 1 { depth_complexity.clone() } else { tile.crop(&depth_complexity, self.width) };
+                let counts: std::borrow::Cow<[u32]> = match tiles.len() {
+                    1 => depth_complexity.as_slice().into(),
+                    _ => tile.crop(&depth_complexity, self.width).into(),
+                };
                 self.set_uniform(camera, gpu_scene, background, *tile);
                 self.timer.reset();
                 let mut cx = FrameCtx {

@@ -65,6 +65,8 @@ impl Counter {
 /// reallocated only when their sizes change.
 pub struct StorageGroup {
     sizes: Vec<u64>,
+    /// Bindings of the group: the buffers, then the counters.
+    bindings: u32,
     pub buffers: Vec<wgpu::Buffer>,
     pub group: wgpu::BindGroup,
 }
@@ -90,18 +92,14 @@ impl StorageGroup {
                 all.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
             let group =
                 d.create_bind_group(&wgpu::BindGroupDescriptor { label: buffers.first().map(|b| b.0), layout: &layout, entries: &entries });
-            *slot = Some(StorageGroup { sizes, buffers: made, group });
+            *slot = Some(StorageGroup { sizes, bindings: all.len() as u32, buffers: made, group });
         }
         slot.as_ref().expect("made above")
     }
 
-    /// The layout a pipeline over this group binds at group 2.
+    /// The layout a pipeline over this group binds at group 2 (its buffers and counters).
     pub fn layout(&self) -> Layout {
-        Layout::Storage(self.group_len())
-    }
-
-    fn group_len(&self) -> u32 {
-        self.buffers.len() as u32
+        Layout::Storage(self.bindings)
     }
 
     /// Records zeroing every buffer of the group (not the counters).

@@ -3,6 +3,7 @@
 
 use crate::bindings::{BOUND_FORMAT, COLOR_FORMAT, DEPTH_FORMAT};
 use crate::context::GpuContext;
+use crate::tiles::Tile;
 
 /// Bytes per row of a texture readback, padded to wgpu's 256-byte copy alignment.
 pub fn padded_row(width: u32, bytes_per_pixel: u32) -> u32 {
@@ -163,7 +164,7 @@ pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> crate:
     data
 }
 
-/// Reads a float texture back into a row-major Vec (row padding removed).
+/// A texture's pixels, row-major, as f32 (`bytes_per_pixel` / 4 values a pixel).
 pub fn read_rows(
     gpu: &GpuContext,
     texture: &wgpu::Texture,
@@ -171,21 +172,37 @@ pub fn read_rows(
     bytes_per_pixel: u32,
 ) -> crate::error::Result<Vec<f32>> {
     let size = texture.size();
-    let row = padded_row(size.width, bytes_per_pixel);
+    read_region(gpu, texture, readback, bytes_per_pixel, Tile::frame(size.width, size.height))
+}
+
+/// The pixels of `tile` of a texture, row-major within the tile, as f32.
+pub fn read_region(
+    gpu: &GpuContext,
+    texture: &wgpu::Texture,
+    readback: &wgpu::Buffer,
+    bytes_per_pixel: u32,
+    tile: Tile,
+) -> crate::error::Result<Vec<f32>> {
+    let row = padded_row(tile.width, bytes_per_pixel);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     enc.copy_texture_to_buffer(
-        texture.as_image_copy(),
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d { x: tile.x, y: tile.y, z: 0 },
+            aspect: wgpu::TextureAspect::All,
+        },
         wgpu::TexelCopyBufferInfo {
             buffer: readback,
             layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
         },
-        size,
+        wgpu::Extent3d { width: tile.width, height: tile.height, depth_or_array_layers: 1 },
     );
     gpu.queue.submit([enc.finish()]);
-    let raw = read_buffer(gpu, readback, row as u64 * size.height as u64)?;
-    let line = (size.width * bytes_per_pixel) as usize;
-    let mut out = Vec::with_capacity(line / 4 * size.height as usize);
-    for r in 0..size.height as usize {
+    let raw = read_buffer(gpu, readback, row as u64 * tile.height as u64)?;
+    let line = (tile.width * bytes_per_pixel) as usize;
+    let mut out = Vec::with_capacity(line / 4 * tile.height as usize);
+    for r in 0..tile.height as usize {
         out.extend(bytemuck::pod_collect_to_vec::<u8, f32>(&raw[r * row as usize..r * row as usize + line]));
     }
     Ok(out)

@@ -17,7 +17,7 @@ use crate::consts::{self, ALPHA_8BIT_ERROR, ROUNDING_TERM as ROUNDING};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::resources::{Readback, StorageGroup};
-use crate::targets::read_rows;
+use crate::targets::read_region;
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "auto",
@@ -192,7 +192,7 @@ impl Method for Auto {
         while let Some(current) = slots.take() {
             attempts += 1;
             let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current))?;
-            let bound = tile.crop(&read_rows(cx.gpu, &t.bound_texture, &t.bound_readback, 4)?, t.width);
+            let bound = read_region(cx.gpu, &t.bound_texture, &t.bound_readback, 4, tile)?;
             let worst = bound.iter().copied().fold(0.0f32, f32::max) as f64;
             hybrid_bytes = report.memory_bytes;
             if worst <= tolerance {

@@ -5,7 +5,7 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::ShaderKey;
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -46,7 +46,7 @@ impl Method for Buckets {
             [("bucket bounds", pixels * 8), ("bucket keys", pixels * buckets as u64 * 8), ("bucket colors", pixels * buckets as u64 * 16)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[dropped]);
         let shader = ShaderKey::new("bucket_peeling.wgsl", &[Const::U32("BUCKETS", buckets)]);
-        let own = Layout::Storage(4);
+        let own = b.layout();
         let mut enc = cx.encoder();
         b.clear(&mut enc);
         dropped.clear(&mut enc);

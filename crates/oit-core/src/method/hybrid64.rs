@@ -7,7 +7,7 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::ShaderKey;
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -54,7 +54,7 @@ impl Method for Hybrid64 {
         let sizes = [("hybrid64 k-TAB", pixels * k as u64 * 8), ("hybrid64 tail", pixels * ACCUM_WORDS * 4)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[tail]);
         let shader = ShaderKey::new("hybrid64.wgsl", &[Const::U32("K", k)]);
-        let own = Layout::Storage(3);
+        let own = b.layout();
         let insert = cx.capture_pipeline(&shader, "fs_insert", own);
         let resolve = cx.resolve_pipeline(&shader, "fs_resolve", own, true);
         let mut enc = cx.encoder();

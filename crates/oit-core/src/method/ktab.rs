@@ -4,7 +4,7 @@
 //! on fragment order (docs/methods.md, "hybrid"). Each pixel gets a uniform k or its own slots.
 
 use super::frame::{FrameCtx, MethodReport};
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::ShaderKey;
 use crate::error::{OitError, Result};
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -93,7 +93,7 @@ impl KTab {
         };
         let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", per_pixel as u32), Const::U32("TAIL", self.tail as u32)];
         let shader = ShaderKey::new("hybrid.wgsl", &consts);
-        let own = Layout::Storage(5);
+        let own = b.layout();
         let mut enc = cx.encoder();
         enc.clear_buffer(&b.buffers[0], 0, None);
         enc.clear_buffer(&b.buffers[2], 0, None);

@@ -6,7 +6,7 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::ShaderKey;
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -72,7 +72,7 @@ impl Method for Peel {
         // The first pass only finds; each later pass shades one layer (two when dual).
         let passes = if self.dual { layers.div_ceil(2) } else { layers } + 1;
         let shader = ShaderKey::new("peel.wgsl", &[Const::U32("DUAL", self.dual as u32)]);
-        let own = Layout::Storage(4);
+        let own = b.layout();
         let (init, composite) = (cx.compute_pipeline(&shader, "cs_init", own), cx.compute_pipeline(&shader, "cs_composite", own));
         let peel = cx.capture_pipeline(&shader, "fs_peel", own);
         let mut enc = cx.encoder();

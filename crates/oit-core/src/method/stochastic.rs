@@ -60,7 +60,7 @@ impl Method for Stochastic {
         // The accumulation targets are read only by the resolve, at bindings 1 and 2 of its group.
         let w = AccumTargets::ensure(&mut self.targets, cx, &[1, 2]);
         let shader = ShaderKey::new("stochastic.wgsl", &[Const::U32("SAMPLES", samples)]);
-        let own = Layout::Storage(1);
+        let own = b.layout();
         let depth = cx.capture_pipeline(&shader, "fs_depth", own);
         let groups = vec![Layout::Scene, Layout::Targets, own];
         let accumulate = cx.draw_pipeline(&shader, "fs_accum", groups, accumulation_targets(Aux::Reveal), pipeline::depth_test_only());
