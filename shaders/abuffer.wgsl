@@ -16,7 +16,7 @@ struct Node {
 
 @group(2) @binding(6) var<storage, read_write> state: array<u32>;
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_capture(in: VsOut) {
     if behind_opaque(in.clip) {
         return;

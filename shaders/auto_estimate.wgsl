@@ -15,7 +15,7 @@
 // Alpha quantization at 2^-24 per unit, rounded up.
 // TAU_CAP and the scales TAU_SCALE, TAU2_SCALE, QUANT_SCALE come from crates/oit-core/src/consts.rs.
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_estimate(in: VsOut) {
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;

@@ -29,7 +29,7 @@ fn bucket(px: u32, z: f32) -> u32 {
     return min(u32((z - lo) / (hi - lo) * f32(BUCKETS)), BUCKETS - 1u);
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_bounds(in: VsOut) {
     if behind_opaque(in.clip) {
         return;
@@ -40,7 +40,7 @@ fn fs_bounds(in: VsOut) {
     atomicMax(&bounds[2u * px + 1u], bits);
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_keys(in: VsOut) {
     if behind_opaque(in.clip) {
         return;
@@ -49,7 +49,7 @@ fn fs_keys(in: VsOut) {
     atomicMax(&keys[px * BUCKETS + bucket(px, in.clip.z)], frag_key(in.clip.z, in.prim));
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_shade(in: VsOut) {
     if behind_opaque(in.clip) {
         return;

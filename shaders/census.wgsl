@@ -5,7 +5,7 @@
 
 @group(2) @binding(0) var<storage, read_write> counts: array<atomic<u32>>;
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_census(in: VsOut) {
     if behind_opaque(in.clip) {
         return;

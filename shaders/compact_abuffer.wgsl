@@ -39,7 +39,7 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
     shading[chunk.first_triangle + t] = s;
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_capture(in: VsOut) {
     if behind_opaque(in.clip) {
         return;

@@ -3,8 +3,12 @@
 //                 sorted, by the single-pass atomic bubble (one atomicMax per slot).
 //   cs_visibility full screen: transmittance in front of each core slot (eq. 2).
 //   fs_shade      geometry pass 2: core fragments add C * v (eq. 3), the others the tail
-//                 sums C * alpha, alpha and their count (eqs. 5-6).
-//   fs_final      full screen: eqs. 7-11 over the opaque scene or background.
+//                 sums C * alpha, alpha and their count (eqs. 5-6), by fixed-point storage
+//                 atomics (tail = "exact": bit-identical under any order);
+//   fs_shade_blend  or by additive blending into float targets, as the paper does
+//                 (tail = "blend": faster, order-dependent in float rounding).
+//   fs_final      full screen: eqs. 7-11 over the opaque scene or background (fs_final_blend
+//                 reads the blended targets).
 // Keys, ties and error bounds: docs/methods.md ("hybrid").
 //!include common/scene.wgsl
 //!include common/targets.wgsl
@@ -52,7 +56,7 @@ fn key_alpha(key: u32) -> f32 {
     return f32((~key) & 0xffu) / 255.0;
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_store(in: VsOut) {
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
@@ -125,16 +129,21 @@ fn cs_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
     atomicStore(&accum[px * ACCUM_WORDS + T_CORE], bitcast<u32>(t));
 }
 
-@fragment
-fn fs_shade(in: VsOut) {
-    if behind_opaque(in.clip) || in.color.a <= 0.0 {
-        return;
-    }
-    let px = pixel_index(in.clip);
+// Where a fragment of pixel px with depth z and alpha a goes: the core, with the weight of its
+// color and its alpha's quantization error, or the tail.
+struct Placed {
+    core: bool,
+    // v * share: the weight of C in the core sum (eq. 3).
+    w: f32,
+    // The transmittance in front of its slot, and |alpha - its 8-bit alpha| (error bound).
+    vis: f32,
+    d: f32,
+}
+
+fn place(px: u32, z: f32, a: f32) -> Placed {
     let sl = slots(px);
     let base = sl.x;
-    let acc = px * ACCUM_WORDS;
-    let key = pack_key(in.clip.z, in.color.a);
+    let key = pack_key(z, a);
     if key >= core_bound(px) {
         // Core: the first slot holding this key (the table is sorted by descending key).
         var lo = 0u;
@@ -149,18 +158,30 @@ fn fs_shade(in: VsOut) {
         }
         if m > 0u {
             // m fragments share one quantized key: they share the visibility of their slots.
-            let a = in.color.a;
             let share = select((1.0 - pow(1.0 - a, f32(m))) / f32(m), a, m == 1u);
-            let w = vis[base + lo] * share;
-            // The 8-bit alpha of this key moved every transmittance behind it (error bound).
-            let d = abs(a - key_alpha(key));
-            add_fixed32(acc + QUANT_W, d * vis[base + lo]);
-            add_fixed32(acc + QUANT_D, d);
-            add_fixed32(acc + CORE_R, in.color.r * w);
-            add_fixed32(acc + CORE_R + 1u, in.color.g * w);
-            add_fixed32(acc + CORE_R + 2u, in.color.b * w);
-            return;
+            let v = vis[base + lo];
+            return Placed(true, v * share, v, abs(a - key_alpha(key)));
         }
+    }
+    return Placed(false, 0.0, 0.0, 0.0);
+}
+
+@fragment @early_depth_test(force)
+fn fs_shade(in: VsOut) {
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
+        return;
+    }
+    let px = pixel_index(in.clip);
+    let acc = px * ACCUM_WORDS;
+    let p = place(px, in.clip.z, in.color.a);
+    if p.core {
+        // The 8-bit alpha of this key moved every transmittance behind it (error bound).
+        add_fixed32(acc + QUANT_W, p.d * p.vis);
+        add_fixed32(acc + QUANT_D, p.d);
+        add_fixed32(acc + CORE_R, in.color.r * p.w);
+        add_fixed32(acc + CORE_R + 1u, in.color.g * p.w);
+        add_fixed32(acc + CORE_R + 2u, in.color.b * p.w);
+        return;
     }
     atomicAdd(&accum[acc + TAIL_COUNT], 1u);
     // The range of the tail's colors bounds what the estimate behind the core can be off by.
@@ -172,31 +193,88 @@ fn fs_shade(in: VsOut) {
     }
 }
 
-@fragment
-fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
+// The same sums by fixed-function blending (oit_core::method::ktab::blend_targets): added
+// (core color and tail count; tail C * alpha and alpha; the quantization terms) or kept by
+// max (the tail's largest channel, and 1 - its smallest).
+struct Shade {
+    @location(0) core: vec4<f32>,
+    @location(1) tail: vec4<f32>,
+    @location(2) quant: vec4<f32>,
+    @location(3) low: vec4<f32>,
+}
+
+@fragment @early_depth_test(force)
+fn fs_shade_blend(in: VsOut) -> Shade {
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
+        discard;
+    }
+    let p = place(pixel_index(in.clip), in.clip.z, in.color.a);
+    if p.core {
+        return Shade(vec4<f32>(in.color.rgb * p.w, 0.0), vec4<f32>(0.0), vec4<f32>(p.d * p.vis, p.d, 0.0, 0.0), vec4<f32>(0.0));
+    }
+    let c = clamp(in.color.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
+    let sums = select(vec4<f32>(0.0), vec4<f32>(in.color.rgb * in.color.a, in.color.a), TAIL != 0u);
+    let hi = max(c.r, max(c.g, c.b));
+    return Shade(vec4<f32>(0.0, 0.0, 0.0, 1.0), sums, vec4<f32>(0.0, 0.0, 0.0, hi), vec4<f32>(1.0 - min(c.r, min(c.g, c.b)), 0.0, 0.0, 0.0));
+}
+
+// Eq. 11 and the error bound, from the core color, the transmittance behind the core, the
+// tail (count fragments), the quantization sums, and the tail's color range [lo, hi].
+// `sums` bounds the rounding of the float sums of the blended tail (0 in fixed point).
+fn finish(pos: vec4<f32>, core: vec3<f32>, t_core: f32, count: u32, tail: Tail, quant: vec2<f32>, lo_hi: vec2<f32>, sums: f32) -> Final {
     let base = base_at(pos);
-    let acc = pixel_index(pos) * ACCUM_WORDS;
-    let core = vec3<f32>(read_fixed32(word(acc + CORE_R)), read_fixed32(word(acc + CORE_R + 1u)), read_fixed32(word(acc + CORE_R + 2u)));
-    let t_core = bitcast<f32>(word(acc + T_CORE));
-    let count = word(acc + TAIL_COUNT);
     if count > 0u {
         atomicAdd(&overflow, count);
-    }
-    var tail = Tail(vec3<f32>(0.0), 1.0);
-    if TAIL != 0u {
-        tail = resolve_tail(acc + TAIL_R, count);
     }
     let rgb = core + t_core * (tail.color + tail.trans * base.rgb); // eq. 11
     // Quantized core alphas: sum |d| T' plus the second-order D^2; whatever lies behind the
     // core (tail or, for ktab, nothing) and its estimate are both mixes of the tail colors and
     // the base, so they differ by at most T_core times the range of those values; float32
     // and fixed-point rounding of K + count terms.
-    let d = read_fixed32(word(acc + QUANT_D));
-    var bound = read_fixed32(word(acc + QUANT_W)) + d * d + f32(slots(pixel_index(pos)).y + count + 2u) * ROUNDING_TERM;
+    let d = quant.y;
+    var bound = quant.x + d * d + f32(slots(pixel_index(pos)).y + count + 2u) * ROUNDING_TERM + sums;
     if count > 0u {
-        let lo = min(bitcast<f32>(~word(acc + TAIL_LO)), min(base.r, min(base.g, base.b)));
-        let hi = max(bitcast<f32>(word(acc + TAIL_HI)), max(base.r, max(base.g, base.b)));
+        let lo = min(lo_hi.x, min(base.r, min(base.g, base.b)));
+        let hi = max(lo_hi.y, max(base.r, max(base.g, base.b)));
         bound += t_core * (hi - lo);
     }
     return Final(vec4<f32>(rgb, 1.0 - t_core * tail.trans * (1.0 - base.a)), bound);
+}
+
+@fragment
+fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
+    let acc = pixel_index(pos) * ACCUM_WORDS;
+    let core = vec3<f32>(read_fixed32(word(acc + CORE_R)), read_fixed32(word(acc + CORE_R + 1u)), read_fixed32(word(acc + CORE_R + 2u)));
+    let count = word(acc + TAIL_COUNT);
+    var tail = Tail(vec3<f32>(0.0), 1.0);
+    if TAIL != 0u {
+        tail = resolve_tail(acc + TAIL_R, count);
+    }
+    let quant = vec2<f32>(read_fixed32(word(acc + QUANT_W)), read_fixed32(word(acc + QUANT_D)));
+    let lo_hi = vec2<f32>(bitcast<f32>(~word(acc + TAIL_LO)), bitcast<f32>(word(acc + TAIL_HI)));
+    return finish(pos, core, bitcast<f32>(word(acc + T_CORE)), count, tail, quant, lo_hi, 0.0);
+}
+
+@group(3) @binding(0) var shade_core: texture_2d<f32>;
+@group(3) @binding(1) var shade_tail: texture_2d<f32>;
+@group(3) @binding(2) var shade_quant: texture_2d<f32>;
+@group(3) @binding(3) var shade_low: texture_2d<f32>;
+
+@fragment
+fn fs_final_blend(@builtin(position) pos: vec4<f32>) -> Final {
+    let at = vec2<i32>(pos.xy);
+    let core = textureLoad(shade_core, at, 0);
+    let sums = textureLoad(shade_tail, at, 0);
+    let quant = textureLoad(shade_quant, at, 0);
+    let count = u32(core.a);
+    var tail = Tail(vec3<f32>(0.0), 1.0);
+    if TAIL != 0u {
+        tail = tail_from_sums(sums.rgb, sums.a, count);
+    }
+    let lo_hi = vec2<f32>(1.0 - textureLoad(shade_low, at, 0).r, quant.a);
+    let t_core = bitcast<f32>(word(pixel_index(pos) * ACCUM_WORDS + T_CORE));
+    // Float sums of count terms in [0, 1] in any order: each within count * 2^-24 of its value
+    // relative to the sum; eqs. 7-10 move the tail by at most 3 such relative errors.
+    let rounding = 3.0 * f32(count) * 5.96e-8 * t_core;
+    return finish(pos, core.rgb, t_core, count, tail, quant.xy, lo_hi, rounding);
 }

@@ -43,7 +43,7 @@ fn add_tail(acc: u32, packed: u64) {
     add_tail_sums(acc + TAIL_R, c.rgb, c.a);
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_insert(in: VsOut) {
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;

@@ -46,7 +46,7 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
     blocks[chunk.first_triangle + t] = Block(start, lo.x | (lo.y << 16u), extent.x | (extent.y << 16u), 0u);
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_capture(in: VsOut) {
     if behind_opaque(in.clip) {
         return;

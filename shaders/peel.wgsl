@@ -54,7 +54,7 @@ fn cs_init(@builtin(global_invocation_id) gid: vec3<u32>) {
     acc[a + 7u] = 1.0;
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_peel(in: VsOut) {
     if behind_opaque(in.clip) {
         return;

@@ -6,7 +6,8 @@
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
-// Mirrors oit_core::gpu_types::PoolNode (the link is unused: ranges are contiguous).
+// Mirrors oit_core::gpu_types::PoolNode. Capture links each range's nodes in order, so that the
+// resolve sorts a range by relinking it like a list.
 struct Node {
     depth: f32,
     next: u32,
@@ -20,7 +21,7 @@ struct Node {
 // Counts, then (scanned in place) range starts; entry W * H is the total.
 @group(2) @binding(7) var<storage, read_write> offsets: array<atomic<u32>>;
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_count(in: VsOut) {
     if behind_opaque(in.clip) {
         return;
@@ -28,7 +29,7 @@ fn fs_count(in: VsOut) {
     atomicAdd(&offsets[pixel_index(in.clip)], 1u);
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_capture(in: VsOut) {
     if behind_opaque(in.clip) {
         return;
@@ -37,27 +38,18 @@ fn fs_capture(in: VsOut) {
     if i >= alloc.capacity {
         return; // the scan's total says how many; the host grows the pool
     }
-    store_node(i, Node(in.clip.z, 0u, in.color.rg, in.color.ba));
+    let end = atomicLoad(&offsets[pixel_index(in.clip) + 1u]);
+    store_node(i, Node(in.clip.z, select(0u, i + 2u, i + 1u < end), in.color.rg, in.color.ba));
 }
 
-struct Cursor {
-    at: u32,
-    end: u32,
+fn list_head(px: u32) -> u32 {
+    let start = atomicLoad(&offsets[px]);
+    return select(0u, start + 1u, start < atomicLoad(&offsets[px + 1u]));
 }
 
-fn cursor_begin(px: u32) -> Cursor {
-    return Cursor(atomicLoad(&offsets[px]), atomicLoad(&offsets[px + 1u]));
-}
-
-fn cursor_more(c: Cursor) -> bool {
-    return c.at < c.end;
-}
-
-fn cursor_step(c: ptr<function, Cursor>) -> Frag {
-    let i = (*c).at;
-    let node = load_node(i);
-    (*c).at = i + 1u;
-    return Frag(node.depth, vec4<f32>(node.rg, node.ba), i);
+fn walk(link: u32, px: u32) -> Walked {
+    let node = load_node(link - 1u);
+    return Walked(Frag(node.depth, vec4<f32>(node.rg, node.ba), link), node.next);
 }
 
 fn frag_mask(f: Frag) -> u32 {

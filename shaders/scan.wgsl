@@ -1,6 +1,7 @@
-// Exclusive prefix sum of a u32 array in place, in levels of 256-element blocks: each block
-// is scanned in workgroup memory and its total written to `sums`; the host scans `sums`
-// the same way (recursively) and adds each block's scanned total back (cs_add_blocks).
+// Exclusive prefix sum of a u32 array in place, in levels of 256-element blocks: one
+// invocation scans a block serially and writes its total to `sums` (no workgroup barriers,
+// which a software rasterizer runs as context switches); the host scans `sums` the same way
+// (recursively) and adds each block's scanned total back (cs_add_blocks).
 
 struct ScanParams {
     n: u32,
@@ -14,38 +15,27 @@ struct ScanParams {
 @group(0) @binding(2) var<uniform> params: ScanParams;
 
 const BLOCK: u32 = 256u;
-var<workgroup> tmp: array<u32, BLOCK>;
+// One invocation a block, 64 a workgroup (oit_core::scan::SCAN_GROUP).
+@compute @workgroup_size(64)
+fn cs_scan_blocks(@builtin(global_invocation_id) gid: vec3<u32>) {
+    // Row y of blocks as cs_add_blocks lays them out: groups_x blocks a row.
+    let b = gid.y * params.groups_x + gid.x;
+    let first = b * BLOCK;
+    if gid.x >= params.groups_x || first >= max(params.n, 1u) {
+        return;
+    }
+    let end = min(first + BLOCK, params.n);
+    var total = 0u;
+    for (var i = first; i < end; i++) {
+        let v = data[i];
+        data[i] = total;
+        total += v;
+    }
+    sums[b] = total;
+}
 
 fn block_of(wid: vec3<u32>) -> u32 {
     return wid.y * params.groups_x + wid.x;
-}
-
-@compute @workgroup_size(256)
-fn cs_scan_blocks(@builtin(local_invocation_id) lid: vec3<u32>, @builtin(workgroup_id) wid: vec3<u32>) {
-    let b = block_of(wid);
-    let i = b * BLOCK + lid.x;
-    var v = 0u;
-    if i < params.n {
-        v = data[i];
-    }
-    tmp[lid.x] = v;
-    workgroupBarrier();
-    // Hillis-Steele inclusive scan over the block.
-    for (var off = 1u; off < BLOCK; off *= 2u) {
-        var t = 0u;
-        if lid.x >= off {
-            t = tmp[lid.x - off];
-        }
-        workgroupBarrier();
-        tmp[lid.x] += t;
-        workgroupBarrier();
-    }
-    if i < params.n {
-        data[i] = tmp[lid.x] - v;
-    }
-    if lid.x == BLOCK - 1u {
-        sums[b] = tmp[BLOCK - 1u];
-    }
 }
 
 @compute @workgroup_size(256)

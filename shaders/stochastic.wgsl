@@ -32,7 +32,7 @@ fn covers(prim: u32, px: u32, s: u32, alpha: f32) -> bool {
     return f32(h >> 8u) * (1.0 / 16777216.0) < alpha;
 }
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_depth(in: VsOut) {
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;

@@ -97,15 +97,14 @@ def test_hundreds_of_layers_in_one_pixel(renderer):
 @pytest.mark.parametrize("layers", [1000, 4000])
 def test_thousands_of_layers_in_one_pixel(renderer, layers):
     # Mesa's llvmpipe (lavapipe) ends every shader invocation's loops after 65535 iterations
-    # in all. The resolve therefore runs one sweep (one pass over the list, heap-selected
-    # batch of 32) per dispatch, floor(n / 32) + 1 dispatches, so no invocation loops more
-    # than about 6n times.
+    # in all. The resolve sorts a deep list in runs of 32 and merges them, pausing each
+    # invocation within that budget and resuming in the next dispatch.
     check_many_layers(renderer, layers, seed=5)
 
 
 def test_identical_coplanar_layers_each_count_once(renderer):
-    # 100 equal fragments a pixel (same depth, same color) straddle three batch boundaries
-    # of the resolve: none may be dropped or counted twice.
+    # 100 equal fragments a pixel (same depth, same color) straddle the resolve's runs and
+    # merges: none may be dropped or counted twice.
     n, alpha = 100, 0.05
     meshes = [layer(0.5, (0.9, 0.2, 0.1, alpha)) for _ in range(n)]
     frame = renderer(4, 4).render(build_scene(meshes), IDENTITY, background=(0.0, 0.0, 1.0))

@@ -70,7 +70,7 @@ def test_a_failing_method_gives_a_failed_row(monkeypatch):
     assert rows["hybrid"]["message"] == "adapter limit: too many layers for this adapter"
     assert math.isnan(rows["hybrid"]["mean_err"])
     assert rows["wboit"]["status"] == "ok"
-    assert "| hybrid | k=8 |" in harness.markdown(list(rows.values()), results.COLUMNS)
+    assert "| hybrid | k=8 tail=exact |" in harness.markdown(list(rows.values()), results.COLUMNS)
     assert "failed: adapter limit" in harness.markdown(list(rows.values()), results.COLUMNS)
 
 

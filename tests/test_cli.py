@@ -146,7 +146,7 @@ def test_bench_quick_writes_its_tables(tmp_path):
     for r in rows.values():
         assert r["status"] == "ok" and r["size"] == "64x64" and float(r["wall_ms"]) > 0
         assert int(r["max_depth"]) >= 2  # the glass shells overlap
-    assert rows["hybrid"]["params"] == "k=8"
+    assert rows["hybrid"]["params"] == "k=8 tail=exact"
     assert float(rows["abuffer"]["mean_err"]) == 0.0
     # Glass is ordered worst for submission-order blending; hybrid's 8 slots hold its few layers.
     assert float(rows["hybrid"]["mean_err"]) < 0.01 < float(rows["unsorted"]["mean_err"])
@@ -159,4 +159,4 @@ def test_bench_quick_defaults_run_every_showcase_scene_and_method():
     plan = harness.method_plan(args.methods, args.quick)
     assert [method for method, _, _ in plan] == [m["name"] for m in oit.methods()]
     assert all(is_default for *_, is_default in plan)
-    assert {m: p for m, p, _ in plan}["hybrid"] == {"k": 8}
+    assert {m: p for m, p, _ in plan}["hybrid"] == {"k": 8, "tail": "exact"}

@@ -226,3 +226,46 @@ def test_a_flat_alpha_of_0_7_shades_flat(renderer, method):
     frame = renderer(32, 32).render(build_scene(meshes), IDENTITY, method, k=2, background=(1.0, 1.0, 1.0))
     rgb = frame.image[2:-2, 2:-2, :3].reshape(-1, 3)
     assert np.abs(rgb - rgb[0]).max() <= 2e-6
+
+
+# tail="blend" (docs/methods.md, "hybrid"): the same sums by float blending, in whatever order
+# fragments arrive. Each of the three tail sums (C alpha, alpha, count) is within n 2^-24 of
+# its value relative to the sum, and eqs. 7-10 move the tail by at most three such relative
+# errors: 3 n 2^-24 on top of the fixed-point tail's tolerance.
+@pytest.mark.parametrize("alphas", ["random", "worst"])
+@pytest.mark.parametrize("k", [1, 4])
+def test_blended_tail_matches_the_model_within_float_sums(renderer, k, alphas):
+    layers = 100
+    built = stacks(layers=layers, alphas=alphas, size=(6, 6), seed=layers)
+    frame = renderer(6, 6).render(built.scene, built.camera, "hybrid", background=tuple(BG), k=k, tail="blend")
+    want = model_image(built, "hybrid", {"k": k})
+    assert np.abs(frame.image.reshape(-1, 4) - want).max() <= 2e-6 + 3 * layers * 2.0**-24
+    assert frame.stats["params"]["tail"] == "blend"
+
+
+def test_blended_tail_depends_on_order_only_within_its_rounding(renderer):
+    meshes = random_meshes(7, transparent=12, opaque=1, triangles=8, space="ndc", spread=0.9)
+    r = renderer(40, 40)
+    first = r.render(build_scene(meshes), IDENTITY, "hybrid", background=(0.3, 0.3, 0.3), k=2, tail="blend")
+    n = first.stats["max_depth_complexity"]
+    assert first.stats["overflow_fragments"] > 0  # a tail to sum
+    exact = r.render(build_scene(meshes), IDENTITY, "hybrid", background=(0.3, 0.3, 0.3), k=2)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        shuffled = [meshes[i].shuffled(rng) for i in rng.permutation(len(meshes))]
+        frame = r.render(build_scene(shuffled), IDENTITY, "hybrid", background=(0.3, 0.3, 0.3), k=2, tail="blend")
+        assert np.abs(frame.image - first.image).max() <= 2 * 3 * n * 2.0**-24
+        # The fixed-point tail is bit-identical under the same shuffles.
+        assert np.array_equal(r.render(build_scene(shuffled), IDENTITY, "hybrid", background=(0.3, 0.3, 0.3), k=2).image, exact.image)
+    # Both tails keep the per-pixel error bound against the exact composite.
+    ref = r.render(build_scene(meshes), IDENTITY, "abuffer", background=(0.3, 0.3, 0.3)).image
+    for frame in (first, exact):
+        assert (np.abs(frame.image - ref)[..., :3] <= frame.error_bound + 1e-6).all()
+
+
+def test_tail_must_be_exact_or_blend(renderer):
+    built = stacks(layers=4, alphas="random", size=(2, 2), seed=1)
+    with pytest.raises(ValueError, match="exact, blend"):
+        renderer(2, 2).render(built.scene, built.camera, "hybrid", tail="fast")
+    with pytest.raises(ValueError, match="no parameter 'tail'"):
+        renderer(2, 2).render(built.scene, built.camera, "ktab", tail="blend")

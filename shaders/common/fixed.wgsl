@@ -49,21 +49,26 @@ struct Tail {
 }
 
 fn resolve_tail(sums: u32, count: u32) -> Tail {
-    var tail = Tail(vec3<f32>(0.0), 1.0);
     if count == 0u {
+        return Tail(vec3<f32>(0.0), 1.0);
+    }
+    let sum_c = vec3<f32>(
+        read_fixed64(word(sums), word(sums + 1u)),
+        read_fixed64(word(sums + 2u), word(sums + 3u)),
+        read_fixed64(word(sums + 4u), word(sums + 5u)),
+    );
+    return tail_from_sums(sum_c, read_fixed64(word(sums + 6u), word(sums + 7u)), count);
+}
+
+// Eqs. 7-10 from the sums of C * alpha (sum_c) and alpha (sum_a) over count fragments.
+fn tail_from_sums(sum_c: vec3<f32>, sum_a: f32, count: u32) -> Tail {
+    var tail = Tail(vec3<f32>(0.0), 1.0);
+    if count == 0u || sum_a <= 0.0 {
         return tail;
     }
-    let sum_a = read_fixed64(word(sums + 6u), word(sums + 7u));
-    if sum_a > 0.0 {
-        let sum_c = vec3<f32>(
-            read_fixed64(word(sums), word(sums + 1u)),
-            read_fixed64(word(sums + 2u), word(sums + 3u)),
-            read_fixed64(word(sums + 4u), word(sums + 5u)),
-        );
-        let n = f32(count);
-        let a_avg = min(sum_a / n, 1.0);                            // eq. 8
-        tail.trans = select(pow(1.0 - a_avg, n), 0.0, a_avg >= 1.0); // eq. 9
-        tail.color = (sum_c / sum_a) * (1.0 - tail.trans);           // eqs. 7 and 10
-    }
+    let n = f32(count);
+    let a_avg = min(sum_a / n, 1.0);                            // eq. 8
+    tail.trans = select(pow(1.0 - a_avg, n), 0.0, a_avg >= 1.0); // eq. 9
+    tail.color = (sum_c / sum_a) * (1.0 - tail.trans);           // eqs. 7 and 10
     return tail;
 }

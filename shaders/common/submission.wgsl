@@ -28,7 +28,7 @@ fn frag_less(a: Frag, b: Frag) -> bool {
 }
 //!include common/select.wgsl
 
-@fragment
+@fragment @early_depth_test(force)
 fn fs_capture(in: VsOut) {
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;

@@ -1,34 +1,70 @@
 // The exact resolve shared by the fragment-storing methods (abuffer, sbuffer, pall,
-// compact_abuffer): sweeps (compute, one dispatch each) in which every pixel takes the BATCH
-// nearest fragments behind the last one it composited, sorts them and composites them front
-// to back, then a full-screen pass over the opaque scene or background. The host dispatches
-// floor(max depth complexity / BATCH) + 1 sweeps, so each invocation's work is one pass over
-// its fragments (llvmpipe ends an invocation's loops after 65,535 iterations).
-// The including shader defines how a pixel's fragments are walked:
-//   struct Cursor; fn cursor_begin(px: u32) -> Cursor; fn cursor_more(c: Cursor) -> bool;
-//   fn cursor_step(c: ptr<function, Cursor>) -> Frag  (returns the fragment, advances)
-// and declares the `state` storage binding. docs/methods.md ("abuffer").
+// compact_abuffer): each pixel's list is sorted once, in place, in O(n log n), then
+// composited front to back; a full-screen pass adds the opaque scene or background.
+//   - A pixel of at most RUN fragments (most pixels) loads them into a local array, sorts it
+//     by insertion and composites it: one walk of its list.
+//   - A deeper pixel sorts its list in runs of RUN (each run sorted locally and relinked),
+//     then merges the runs bottom-up by relinking the nodes' `next` fields (no scratch
+//     memory), then walks the sorted list to composite it.
+// The work is a per-pixel state machine that stops after STEP_BUDGET steps and resumes in the
+// next dispatch, so any depth completes; the host dispatches enough sweeps for the deepest
+// pixel (oit_core::method::lists::resolve_steps mirrors the counts below). A step is one
+// iteration of llvmpipe's loop limiter, which ends an invocation's loops after 65,535 in all
+// and counts every `switch` as one (SPIR-V to NIR makes a switch a loop): each pool access
+// is one (common/nodes.wgsl). Where the work pauses does not change the result: the sorted
+// order is unique and the composite runs in that order.
+// The including shader defines
+//   fn list_head(px: u32) -> u32             the link (node index + 1) of the first node, 0: none
+//   fn walk(link: u32, px: u32) -> Walked    a node's fragment and link, from one load
+//   fn frag_mask(f: Frag) -> u32             the pixel's samples it covers (bit s: sample s)
+// and declares the `state` storage binding; common/nodes.wgsl gives load_next/store_next.
+// docs/methods.md ("abuffer").
 
-// Per-pixel sweep state (STATE_WORDS words): the last composited fragment's key (6 words),
-// flags, a spare word, then per sample of the pixel (PIXEL_SAMPLES, from the targets include:
-// 1, or the coverage-mask sample count) its accumulated color and transmittance.
-const STATE_WORDS: u32 = 8u + 4u * PIXEL_SAMPLES;
-const FLAGS: u32 = 6u;
-const SAMPLE_STATE: u32 = 8u;
-const STARTED: u32 = 1u;
-const DONE: u32 = 2u;
+// Per-pixel state (STATE_WORDS words), then per sample of the pixel (PIXEL_SAMPLES, from the
+// targets include: 1, or the coverage-mask sample count) its accumulated color and
+// transmittance.
+const STATE_WORDS: u32 = 12u + 4u * PIXEL_SAMPLES;
+const S_PHASE: u32 = 0u; // phase | sub-phase << 4 | MULTI (this pass wrote more than one run)
+const S_WIDTH: u32 = 1u; // run length of the merge pass
+const S_SRC: u32 = 2u;   // next node this pass has not reached; the composite's cursor
+const S_TAIL: u32 = 3u;  // last node of this pass's output (0: none yet)
+const S_A: u32 = 4u;     // the pair being merged: its first run's next node and count left,
+const S_NA: u32 = 5u;
+const S_B: u32 = 6u;     // the second run's,
+const S_NB: u32 = 7u;
+const S_REST: u32 = 8u;  // and the node after the pair
+const SAMPLE_STATE: u32 = 12u;
 
-// The including shader also defines `fn frag_mask(f: Frag) -> u32`: the pixel's samples the
-// fragment covers (bit s: sample s), 1 without coverage masks. The mask stays out of Frag,
-// which the heap moves around: one more word there slowed every list sweep by a tenth.
+const FRESH: u32 = 0u;
+const RUNS: u32 = 1u;
+const MERGE: u32 = 2u;
+const COMPOSITE: u32 = 3u;
+const DONE: u32 = 4u;
+const SPLIT_A: u32 = 0u;
+const SPLIT_B: u32 = 1u;
+const MERGING: u32 = 2u;
+const MULTI: u32 = 0x100u;
+// Steps per node loaded into a run (the loop, the pool switch), per node relinked (the loop,
+// append's switch), per merge step (its own switch, two fragments, the link, the append), and
+// per fragment composited from the list.
+const LOAD_STEPS: u32 = 2u;
+const LINK_STEPS: u32 = 2u;
+const MERGE_STEPS: u32 = 6u;
+const COMPOSITE_STEPS: u32 = 4u + PIXEL_SAMPLES;
+
 struct Frag {
     depth: f32,
     color: vec4<f32>,
     id: u32,
 }
 
-// Strict total order: depth, then color, then node index. Fragments equal in depth and
-// color are interchangeable, so the composite does not depend on submission order.
+struct Walked {
+    frag: Frag,
+    next: u32,
+}
+
+// Strict total order: depth, then color, then node link. Fragments equal in depth and color
+// are interchangeable, so the composite does not depend on submission order.
 fn frag_less(a: Frag, b: Frag) -> bool {
     if a.depth != b.depth { return a.depth < b.depth; }
     if a.color.r != b.color.r { return a.color.r < b.color.r; }
@@ -37,81 +73,345 @@ fn frag_less(a: Frag, b: Frag) -> bool {
     if a.color.a != b.color.a { return a.color.a < b.color.a; }
     return a.id < b.id;
 }
-//!include common/select.wgsl
 
+// Front-to-back compositing per sample of the pixel.
+struct Acc {
+    color: array<vec3<f32>, PIXEL_SAMPLES>,
+    trans: array<f32, PIXEL_SAMPLES>,
+}
+
+fn acc_empty() -> Acc {
+    var c: Acc;
+    for (var k = 0u; k < PIXEL_SAMPLES; k++) {
+        c.trans[k] = 1.0;
+    }
+    return c;
+}
+
+// Composites one fragment into every sample it covers; true when all samples are opaque.
+fn composite(c: ptr<function, Acc>, f: Frag) -> bool {
+    let mask = frag_mask(f);
+    var opaque = true;
+    for (var k = 0u; k < PIXEL_SAMPLES; k++) {
+        if (mask & (1u << k)) != 0u {
+            (*c).color[k] += (*c).trans[k] * f.color.a * f.color.rgb;
+            (*c).trans[k] *= 1.0 - f.color.a;
+        }
+        opaque = opaque && (*c).trans[k] == 0.0;
+    }
+    return opaque;
+}
+
+fn load_acc(px: u32) -> Acc {
+    var c: Acc;
+    for (var k = 0u; k < PIXEL_SAMPLES; k++) {
+        let w = px * STATE_WORDS + SAMPLE_STATE + 4u * k;
+        c.color[k] = vec3<f32>(bitcast<f32>(state[w]), bitcast<f32>(state[w + 1u]), bitcast<f32>(state[w + 2u]));
+        c.trans[k] = bitcast<f32>(state[w + 3u]);
+    }
+    return c;
+}
+
+fn save_acc(px: u32, c: Acc) {
+    for (var k = 0u; k < PIXEL_SAMPLES; k++) {
+        let w = px * STATE_WORDS + SAMPLE_STATE + 4u * k;
+        state[w] = bitcast<u32>(c.color[k].r);
+        state[w + 1u] = bitcast<u32>(c.color[k].g);
+        state[w + 2u] = bitcast<u32>(c.color[k].b);
+        state[w + 3u] = bitcast<u32>(c.trans[k]);
+    }
+}
+
+// A run of up to RUN fragments in a local array.
+struct Run {
+    frags: array<Frag, RUN>,
+    n: u32,
+    // The node after the run (0: the list ended).
+    next: u32,
+}
+
+// Loads the run starting at `link` and sorts it by insertion; `steps` grows by the work done.
+fn load_run(link: u32, px: u32, run: ptr<function, Run>, steps: ptr<function, u32>) {
+    var n = 0u;
+    var at = link;
+    while at != 0u && n < RUN {
+        let w = walk(at, px);
+        (*run).frags[n] = w.frag;
+        at = w.next;
+        n++;
+    }
+    var shifts = 0u;
+    for (var i = 1u; i < n; i++) {
+        let f = (*run).frags[i];
+        var j = i;
+        while j > 0u && frag_less(f, (*run).frags[j - 1u]) {
+            (*run).frags[j] = (*run).frags[j - 1u];
+            j--;
+        }
+        (*run).frags[j] = f;
+        shifts += i - j + 1u;
+    }
+    (*run).n = n;
+    (*run).next = at;
+    *steps += LOAD_STEPS * (n + 1u) + shifts;
+}
+
+// A deep pixel's progress between dispatches, in registers.
+struct Sweep {
+    px: u32,
+    phase: u32,
+    sub: u32,
+    multi: bool,
+    width: u32,
+    src: u32,
+    tail: u32,
+    a: u32,
+    na: u32,
+    b: u32,
+    nb: u32,
+    rest: u32,
+    // The merge's current fragments of runs a and b (bits 1 and 2 of `have`: loaded); kept
+    // in registers within a dispatch only.
+    fa: Frag,
+    fb: Frag,
+    have: u32,
+}
+
+// Appends node `link` to the pass's output.
+fn append(s: ptr<function, Sweep>, link: u32) {
+    if (*s).tail == 0u {
+        atomicStore(&heads[(*s).px], link);
+    } else {
+        store_next((*s).tail - 1u, link);
+    }
+    (*s).tail = link;
+}
+
+// Ends a pass over the list: the next pass merges runs twice as long, or, when this one
+// wrote a single run, the list is sorted and the composite starts.
+fn end_pass(s: ptr<function, Sweep>) {
+    store_next((*s).tail - 1u, 0u);
+    let head = atomicLoad(&heads[(*s).px]);
+    if (*s).multi {
+        (*s).width = select(RUN, 2u * (*s).width, (*s).phase == MERGE);
+        (*s).phase = MERGE;
+    } else {
+        (*s).phase = COMPOSITE;
+    }
+    (*s).src = head;
+    (*s).tail = 0u;
+    (*s).multi = false;
+    (*s).sub = SPLIT_A;
+    (*s).a = head;
+    (*s).b = head;
+    (*s).na = 0u;
+}
+
+// Relinks a sorted run onto the pass's output; after the list's last run, the merges start.
+fn link_run(s: ptr<function, Sweep>, run: ptr<function, Run>, steps: ptr<function, u32>) {
+    for (var i = 0u; i < (*run).n; i++) {
+        append(s, (*run).frags[i].id);
+    }
+    *steps += LINK_STEPS * (*run).n;
+    (*s).src = (*run).next;
+    (*s).phase = RUNS;
+    if (*run).next == 0u {
+        (*s).multi = true; // at least two runs: a list of one is composited by cs_sort
+        end_pass(s);
+    }
+}
+
+// One step of a merge pass: a node walked while splitting off the pair, or one node merged.
+fn merge_step(s: ptr<function, Sweep>) {
+    switch (*s).sub {
+        case SPLIT_A: {
+            if (*s).na < (*s).width && (*s).b != 0u {
+                (*s).b = load_next((*s).b - 1u);
+                (*s).na++;
+            } else {
+                (*s).sub = SPLIT_B;
+                (*s).rest = (*s).b;
+                (*s).nb = 0u;
+            }
+        }
+        case SPLIT_B: {
+            if (*s).nb < (*s).width && (*s).rest != 0u {
+                (*s).rest = load_next((*s).rest - 1u);
+                (*s).nb++;
+            } else {
+                (*s).sub = MERGING;
+                (*s).multi = (*s).multi || (*s).rest != 0u || (*s).tail != 0u;
+            }
+        }
+        default: {
+            var take_a = (*s).nb == 0u;
+            if (*s).na > 0u && (*s).nb > 0u {
+                if ((*s).have & 1u) == 0u {
+                    (*s).fa = walk((*s).a, (*s).px).frag;
+                }
+                if ((*s).have & 2u) == 0u {
+                    (*s).fb = walk((*s).b, (*s).px).frag;
+                }
+                (*s).have = 3u;
+                take_a = !frag_less((*s).fb, (*s).fa);
+            }
+            var link: u32;
+            if take_a {
+                link = (*s).a;
+                (*s).a = load_next(link - 1u);
+                (*s).na--;
+                (*s).have &= 2u;
+            } else {
+                link = (*s).b;
+                (*s).b = load_next(link - 1u);
+                (*s).nb--;
+                (*s).have &= 1u;
+            }
+            append(s, link);
+            if (*s).na == 0u && (*s).nb == 0u {
+                (*s).src = (*s).rest;
+                (*s).sub = SPLIT_A;
+                (*s).a = (*s).rest;
+                (*s).b = (*s).rest;
+                (*s).na = 0u;
+                if (*s).rest == 0u {
+                    end_pass(s);
+                }
+            }
+        }
+    }
+}
+
+fn load_sweep(px: u32) -> Sweep {
+    let at = px * STATE_WORDS;
+    var s: Sweep;
+    s.px = px;
+    let phase = state[at + S_PHASE];
+    s.phase = phase & 0xfu;
+    s.sub = (phase >> 4u) & 0xfu;
+    s.multi = (phase & MULTI) != 0u;
+    s.width = state[at + S_WIDTH];
+    s.src = state[at + S_SRC];
+    s.tail = state[at + S_TAIL];
+    s.a = state[at + S_A];
+    s.na = state[at + S_NA];
+    s.b = state[at + S_B];
+    s.nb = state[at + S_NB];
+    s.rest = state[at + S_REST];
+    return s;
+}
+
+fn save_sweep(s: Sweep) {
+    let at = s.px * STATE_WORDS;
+    state[at + S_PHASE] = s.phase | (s.sub << 4u) | select(0u, MULTI, s.multi);
+    if s.phase != DONE {
+        state[at + S_WIDTH] = s.width;
+        state[at + S_SRC] = s.src;
+        state[at + S_TAIL] = s.tail;
+        state[at + S_A] = s.a;
+        state[at + S_NA] = s.na;
+        state[at + S_B] = s.b;
+        state[at + S_NB] = s.nb;
+        state[at + S_REST] = s.rest;
+    }
+}
+
+// The first dispatch: every pixel sorts its first run. A list of one run (most pixels) is
+// composited and done; a longer one keeps the run, relinked, and goes on to cs_runs.
 @compute @workgroup_size(8, 8)
-fn cs_sweep(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn cs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = compute_pixel(gid);
     if px == OUTSIDE {
         return;
     }
-    let at = px * STATE_WORDS;
-    let flags = state[at + FLAGS];
-    if (flags & DONE) != 0u {
-        return;
-    }
-    let started = (flags & STARTED) != 0u;
-    var accum: array<vec3<f32>, PIXEL_SAMPLES>;
-    var trans: array<f32, PIXEL_SAMPLES>;
-    var prev: Frag;
-    for (var s = 0u; s < PIXEL_SAMPLES; s++) {
-        let w = at + SAMPLE_STATE + 4u * s;
-        if started {
-            accum[s] = vec3<f32>(bitcast<f32>(state[w]), bitcast<f32>(state[w + 1u]), bitcast<f32>(state[w + 2u]));
-            trans[s] = bitcast<f32>(state[w + 3u]);
-        } else {
-            accum[s] = vec3<f32>(0.0);
-            trans[s] = 1.0;
-        }
-    }
-    if started {
-        prev = Frag(bitcast<f32>(state[at]),
-                    vec4<f32>(bitcast<f32>(state[at + 1u]), bitcast<f32>(state[at + 2u]), bitcast<f32>(state[at + 3u]), bitcast<f32>(state[at + 4u])),
-                    state[at + 5u]);
-    }
-    var heap: array<Frag, BATCH>;
-    var n = 0u;
-    var c = cursor_begin(px);
-    while cursor_more(c) {
-        let f = cursor_step(&c);
-        if !started || frag_less(prev, f) {
-            n = heap_offer(&heap, n, f);
-        }
-    }
-    heap_sort(&heap, n);
-    for (var b = 0u; b < n; b++) {
-        let f = heap[b];
-        let mask = frag_mask(f);
-        for (var s = 0u; s < PIXEL_SAMPLES; s++) {
-            if (mask & (1u << s)) != 0u {
-                accum[s] += trans[s] * f.color.a * f.color.rgb;
-                trans[s] *= 1.0 - f.color.a;
+    var run: Run;
+    var steps = 0u;
+    load_run(list_head(px), px, &run, &steps);
+    var c = acc_empty();
+    if run.next == 0u {
+        for (var i = 0u; i < run.n; i++) {
+            if composite(&c, run.frags[i]) {
+                break;
             }
         }
+        state[px * STATE_WORDS + S_PHASE] = DONE;
+    } else {
+        var s: Sweep;
+        s.px = px;
+        link_run(&s, &run, &steps);
+        save_sweep(s);
     }
-    var out_flags = STARTED;
-    var opaque = true;
-    for (var s = 0u; s < PIXEL_SAMPLES; s++) {
-        let w = at + SAMPLE_STATE + 4u * s;
-        state[w] = bitcast<u32>(accum[s].r);
-        state[w + 1u] = bitcast<u32>(accum[s].g);
-        state[w + 2u] = bitcast<u32>(accum[s].b);
-        state[w + 3u] = bitcast<u32>(trans[s]);
-        opaque = opaque && trans[s] == 0.0;
+    save_acc(px, c);
+}
+
+// The deeper pixels, one phase an entry point so that each dispatch runs one tight loop:
+// their further runs, then their merge passes, then their composite, STEP_BUDGET steps a
+// dispatch. The host dispatches each enough times for the deepest pixel
+// (oit_core::method::lists::resolve_dispatches); a pixel in another phase returns at once.
+fn resume(gid: vec3<u32>, phase: u32) -> u32 {
+    let px = compute_pixel(gid);
+    if px == OUTSIDE || (state[px * STATE_WORDS + S_PHASE] & 0xfu) != phase {
+        return OUTSIDE;
     }
-    if n < BATCH || opaque {
-        out_flags |= DONE;
+    return px;
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_runs(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let px = resume(gid, RUNS);
+    if px == OUTSIDE {
+        return;
     }
-    if n > 0u {
-        let last = heap[n - 1u];
-        state[at] = bitcast<u32>(last.depth);
-        state[at + 1u] = bitcast<u32>(last.color.r);
-        state[at + 2u] = bitcast<u32>(last.color.g);
-        state[at + 3u] = bitcast<u32>(last.color.b);
-        state[at + 4u] = bitcast<u32>(last.color.a);
-        state[at + 5u] = last.id;
+    var s = load_sweep(px);
+    var steps = 0u;
+    while s.phase == RUNS && steps < STEP_BUDGET {
+        var run: Run;
+        load_run(s.src, px, &run, &steps);
+        link_run(&s, &run, &steps);
     }
-    state[at + FLAGS] = out_flags;
+    save_sweep(s);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_merge(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let px = resume(gid, MERGE);
+    if px == OUTSIDE {
+        return;
+    }
+    var s = load_sweep(px);
+    var steps = 0u;
+    while s.phase == MERGE && steps < STEP_BUDGET {
+        merge_step(&s);
+        steps += MERGE_STEPS;
+    }
+    save_sweep(s);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_composite(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let px = resume(gid, COMPOSITE);
+    if px == OUTSIDE {
+        return;
+    }
+    var c = load_acc(px);
+    var link = state[px * STATE_WORDS + S_SRC];
+    var steps = 0u;
+    var done = false;
+    while !done && steps < STEP_BUDGET {
+        if link == 0u {
+            done = true;
+        } else {
+            let w = walk(link, px);
+            done = composite(&c, w.frag);
+            link = w.next;
+        }
+        steps += COMPOSITE_STEPS;
+    }
+    state[px * STATE_WORDS + S_SRC] = link;
+    if done {
+        state[px * STATE_WORDS + S_PHASE] = DONE;
+    }
+    save_acc(px, c);
 }
 
 // The pixel: the mean over its samples of the composite over that sample's opaque scene or
@@ -119,15 +419,15 @@ fn cs_sweep(@builtin(global_invocation_id) gid: vec3<u32>) {
 @fragment
 fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let at = pixel_index(pos) * STATE_WORDS;
-    let started = (state[at + FLAGS] & STARTED) != 0u;
+    let started = (state[at + S_PHASE] & 0xfu) == DONE;
     var sum = vec4<f32>(0.0);
-    for (var s = 0u; s < PIXEL_SAMPLES; s++) {
-        let base = base_at_sample(pos, s);
+    for (var k = 0u; k < PIXEL_SAMPLES; k++) {
+        let base = base_at_sample(pos, k);
         if !started {
             sum += base;
             continue;
         }
-        let w = at + SAMPLE_STATE + 4u * s;
+        let w = at + SAMPLE_STATE + 4u * k;
         let accum = vec3<f32>(bitcast<f32>(state[w]), bitcast<f32>(state[w + 1u]), bitcast<f32>(state[w + 2u]));
         let trans = bitcast<f32>(state[w + 3u]);
         sum += vec4<f32>(accum + trans * base.rgb, 1.0 - trans * (1.0 - base.a));

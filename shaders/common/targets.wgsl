@@ -4,7 +4,9 @@
 @group(1) @binding(1) var base_color: texture_2d<f32>;
 
 // Storage-writing passes test the opaque depth themselves: a fragment shader with side
-// effects may run its depth test late, after its atomics already happened.
+// effects may run its depth test late, after its atomics already happened. They also ask
+// for the test before the shader (`@early_depth_test(force)`), so that an adapter that
+// honours it never runs the shader for a fragment behind the opaque scene.
 fn behind_opaque(pos: vec4<f32>) -> bool {
     return pos.z >= textureLoad(opaque_depth, vec2<i32>(pos.xy), 0);
 }

@@ -28,6 +28,7 @@ pub fn wanted_features() -> wgpu::Features {
         | wgpu::Features::SHADER_INT64
         | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
         | wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS
+        | wgpu::Features::SHADER_EARLY_DEPTH_TEST
 }
 
 /// Adapter preference, lower first: hardware before software (lavapipe).

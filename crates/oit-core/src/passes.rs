@@ -9,9 +9,20 @@ pub fn capture_pass<'e>(
     depth: &'e wgpu::TextureView,
     timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
 ) -> wgpu::RenderPass<'e> {
+    capture_into(enc, label, depth, &[], timestamps)
+}
+
+/// A geometry pass that reads the opaque depth and blends into `colors`.
+pub fn capture_into<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    depth: &'e wgpu::TextureView,
+    colors: &[Option<wgpu::RenderPassColorAttachment<'e>>],
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
+) -> wgpu::RenderPass<'e> {
     enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
-        color_attachments: &[],
+        color_attachments: colors,
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: depth, depth_ops: None, stencil_ops: None }),
         timestamp_writes: timestamps,
         occlusion_query_set: None,

@@ -1,16 +1,22 @@
 //! Exclusive prefix sum of a u32 storage buffer in place (shaders/scan.wgsl): 256-element
-//! blocks scanned in workgroup memory, their totals scanned recursively, then added back.
+//! blocks scanned serially, one an invocation, their totals scanned recursively, then added
+//! back.
 
 use crate::context::GpuContext;
 use crate::shader;
 use crate::targets::storage_buffer;
 
 const BLOCK: u64 = 256;
+/// Blocks one workgroup of `cs_scan_blocks` scans.
+const SCAN_GROUP: u64 = 64;
 const MAX_GROUPS_X: u64 = 65_535;
 
 struct Level {
     group: wgpu::BindGroup,
-    groups: (u32, u32),
+    /// Workgroups of the block scan (one invocation a block) and of the add (one a word),
+    /// both laid out `add.0` wide as the shader's `groups_x` says.
+    scan: (u32, u32),
+    add: (u32, u32),
 }
 
 pub struct Scan {
@@ -55,6 +61,7 @@ impl Scan {
             let blocks = len.div_ceil(BLOCK).max(1);
             let sums = storage_buffer(d, "scan sums", blocks * 4, wgpu::BufferUsages::empty());
             let groups = groups_for(len);
+            let scan_groups = (groups.0.div_ceil(SCAN_GROUP as u32), groups.1);
             let params = d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("scan params"),
                 size: 16,
@@ -72,7 +79,7 @@ impl Scan {
                     wgpu::BindGroupEntry { binding: 2, resource: params.as_entire_binding() },
                 ],
             });
-            levels.push(Level { group, groups });
+            levels.push(Level { group, scan: scan_groups, add: groups });
             bytes += blocks * 4 + 16;
             buffers.push(params);
             if let Some(c) = current.take() {
@@ -93,12 +100,12 @@ impl Scan {
         pass.set_pipeline(&self.scan);
         for l in &self.levels {
             pass.set_bind_group(0, &l.group, &[]);
-            pass.dispatch_workgroups(l.groups.0, l.groups.1, 1);
+            pass.dispatch_workgroups(l.scan.0, l.scan.1, 1);
         }
         pass.set_pipeline(&self.add);
         for l in self.levels.iter().rev().skip(1) {
             pass.set_bind_group(0, &l.group, &[]);
-            pass.dispatch_workgroups(l.groups.0, l.groups.1, 1);
+            pass.dispatch_workgroups(l.add.0, l.add.1, 1);
         }
     }
 }

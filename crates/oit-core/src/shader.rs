@@ -8,7 +8,10 @@ pub use crate::consts::Const;
 /// Constants a shader needs when it is validated without a pipeline (tests, tools).
 pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("NODES_PER_BINDING", 1 << 20),
+    Const::U32("POOL_SPLIT", 4),
     Const::U32("BATCH", 32),
+    Const::U32("RUN", 32),
+    Const::U32("STEP_BUDGET", 32_768),
     Const::U32("K", 8),
     Const::U32("PER_PIXEL", 0),
     Const::U32("TAIL", 1),
@@ -61,9 +64,15 @@ pub fn entry_files() -> impl Iterator<Item = &'static str> {
     SOURCES.iter().map(|(p, _)| *p).filter(|p| !p.starts_with("common/"))
 }
 
+/// The attribute that asks for the depth test before a storage-writing fragment shader; it is
+/// dropped where the device lacks SHADER_EARLY_DEPTH_TEST (those shaders test the opaque
+/// depth themselves first, so only the time changes).
+const EARLY_DEPTH_TEST: &str = " @early_depth_test(force)";
+
 pub(crate) fn module(device: &wgpu::Device, path: &str, consts: &[Const]) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(path),
-        source: wgpu::ShaderSource::Wgsl(compose(path, consts).into()),
-    })
+    let mut text = compose(path, consts);
+    if !device.features().contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST) {
+        text = text.replace(EARLY_DEPTH_TEST, "");
+    }
+    device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(path), source: wgpu::ShaderSource::Wgsl(text.into()) })
 }

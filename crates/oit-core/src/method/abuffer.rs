@@ -3,7 +3,7 @@
 
 use super::frame::{FrameCtx, Limits, Method, MethodReport};
 use super::info::{AntialiasMode, ErrorBound, Memory, MethodInfo, Order, Tiling};
-use super::lists::{check_sweep_budget, state_words, Aux, ListLayout, ListMethod, STATE_WORDS};
+use super::lists::{state_words, Aux, ListLayout, ListMethod, PIXEL_BYTES, STATE_WORDS};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::gpu_types::{CoverageNode, PoolNode};
@@ -18,9 +18,9 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: &[AntialiasMode::Frames, AntialiasMode::Coverage],
-    memory: Memory::Scene { formula: "24 B/fragment + 52 B/pixel (the node pool grows with the scene)" },
+    memory: Memory::Scene { formula: "24 B/fragment + 68 B/pixel (the node pool grows with the scene)" },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: 52, per_fragment: 24, per_triangle: 0 },
+    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 
@@ -39,6 +39,7 @@ impl ABuffer {
                 shader: "abuffer.wgsl",
                 node_bytes: std::mem::size_of::<PoolNode>() as u64,
                 state_words: STATE_WORDS,
+                samples: 1,
                 aux: Aux::None,
             },
         );
@@ -48,7 +49,6 @@ impl ABuffer {
 
 impl Method for ABuffer {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        check_sweep_budget(cx)?;
         match cx.coverage {
             Some(c) => {
                 let lists = self.coverage.get_or_insert_with(|| {
@@ -59,6 +59,7 @@ impl Method for ABuffer {
                             shader: "abuffer_coverage.wgsl",
                             node_bytes: std::mem::size_of::<CoverageNode>() as u64,
                             state_words: state_words(c.samples),
+                            samples: c.samples,
                             aux: Aux::None,
                         },
                     )

@@ -32,7 +32,13 @@ pub const INFO: MethodInfo = MethodInfo {
         Box::new(Adaptive(ListMethod::new(
             gpu,
             limits,
-            ListLayout { shader: "adaptive.wgsl", node_bytes: std::mem::size_of::<PrimNode>() as u64, state_words: 0, aux: Aux::None },
+            ListLayout {
+                shader: "adaptive.wgsl",
+                node_bytes: std::mem::size_of::<PrimNode>() as u64,
+                state_words: 0,
+                samples: 1,
+                aux: Aux::None,
+            },
         )))
     },
 };

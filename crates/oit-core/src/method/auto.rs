@@ -10,7 +10,7 @@
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::ktab::{KTab, Slots};
+use super::ktab::{self, KTab, Slots};
 use super::params::{ParamInfo, ParamKind, Params};
 use crate::cache::ShaderKey;
 use crate::consts::{self, ALPHA_8BIT_ERROR, ROUNDING_TERM as ROUNDING};
@@ -191,7 +191,7 @@ impl Method for Auto {
         let mut slots = predicted;
         while let Some(current) = slots.take() {
             attempts += 1;
-            let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current))?;
+            let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current), ktab::Sums::Exact)?;
             let bound = read_region(cx.gpu, &t.bound_texture, &t.bound_readback, 4, tile)?;
             let worst = bound.iter().copied().fold(0.0f32, f32::max) as f64;
             hybrid_bytes = report.memory_bytes;

@@ -103,7 +103,13 @@ impl<'a> FrameCtx<'a> {
 
     /// A full-screen resolve of `fs` into the output (and the error bound, with `bound`).
     pub fn resolve_pipeline(&self, shader: &ShaderKey, fs: &'static str, own: Layout, bound: bool) -> wgpu::RenderPipeline {
-        let groups = vec![Layout::Scene, self.targets_key(), own];
+        self.resolve_pipeline_groups(shader, fs, &[own], bound)
+    }
+
+    /// A full-screen resolve with the method's groups `own` at 2, 3, ...
+    pub fn resolve_pipeline_groups(&self, shader: &ShaderKey, fs: &'static str, own: &[Layout], bound: bool) -> wgpu::RenderPipeline {
+        let mut groups = vec![Layout::Scene, self.targets_key()];
+        groups.extend_from_slice(own);
         let desc = RenderDesc { shader: shader.clone(), entry: fs, groups, draw: Draw::Fullscreen, targets: resolve_targets(bound) };
         self.gpu.cache.render(&self.gpu.device, &desc)
     }
@@ -130,7 +136,20 @@ impl<'a> FrameCtx<'a> {
     /// with the frame's targets at group 1 and `own` at group 2.
     pub fn capture(&mut self, enc: &mut wgpu::CommandEncoder, label: &'static str, pipeline: &wgpu::RenderPipeline, own: &wgpu::BindGroup) {
         let (depth, targets, scene) = (self.raster_depth(), self.targets_group(), self.scene);
-        capture_pass(enc, label, depth, targets, scene, self.tile, self.timer.render_pass(label), pipeline, own);
+        capture_pass(enc, label, depth, &[], targets, scene, self.tile, self.timer.render_pass(label), pipeline, own);
+    }
+
+    /// Records a geometry pass like `capture` that also blends into `colors` (timed as `label`).
+    pub fn capture_into(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        label: &'static str,
+        pipeline: &wgpu::RenderPipeline,
+        own: &wgpu::BindGroup,
+        colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
+    ) {
+        let (depth, targets, scene) = (self.raster_depth(), self.targets_group(), self.scene);
+        capture_pass(enc, label, depth, colors, targets, scene, self.tile, self.timer.render_pass(label), pipeline, own);
     }
 
     /// [`FrameCtx::capture`] inside a span the caller times (per-layer passes).
@@ -141,7 +160,7 @@ impl<'a> FrameCtx<'a> {
         pipeline: &wgpu::RenderPipeline,
         own: &wgpu::BindGroup,
     ) {
-        capture_pass(enc, label, self.raster_depth(), self.targets_group(), self.scene, self.tile, None, pipeline, own);
+        capture_pass(enc, label, self.raster_depth(), &[], self.targets_group(), self.scene, self.tile, None, pipeline, own);
     }
 
     /// Binds the shared groups, `own` and `pipeline` to `pass` and dispatches one invocation
@@ -160,6 +179,18 @@ impl<'a> FrameCtx<'a> {
         own: &wgpu::BindGroup,
         bound: bool,
     ) {
+        self.resolve_groups(enc, label, pipeline, &[own], bound);
+    }
+
+    /// A full-screen pass like `resolve`, with the method's groups `own` at 2, 3, ...
+    pub fn resolve_groups(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        label: &'static str,
+        pipeline: &wgpu::RenderPipeline,
+        own: &[&wgpu::BindGroup],
+        bound: bool,
+    ) {
         let (t, targets, scene, tile) = (self.targets, self.targets_group(), self.scene, self.tile);
         let timestamps = self.timer.render_pass(label);
         let mut pass = if bound {
@@ -171,7 +202,9 @@ impl<'a> FrameCtx<'a> {
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, scene.transparent.group(), &[]);
         pass.set_bind_group(1, targets, &[]);
-        pass.set_bind_group(2, own, &[]);
+        for (i, g) in own.iter().enumerate() {
+            pass.set_bind_group(2 + i as u32, *g, &[]);
+        }
         pass.draw(0..3, 0..1);
     }
 
@@ -203,6 +236,7 @@ fn capture_pass(
     enc: &mut wgpu::CommandEncoder,
     label: &str,
     depth: &wgpu::TextureView,
+    colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
     targets: &wgpu::BindGroup,
     scene: &GpuScene,
     tile: Tile,
@@ -210,7 +244,7 @@ fn capture_pass(
     pipeline: &wgpu::RenderPipeline,
     own: &wgpu::BindGroup,
 ) {
-    let mut pass = passes::capture_pass(enc, label, depth, timestamps);
+    let mut pass = passes::capture_into(enc, label, depth, colors, timestamps);
     tile.scissor(&mut pass);
     pass.set_pipeline(pipeline);
     pass.set_bind_group(1, targets, &[]);

@@ -3,7 +3,7 @@
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::ktab::{memory_bytes, KTab, Slots};
+use super::ktab::{memory_bytes, KTab, Slots, Sums};
 use super::params::{ParamInfo, ParamKind};
 use crate::error::Result;
 
@@ -13,13 +13,20 @@ const K_PARAM: ParamInfo = ParamInfo {
     doc: "core size: fragments per pixel kept exactly, sorted (k-TAB slots)",
 };
 
+const TAIL_PARAM: ParamInfo = ParamInfo {
+    name: "tail",
+    kind: ParamKind::Choice { choices: &["exact", "blend"], default: "exact" },
+    doc: "how the second pass sums core and tail: 'exact' by fixed-point atomics (bit-identical under any order), \
+          'blend' by float blending as in the paper (faster; order changes the rounding, docs/methods.md)",
+};
+
 pub const HYBRID: MethodInfo = MethodInfo {
     name: "hybrid",
     summary: "hybrid transparency: the k nearest fragments exactly (k-TAB), the rest by weighted average",
     exact: false,
     bounded_memory: true,
     passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core and tail (geometry)", "final composite (full screen)"],
-    params: &[K_PARAM],
+    params: &[K_PARAM, TAIL_PARAM],
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
@@ -33,6 +40,7 @@ pub const KTAB: MethodInfo = MethodInfo {
     name: "ktab",
     summary: "k-TAB: the k nearest fragments composited exactly, the others discarded (hybrid's core alone)",
     passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core (geometry)", "final composite (full screen)"],
+    params: &[K_PARAM],
     create: |_, _| Box::new(Hybrid(KTab::new(false))),
     ..HYBRID
 };
@@ -45,6 +53,8 @@ struct Hybrid(KTab);
 impl Method for Hybrid {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let k = cx.params.int("k") as u32;
-        self.0.render_slots(cx, Slots::Uniform(k))
+        // ktab has no tail, and sums its core as hybrid's default does.
+        let sums = if cx.params.0.contains_key("tail") { Sums::from_param(cx.params.choice("tail")) } else { Sums::Exact };
+        self.0.render_slots(cx, Slots::Uniform(k), sums)
     }
 }

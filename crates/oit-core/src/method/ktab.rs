@@ -3,8 +3,9 @@
 //! second geometry pass, composite. Accumulation in fixed point, so that frames do not depend
 //! on fragment order (docs/methods.md, "hybrid"). Each pixel gets a uniform k or its own slots.
 
+use super::accum::ADD;
 use super::frame::{FrameCtx, MethodReport};
-use crate::cache::ShaderKey;
+use crate::cache::{Layout, ShaderKey};
 use crate::error::{OitError, Result};
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -35,16 +36,100 @@ pub(crate) enum Slots<'s> {
 /// Binding of the per-pixel slot offsets in the group (shaders/hybrid.wgsl).
 const OFFSETS: usize = 3;
 
+/// How the second geometry pass sums the core and the tail.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Sums {
+    /// Fixed-point storage atomics: bit-identical under any fragment order.
+    Exact,
+    /// Fixed-function additive (and max) blending into float targets, as Maule et al. do:
+    /// fewer atomics, but float sums that round differently in another order.
+    Blend,
+}
+
+impl Sums {
+    pub(crate) fn from_param(name: &str) -> Self {
+        if name == "blend" {
+            Sums::Blend
+        } else {
+            Sums::Exact
+        }
+    }
+}
+
+/// The blended sums' targets, as shaders/hybrid.wgsl's `Shade`: core color and tail count;
+/// tail C * alpha and alpha; the quantization sums and the tail's largest channel (max); one
+/// minus its smallest (max).
+const BLEND_FORMATS: [wgpu::TextureFormat; 4] =
+    [wgpu::TextureFormat::Rgba32Float, wgpu::TextureFormat::Rgba32Float, wgpu::TextureFormat::Rgba32Float, wgpu::TextureFormat::R32Float];
+const BLEND_BINDINGS: &[u32] = &[0, 1, 2, 3];
+
+/// Bytes a frame pixel of the blended sums' targets.
+pub const BLEND_BYTES_PER_PIXEL: u64 = 3 * 16 + 4;
+
+const MAX: wgpu::BlendComponent =
+    wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Max };
+
+fn blend_targets() -> Vec<Option<wgpu::ColorTargetState>> {
+    let states = [(ADD, ADD), (ADD, ADD), (ADD, MAX), (MAX, MAX)];
+    BLEND_FORMATS
+        .iter()
+        .zip(states)
+        .map(|(&format, (color, alpha))| {
+            Some(wgpu::ColorTargetState { format, blend: Some(wgpu::BlendState { color, alpha }), write_mask: wgpu::ColorWrites::ALL })
+        })
+        .collect()
+}
+
+/// The blended sums' targets at the frame's size (tiles draw into their own part), and the
+/// group the final pass reads them through.
+struct BlendSums {
+    size: (u32, u32),
+    views: Vec<wgpu::TextureView>,
+    group: wgpu::BindGroup,
+}
+
+impl BlendSums {
+    fn ensure<'s>(slot: &'s mut Option<BlendSums>, cx: &FrameCtx<'_>) -> &'s BlendSums {
+        let size = (cx.targets.width, cx.targets.height);
+        if slot.as_ref().is_none_or(|t| t.size != size) {
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+            let views: Vec<wgpu::TextureView> = BLEND_FORMATS
+                .iter()
+                .map(|&f| crate::targets::texture(&cx.gpu.device, "hybrid sums", size.0, size.1, f, usage).create_view(&Default::default()))
+                .collect();
+            let resources: Vec<wgpu::BindingResource<'_>> = views.iter().map(wgpu::BindingResource::TextureView).collect();
+            let group = cx.group(Layout::Textures(BLEND_BINDINGS), &resources);
+            *slot = Some(BlendSums { size, views, group });
+        }
+        slot.as_ref().expect("made above")
+    }
+
+    fn attachments(&self) -> Vec<Option<wgpu::RenderPassColorAttachment<'_>>> {
+        self.views
+            .iter()
+            .map(|view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                })
+            })
+            .collect()
+    }
+}
+
 pub(crate) struct KTab {
     /// Whether fragments behind the core form the tail (hybrid) or are discarded (ktab).
     tail: bool,
     buffers: Option<StorageGroup>,
     overflow: Option<Counter>,
+    blend: Option<BlendSums>,
 }
 
 impl KTab {
     pub(crate) fn new(tail: bool) -> Self {
-        Self { tail, buffers: None, overflow: None }
+        Self { tail, buffers: None, overflow: None, blend: None }
     }
 
     /// Refuses buffers past a binding, and returns the slots in all and whether they are per pixel.
@@ -72,9 +157,14 @@ impl KTab {
         }
     }
 
-    /// One frame with the k-TAB slots `slots` gives each pixel.
-    pub(crate) fn render_slots(&mut self, cx: &mut FrameCtx<'_>, slots: Slots<'_>) -> Result<MethodReport> {
+    /// One frame with the k-TAB slots `slots` gives each pixel, its sums made as `sums` says.
+    pub(crate) fn render_slots(&mut self, cx: &mut FrameCtx<'_>, slots: Slots<'_>, sums: Sums) -> Result<MethodReport> {
         let (total, per_pixel) = self.plan(cx, &slots)?;
+        if sums == Sums::Blend && !cx.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
+            return Err(OitError::Unsupported(
+                "tail = 'blend' blends into float32 targets, which this adapter cannot (FLOAT32_BLENDABLE): use tail = 'exact'".into(),
+            ));
+        }
         let pixels = cx.pixels();
         let overflow = self.overflow.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid overflow"));
         let sizes = [
@@ -100,12 +190,27 @@ impl KTab {
         overflow.clear(&mut enc);
         cx.capture(&mut enc, "store", &cx.capture_pipeline(&shader, "fs_store", own), &b.group);
         cx.dispatch(&mut enc, "visibility", &cx.compute_pipeline(&shader, "cs_visibility", own), &b.group);
-        cx.capture(&mut enc, "shade", &cx.capture_pipeline(&shader, "fs_shade", own), &b.group);
-        cx.resolve(&mut enc, "final", &cx.resolve_pipeline(&shader, "fs_final", own, true), &b.group, true);
+        match sums {
+            Sums::Exact => {
+                cx.capture(&mut enc, "shade", &cx.capture_pipeline(&shader, "fs_shade", own), &b.group);
+                cx.resolve(&mut enc, "final", &cx.resolve_pipeline(&shader, "fs_final", own, true), &b.group, true);
+            }
+            Sums::Blend => {
+                let targets = BlendSums::ensure(&mut self.blend, cx);
+                let groups = vec![Layout::Scene, Layout::Targets, own];
+                let shade = cx.draw_pipeline(&shader, "fs_shade_blend", groups, blend_targets(), crate::pipeline::depth_test_only());
+                cx.capture_into(&mut enc, "shade", &shade, &b.group, &targets.attachments());
+                let fin = cx.resolve_pipeline_groups(&shader, "fs_final_blend", &[own, Layout::Textures(BLEND_BINDINGS)], true);
+                cx.resolve_groups(&mut enc, "final", &fin, &[&b.group, &targets.group], true);
+            }
+        }
         overflow.copy(&mut enc);
         cx.submit(enc);
         let overflow = overflow.read(cx.gpu)?;
-        let memory = if per_pixel { memory_bytes_per_pixel(pixels, total) } else { memory_bytes(pixels, k as u64) };
+        let mut memory = if per_pixel { memory_bytes_per_pixel(pixels, total) } else { memory_bytes(pixels, k as u64) };
+        if sums == Sums::Blend {
+            memory += BLEND_BYTES_PER_PIXEL * cx.targets.width as u64 * cx.targets.height as u64;
+        }
         Ok(MethodReport {
             memory_bytes: memory,
             overflow_fragments: overflow,

@@ -14,8 +14,17 @@ use crate::targets::{read_buffer, storage_buffer};
 
 /// Storage bindings the pool is split across (shaders/common/pool.wgsl).
 pub const POOL_BINDINGS: u64 = 4;
-/// Fragments sorted per sweep of a resolve (shaders/abuffer.wgsl, adaptive.wgsl).
+/// Fragments the submission-order replays select per sweep (shaders/common/select.wgsl).
 pub const BATCH: u32 = 32;
+/// Fragments the exact resolve sorts in a local array at most (shaders/common/sweep.wgsl):
+/// a list no longer takes one walk; a longer one is sorted in runs of RUN, then merged.
+pub const RUN: u32 = 32;
+
+/// The local array of a frame whose deepest pixel has n fragments: the smallest of 8, 16
+/// and RUN that holds it (a smaller array is cheaper to sort and to keep).
+pub fn run_length(n: u64) -> u32 {
+    (n.next_power_of_two() as u32).clamp(8, RUN)
+}
 
 /// The pool's group: heads, allocator, the pool bindings, sweep state and binding 7.
 const POOL_LAYOUT: Layout = Layout::Storage(4 + POOL_BINDINGS as u32);
@@ -83,8 +92,11 @@ impl NodePool {
         }
     }
 
-    pub fn consts(&self) -> [Const; 1] {
-        [Const::U32("NODES_PER_BINDING", self.nodes_per_binding as u32)]
+    /// The pool's shape for its shaders: nodes a binding, and bindings in use (1 lets them
+    /// skip the switch over bindings).
+    pub fn consts(&self) -> [Const; 2] {
+        let split = if self.capacity <= self.nodes_per_binding { 1 } else { POOL_BINDINGS as u32 };
+        [Const::U32("NODES_PER_BINDING", self.nodes_per_binding as u32), Const::U32("POOL_SPLIT", split)]
     }
 
     pub fn max_nodes(&self) -> u64 {
@@ -186,8 +198,9 @@ pub(crate) struct ListMethod {
     shader: &'static str,
     consts: Vec<Const>,
     pool: NodePool,
-    /// Whether the resolve runs `cs_sweep` dispatches before the full-screen pass.
-    sweeps: bool,
+    /// Whether the resolve runs `cs_sweep` dispatches before the full-screen pass, and the
+    /// samples a pixel it composites.
+    sweeps: Option<u32>,
     aux: Aux,
     /// The prefix sum over binding 7, for `Aux::PixelOffsets`, and the pixels it is for.
     scan: Option<(u64, Scan)>,
@@ -197,7 +210,8 @@ struct Pipelines {
     allocate: Option<wgpu::ComputePipeline>,
     count: Option<wgpu::RenderPipeline>,
     capture: wgpu::RenderPipeline,
-    sweep: Option<wgpu::ComputePipeline>,
+    /// The sorted resolve's first dispatch, then the deeper pixels' runs, merges and composite.
+    sweep: Option<[wgpu::ComputePipeline; 4]>,
     resolve: wgpu::RenderPipeline,
 }
 
@@ -208,6 +222,8 @@ pub(crate) struct ListLayout {
     pub node_bytes: u64,
     /// Per-pixel words carried between resolve sweeps; 0 for a single-pass resolve.
     pub state_words: u64,
+    /// Samples a pixel of the sorted resolve (common/sweep.wgsl); unused without sweeps.
+    pub samples: u32,
     /// What binding 7 holds, and so which passes run before capture.
     pub aux: Aux,
 }
@@ -228,7 +244,7 @@ impl ListMethod {
             shader: layout.shader,
             consts: Vec::new(),
             pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.aux),
-            sweeps: layout.state_words > 0,
+            sweeps: (layout.state_words > 0).then_some(layout.samples),
             aux: layout.aux,
             scan: None,
         }
@@ -240,9 +256,11 @@ impl ListMethod {
     }
 
     /// This frame's pipelines, from the device's cache.
-    fn pipelines(&self, cx: &FrameCtx<'_>) -> Pipelines {
+    fn pipelines(&self, cx: &FrameCtx<'_>, run: u32) -> Pipelines {
         let mut consts = self.pool.consts().to_vec();
         consts.push(Const::U32("BATCH", BATCH));
+        consts.push(Const::U32("RUN", run));
+        consts.push(Const::U32("STEP_BUDGET", step_budget(cx.gpu) as u32));
         consts.extend(self.consts.iter().copied());
         let shader = ShaderKey::new(self.shader, &consts);
         let compute = |entry| cx.compute_pipeline(&shader, entry, POOL_LAYOUT);
@@ -250,7 +268,7 @@ impl ListMethod {
             allocate: matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate")),
             count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(&shader, "fs_count", POOL_LAYOUT)),
             capture: cx.capture_pipeline(&shader, "fs_capture", POOL_LAYOUT),
-            sweep: self.sweeps.then(|| compute("cs_sweep")),
+            sweep: self.sweeps.map(|_| ["cs_sort", "cs_runs", "cs_merge", "cs_composite"].map(compute)),
             resolve: cx.resolve_pipeline(&shader, "fs_resolve", POOL_LAYOUT, false),
         }
     }
@@ -281,7 +299,6 @@ impl ListMethod {
     }
 
     pub fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        let p = self.pipelines(cx);
         let tile = cx.tile;
         let pixels = cx.pixels();
         cx.check_per_pixel(
@@ -296,8 +313,7 @@ impl ListMethod {
             (false, 0) => pixels.min(self.pool.max_nodes()),
             (false, c) => c,
         };
-        // A list of n fragments takes floor(n / BATCH) + 1 sweeps (the last one finds it empty).
-        let sweeps = cx.max_depth_complexity / BATCH + 1;
+        let sweeps = self.sweeps.map_or([0; 3], |samples| resolve_dispatches(cx.gpu, cx.max_depth_complexity as u64, samples as u64));
         let triangles = cx.scene.transparent.triangles as u64;
         self.pool.reserve(cx.gpu, initial, pixels, triangles, tiled)?;
         if self.aux == Aux::PixelOffsets && self.scan.as_ref().is_none_or(|(p, _)| *p != pixels) {
@@ -307,6 +323,7 @@ impl ListMethod {
         let targets_group = cx.targets_group();
         loop {
             cx.timer.reset();
+            let p = self.pipelines(cx, run_length(cx.max_depth_complexity as u64));
             let group = self.pool.group.as_ref().expect("reserved above");
             let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
             self.pool.clear(cx.gpu, &mut enc);
@@ -330,17 +347,16 @@ impl ListMethod {
             }
             cx.capture(&mut enc, "capture", &p.capture, group);
             self.pool.copy_count(&mut enc);
-            if let Some(sweep) = &p.sweep {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("list sweeps"),
-                    timestamp_writes: cx.timer.compute_pass("sweeps"),
-                });
-                pass.set_pipeline(sweep);
-                pass.set_bind_group(0, cx.scene.transparent.group(), &[]);
-                pass.set_bind_group(1, targets_group, &[]);
-                pass.set_bind_group(2, group, &[]);
-                for _ in 0..sweeps {
-                    pass.dispatch_workgroups(tile.width.div_ceil(8), tile.height.div_ceil(8), 1);
+            if let Some([sort, phases @ ..]) = &p.sweep {
+                cx.dispatch(&mut enc, "sort", sort, group);
+                for ((label, pipeline), n) in ["runs", "merge", "composite"].into_iter().zip(phases).zip(sweeps) {
+                    if n > 0 {
+                        let timestamp_writes = cx.timer.compute_pass(label);
+                        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
+                        for _ in 0..n {
+                            cx.bind_dispatch(&mut pass, pipeline, group);
+                        }
+                    }
                 }
             }
             cx.resolve(&mut enc, "resolve", &p.resolve, group, false);
@@ -362,7 +378,7 @@ impl ListMethod {
                 }
                 let extra = vec![
                     ("pool_regrown", regrown),
-                    ("resolve_sweeps", if p.sweep.is_some() { sweeps as f64 } else { 1.0 }),
+                    ("resolve_sweeps", if p.sweep.is_some() { 1.0 + sweeps.iter().sum::<u32>() as f64 } else { 1.0 }),
                     ("pool_nodes", count as f64),
                 ];
                 return Ok(MethodReport { memory_bytes: memory, extra, ..Default::default() });
@@ -379,32 +395,51 @@ impl ListMethod {
 }
 
 /// Words of per-pixel sweep state at one sample a pixel (STATE_WORDS in
-/// shaders/common/sweep.wgsl: 8 + 4 per sample).
+/// shaders/common/sweep.wgsl: 12 + 4 per sample).
 pub(crate) const STATE_WORDS: u64 = state_words(1);
 
 pub(crate) const fn state_words(samples: u32) -> u64 {
-    8 + 4 * samples as u64
+    12 + 4 * samples as u64
 }
 
-/// Loop iterations of one sweep over a list of n fragments, at worst: one per node and
-/// log2(BATCH) heap steps per node kept, then the batch's heap sort.
-pub fn sweep_iterations(n: u64) -> u64 {
-    let log = BATCH.ilog2() as u64;
-    n * (1 + log) + BATCH as u64 * (log + 1)
-}
+/// Bytes a pixel of a sorted-resolve method keeps besides its pool: its head and sweep state.
+pub(crate) const PIXEL_BYTES: u64 = 4 + 4 * STATE_WORDS;
 
-/// Refuses a frame whose deepest pixel one sweep could not walk on llvmpipe.
-pub(crate) fn check_sweep_budget(cx: &FrameCtx<'_>) -> Result<()> {
-    let n = cx.frame_max_depth_complexity as u64;
-    if loop_limited(cx.gpu) && sweep_iterations(n) > LLVMPIPE_LOOP_LIMIT {
-        return Err(OitError::Unsupported(format!(
-            "a pixel has {n} transparent fragments; on llvmpipe one resolve sweep handles at most about {} \
-             (the driver ends a shader's loops after {LLVMPIPE_LOOP_LIMIT} iterations): use a hardware adapter, \
-             fewer layers, or a bounded method such as hybrid",
-            (LLVMPIPE_LOOP_LIMIT - BATCH as u64 * 6) / 6
-        )));
+/// Steps one invocation of the sorted resolve takes before it pauses until the next dispatch:
+/// on llvmpipe, whose loop limiter counts them, its limit less the largest unit of work (a
+/// run of RUN sorted and composited, under 1,000); large elsewhere. The image does not
+/// depend on it.
+pub fn step_budget(gpu: &GpuContext) -> u64 {
+    if loop_limited(gpu) {
+        LLVMPIPE_LOOP_LIMIT - 4096
+    } else {
+        1 << 22
     }
-    Ok(())
+}
+
+/// Steps of each phase of the sorted resolve (shaders/common/sweep.wgsl, whose step counts
+/// this mirrors) after its first dispatch, on a pixel of n fragments at `samples` samples, at
+/// most: the further runs of RUN loaded, insertion-sorted and relinked; ceil(log2(runs))
+/// merge passes of two steps a node and two a pair; the composite walk. Zero for a list of
+/// one run, which the first dispatch composites.
+pub fn resolve_steps(n: u64, samples: u64) -> [u64; 3] {
+    const LOAD: u64 = 3;
+    const LINK: u64 = 2;
+    const MERGE: u64 = 6;
+    let run = RUN as u64;
+    if n <= run {
+        return [0; 3];
+    }
+    let sort = LOAD * (run + 1) + (run - 1) * (run + 2) / 2 + LINK * run;
+    let runs = n.div_ceil(run);
+    let passes = runs.next_power_of_two().ilog2() as u64;
+    [(runs - 1) * sort, passes * MERGE * (2 * n + 2 * runs), (n + 1) * (4 + samples)]
+}
+
+/// Dispatches of each phase after `cs_sort` (runs, merge, composite) that finish a frame
+/// whose deepest pixel has n fragments.
+pub fn resolve_dispatches(gpu: &GpuContext, n: u64, samples: u64) -> [u32; 3] {
+    resolve_steps(n, samples).map(|steps| steps.div_ceil(step_budget(gpu)) as u32)
 }
 
 /// Refuses a frame whose deepest pixel the one-invocation replay of a submission-order

@@ -28,7 +28,13 @@ pub const INFO: MethodInfo = MethodInfo {
         Box::new(Mlab(ListMethod::new(
             gpu,
             limits,
-            ListLayout { shader: "mlab.wgsl", node_bytes: std::mem::size_of::<PrimNode>() as u64, state_words: 0, aux: Aux::None },
+            ListLayout {
+                shader: "mlab.wgsl",
+                node_bytes: std::mem::size_of::<PrimNode>() as u64,
+                state_words: 0,
+                samples: 1,
+                aux: Aux::None,
+            },
         )))
     },
 };

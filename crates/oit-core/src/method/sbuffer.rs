@@ -5,8 +5,8 @@
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::lists::{check_sweep_budget, STATE_WORDS};
 use super::lists::{Aux, ListLayout, ListMethod};
+use super::lists::{PIXEL_BYTES, STATE_WORDS};
 use crate::error::Result;
 use crate::gpu_types::PoolNode;
 
@@ -20,9 +20,9 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { formula: "24 B/fragment + 56 B/pixel + scan sums" },
+    memory: Memory::Scene { formula: "24 B/fragment + 72 B/pixel + scan sums" },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: 60, per_fragment: 24, per_triangle: 0 },
+    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES + 8, per_fragment: 24, per_triangle: 0 },
     create: |gpu, limits| {
         Box::new(SBuffer(ListMethod::new(
             gpu,
@@ -31,6 +31,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 shader: "sbuffer.wgsl",
                 node_bytes: std::mem::size_of::<PoolNode>() as u64,
                 state_words: STATE_WORDS,
+                samples: 1,
                 aux: Aux::PixelOffsets,
             },
         )))
@@ -41,7 +42,6 @@ struct SBuffer(ListMethod);
 
 impl Method for SBuffer {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        check_sweep_budget(cx)?;
         self.0.render(cx)
     }
 }
