@@ -38,9 +38,12 @@ fn fs_depth(in: VsOut) {
         return;
     }
     let px = pixel_index(in.clip);
+    // The noise follows the frame's pixel, not the tile's, so tiles do not change it.
+    let at = vec2<u32>(in.clip.xy);
+    let frame_px = at.y * frame.size.x + at.x;
     let key = ~bitcast<u32>(in.clip.z);
     for (var s = 0u; s < SAMPLES; s++) {
-        if covers(in.prim, px, s, in.color.a) {
+        if covers(in.prim, frame_px, s, in.color.a) {
             atomicMax(&samples[px * SAMPLES + s], key);
         }
     }

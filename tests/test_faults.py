@@ -220,10 +220,10 @@ def test_threads_with_their_own_renderers_get_correct_images(renderer):
 
 def test_the_gil_is_released_during_gpu_work(renderer):
     # A CPU-bound Python thread keeps counting while the main thread waits on a long render
-    # (4,000 fragments at one pixel: ~0.3 s of GPU work on lavapipe). Were the GIL held, it
-    # could count only between native calls: close to nothing.
-    deep = stacks(1, 1, 4000, seed=4, alpha=lambda rng, n: rng.uniform(1e-4, 2e-3, n))
-    r = renderer(1, 1)
+    # (4,000 fragments at each of 16 pixels: ~0.3 s of GPU work on lavapipe). Were the GIL
+    # held, it could count only between native calls: close to nothing.
+    deep = stacks(4, 4, 4000, seed=4, alpha=lambda rng, n: rng.uniform(1e-4, 2e-3, n))
+    r = renderer(4, 4)
     r.render(deep.scene, IDENTITY, NAMES[0])  # warm: upload and pipelines
     count, stop = [0], threading.Event()
 

@@ -43,6 +43,14 @@ def test_a_budget_tiles_the_frame_and_the_image_stays(hair_scene, name):
     budget = budget_for(name, untiled)
     r = oit.Renderer(*SIZE, memory_budget=budget)
     fixed = INFO[name]["tiling"].get("per_triangle", 0) * scene._native.triangle_count
+    shared = INFO[name]["tiling"].get("target_bytes_per_pixel", 0) * SIZE[0] * SIZE[1]
+    if shared:
+        # Frame-sized render targets (stochastic's) are shared by the tiles: a budget at or
+        # below them is refused, and the budget is a third of the rest on top of them.
+        with pytest.raises(MemoryError, match="frame-sized render targets"):
+            oit.Renderer(*SIZE, memory_budget=shared).render(scene, camera, name)
+        budget = shared + (untiled.stats["memory_bytes"] - shared) // 3
+        r = oit.Renderer(*SIZE, memory_budget=budget)
     if fixed:
         # Per-triangle data does not shrink with the tile: a budget below it is refused, and
         # the budget is a third of the rest on top of it.

@@ -40,6 +40,7 @@ class _TilingInfo(TypedDict, total=False):
     per_pixel: int  # census only: bytes a pixel, a stored fragment, a transparent triangle
     per_fragment: int
     per_triangle: int
+    target_bytes_per_pixel: int  # formula only: frame-sized render targets the tiles share
 
 class _MethodInfo(TypedDict):
     name: str

@@ -477,15 +477,24 @@ impl Renderer {
                 }
                 return Ok(vec![Tile::frame(w, h)]);
             }
-            Tiling::Formula => {
+            Tiling::Formula { targets } => {
                 let one = info.memory_bytes(1, params, None).unwrap_or(0);
-                let per_pixel = info.memory_bytes(2, params, None).unwrap_or(0) - one;
+                let per_pixel = info.memory_bytes(2, params, None).unwrap_or(0) - one - targets;
+                // Frame-sized render targets, which no tile makes smaller.
+                let shared = targets * w as u64 * h as u64;
+                if shared > 0 && shared >= budget {
+                    return Err(OitError::OutOfMemory(format!(
+                        "'{}' keeps {shared} bytes of frame-sized render targets for a {w} x {h} frame, which no tile \
+                         can make smaller and which pass the memory_budget of {budget} bytes: raise memory_budget",
+                        info.name
+                    )));
+                }
                 // Every buffer of the method within one binding: at most all of a tile's bytes.
                 let fits = binding / per_pixel.max(1);
                 Footprint {
                     per_pixel,
                     per_fragment: 0,
-                    budget: variable(budget.saturating_sub(one - per_pixel)),
+                    budget: variable(budget.saturating_sub(one - per_pixel - targets).saturating_sub(shared)),
                     max_pixels: fits,
                     max_fragments: u64::MAX,
                 }

@@ -45,9 +45,12 @@ pub(crate) fn accumulation_targets(aux: Aux) -> Vec<Option<wgpu::ColorTargetStat
     ]
 }
 
+/// Bytes a pixel of the two targets.
+pub const TARGET_BYTES: u64 = 16 + 4;
+
 /// Bytes of the two targets at `pixels` pixels.
 pub fn memory_bytes(pixels: u64) -> u64 {
-    pixels * (16 + 4)
+    pixels * TARGET_BYTES
 }
 
 /// The accumulation targets of one frame size, and the group a resolve reads them through.
@@ -87,7 +90,8 @@ impl AccumTargets {
     }
 
     /// Records the accumulation pass (timed as "accumulate"): `pipeline` over the transparent
-    /// geometry, tested against the opaque depth, with `groups` bound at 1, 2, ...
+    /// geometry, tested against the opaque depth, scissored to the tile, with `groups` bound
+    /// at 1, 2, ...
     pub fn accumulate(
         &self,
         cx: &mut FrameCtx<'_>,
@@ -114,6 +118,7 @@ impl AccumTargets {
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        cx.tile.scissor(&mut pass);
         pass.set_pipeline(pipeline);
         for (i, g) in groups.iter().enumerate() {
             pass.set_bind_group(1 + i as u32, *g, &[]);

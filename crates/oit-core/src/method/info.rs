@@ -115,8 +115,10 @@ impl Memory {
 /// How the renderer plans a method's screen tiles (tiles.rs, docs/methods.md "Tiles").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tiling {
-    /// By its memory formula (`Memory::Frame`): bytes grow with the tile's pixels.
-    Formula,
+    /// By its memory formula (`Memory::Frame`): bytes grow with the tile's pixels, except
+    /// `targets` bytes a frame pixel of render targets, which are frame-sized and shared by the
+    /// tiles (the formula includes them).
+    Formula { targets: u64 },
     /// From the census: `per_pixel` bytes a pixel and `per_fragment` bytes a stored fragment
     /// (a node of its pool), the pool spread over `lists::POOL_BINDINGS` bindings, and
     /// `per_triangle` bytes of each transparent triangle, whatever the tile.
@@ -129,7 +131,7 @@ pub enum Tiling {
 impl Tiling {
     pub fn name(self) -> &'static str {
         match self {
-            Tiling::Formula => "formula",
+            Tiling::Formula { .. } => "formula",
             Tiling::Storage { .. } => "census",
             Tiling::Whole => "whole",
         }

@@ -36,13 +36,13 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·(4·samples + 20)", bytes: |px, p| memory_bytes(px, p.int("samples") as u64) },
     error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
+    tiling: Tiling::Formula { targets: super::accum::TARGET_BYTES },
     create: |_, _| Box::new(Stochastic { samples: None, targets: None }),
 };
 
 /// Bytes stochastic allocates: `samples` depth words per pixel and two float targets.
 pub fn memory_bytes(pixels: u64, samples: u64) -> u64 {
-    pixels * (samples * 4 + 16 + 4)
+    pixels * (samples * 4 + super::accum::TARGET_BYTES)
 }
 
 struct Stochastic {
@@ -73,6 +73,9 @@ impl Method for Stochastic {
         w.accumulate(cx, &mut enc, Aux::Reveal, &accumulate, &[&cx.targets.group, &b.group]);
         cx.resolve(&mut enc, "resolve", &resolve, &w.group, false);
         cx.submit(enc);
-        Ok(MethodReport { memory_bytes: memory_bytes(pixels, samples as u64), ..Default::default() })
+        // The samples are the tile's; the targets are the frame's, shared by its tiles.
+        let frame_pixels = cx.targets.width as u64 * cx.targets.height as u64;
+        let memory = pixels * samples as u64 * 4 + frame_pixels * super::accum::TARGET_BYTES;
+        Ok(MethodReport { memory_bytes: memory, ..Default::default() })
     }
 }
