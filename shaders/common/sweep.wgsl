@@ -35,7 +35,7 @@ const S_NB: u32 = 7u;
 const S_REST: u32 = 8u;  // and the node after the pair
 const SAMPLE_STATE: u32 = 12u;
 
-const FRESH: u32 = 0u;
+const FRESH: u32 = 0u; // the cleared state: no pass has reached the pixel (fs_resolve: the base)
 const RUNS: u32 = 1u;
 const MERGE: u32 = 2u;
 const COMPOSITE: u32 = 3u;
