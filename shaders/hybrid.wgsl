@@ -53,7 +53,8 @@ fn key_alpha(key: u32) -> f32 {
 }
 
 @fragment
-fn fs_store(in: VsOut) {
+fn fs_store(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }
@@ -126,7 +127,8 @@ fn cs_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 @fragment
-fn fs_shade(in: VsOut) {
+fn fs_shade(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }
