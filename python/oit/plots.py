@@ -266,7 +266,8 @@ def shading_cost(rows: list[dict], path: str) -> None:
             ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", markersize=4,
                     label=f"{method} ({slope:.2f} ms / 100)")
         ax.set_xlabel("shading cost N (extra light evaluations a shaded fragment)")
-        ax.set_ylabel("GPU time (ms)" if key == "gpu_ms" else "wall time per frame (ms)")
+        ax.set_ylabel("GPU time (ms, log)" if key == "gpu_ms" else "wall time per frame (ms, log)")
+        ax.set_yscale("log")  # peeling's many passes would squash the other lines
         ax.set_title(f"{scene} {size}", fontsize=9)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
