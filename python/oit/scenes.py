@@ -18,8 +18,9 @@ import numpy as np
 from . import geometry
 from ._api import Camera, Scene
 
-__all__ = ["BuiltScene", "MeshArrays", "from_meshes", "hair", "smoke", "foliage", "dragons", "glass", "stacks", "ALPHA_KINDS",
-           "DRAGON_ALPHAS", "DRAGON_FILE", "shared_data_dir", "default_dragon_path", "SCENES", "SHOWCASE"]
+__all__ = ["BuiltScene", "MeshArrays", "from_meshes", "is_lit", "unlit", "hair", "smoke", "foliage",
+           "dragons", "glass", "stacks", "ALPHA_KINDS", "DRAGON_ALPHAS", "DRAGON_FILE", "shared_data_dir",
+           "default_dragon_path", "SCENES", "SHOWCASE"]
 
 
 @dataclass
@@ -65,6 +66,18 @@ def from_meshes(meshes: Sequence[MeshArrays], camera: Camera, size: tuple[int, i
     scene.ambient = ambient
     meta = {**(meta or {}), "triangles": scene.triangle_count}
     return BuiltScene(scene, camera, size, meta, list(meshes), lights, ambient)
+
+
+def is_lit(built: BuiltScene) -> bool:
+    """Whether any mesh of `built` has a surface or the scene has lights or ambient light."""
+    return any(m.surface for m in built.meshes) or bool(built.lights) or any(built.ambient)
+
+
+def unlit(built: BuiltScene) -> BuiltScene:
+    """The same meshes with their vertex colors only, no lights: what the peers (pygfx, VTK)
+    draw, and an input whose colors do not vary inside a pixel beyond the vertex colors'."""
+    meshes = [MeshArrays(m.positions, m.indices, m.colors, m.opaque) for m in built.meshes]
+    return from_meshes(meshes, built.camera, built.size, dict(built.meta))
 
 
 def _mesh(positions: np.ndarray, indices: Any, rgba: np.ndarray, opaque: bool = False, **surface: Any) -> MeshArrays:
