@@ -17,7 +17,8 @@ struct Node {
 @group(2) @binding(6) var<storage, read_write> state: array<u32>;
 
 @fragment @early_depth_test(force)
-fn fs_capture(in: VsOut) {
+fn fs_capture(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) {
         return;
     }

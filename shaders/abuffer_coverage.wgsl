@@ -21,7 +21,8 @@ struct Node {
 @group(2) @binding(6) var<storage, read_write> state: array<u32>;
 
 @fragment
-fn fs_capture(in: VsOut, @builtin(sample_mask) coverage: u32) {
+fn fs_capture(raw: VsOut, @builtin(sample_mask) coverage: u32) {
+    let in = shaded(raw);
     // Derivatives first, while every invocation of the quad is still running.
     let slope = vec2<f32>(dpdx(in.clip.z), dpdy(in.clip.z));
     let mask = visible_samples(in.clip, slope, coverage);

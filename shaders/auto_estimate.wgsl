@@ -16,7 +16,8 @@
 // TAU_CAP and the scales TAU_SCALE, TAU2_SCALE, QUANT_SCALE come from crates/oit-core/src/consts.rs.
 
 @fragment @early_depth_test(force)
-fn fs_estimate(in: VsOut) {
+fn fs_estimate(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }

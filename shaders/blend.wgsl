@@ -4,12 +4,14 @@
 //!include common/scene.wgsl
 
 @fragment
-fn fs_blend(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_blend(raw: VsOut) -> @location(0) vec4<f32> {
+    let in = shaded(raw);
     return in.color;
 }
 
 // Colored transmission: the fraction of each channel the surface lets through.
 @fragment
-fn fs_filter(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_filter(raw: VsOut) -> @location(0) vec4<f32> {
+    let in = shaded(raw);
     return vec4<f32>(1.0 - in.color.a * (1.0 - in.color.rgb), in.color.a);
 }

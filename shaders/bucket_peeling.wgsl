@@ -50,7 +50,8 @@ fn fs_keys(in: VsOut) {
 }
 
 @fragment @early_depth_test(force)
-fn fs_shade(in: VsOut) {
+fn fs_shade(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) {
         return;
     }

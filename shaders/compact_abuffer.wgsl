@@ -18,10 +18,13 @@ struct Node {
 
 @group(2) @binding(6) var<storage, read_write> state: array<u32>;
 
-// Mirrors oit_core::gpu_types::PrimShading: clip-space corners and their colors.
+// Mirrors oit_core::gpu_types::PrimShading: clip-space corners and their colors, and (shaded
+// scenes) their shading normals with the material index in w, and UVs.
 struct PrimShading {
     clip: array<vec4<f32>, 3>,
     color: array<vec4<f32>, 3>,
+    normal: array<vec4<f32>, 3>,
+    uv: array<vec2<f32>, 3>,
 }
 @group(2) @binding(7) var<storage, read_write> shading: array<PrimShading>;
 
@@ -35,6 +38,12 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var k = 0u; k < 3u; k++) {
         s.clip[k] = clip_vertex(t, k);
         s.color[k] = colors[indices[3u * t + k]];
+        s.normal[k] = vec4<f32>(0.0);
+        s.uv[k] = vec2<f32>(0.0);
+        if frame.shading.x != 0u {
+            s.normal[k] = attributes[2u * indices[3u * t + k]];
+            s.uv[k] = attributes[2u * indices[3u * t + k] + 1u].xy;
+        }
     }
     shading[chunk.first_triangle + t] = s;
 }
@@ -47,13 +56,21 @@ fn fs_capture(in: VsOut) {
     push_node(pixel_index(in.clip), Node(in.clip.z, 0u, in.prim));
 }
 
-// The node keeps only depth and triangle: its color is interpolated here, at the pixel center.
+// The node keeps only depth and triangle: its color is interpolated and shaded here, at the
+// pixel center (deferred shading: only the fragments the sweep composites are shaded).
 fn node_frag(node: Node, link: u32, px: u32) -> Frag {
     let s = shading[node.prim];
     let at = vec2<f32>(pixel_position(px)) + 0.5;
     let ndc = vec2<f32>(at.x * 2.0 / f32(frame.size.x) - 1.0, 1.0 - at.y * 2.0 / f32(frame.size.y));
     let b = barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
-    let color = clamp(b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2], vec4<f32>(0.0), vec4<f32>(1.0));
+    var f: VsOut;
+    f.clip = vec4<f32>(at, node.depth, 1.0);
+    f.color = b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2];
+    f.prim = node.prim;
+    f.normal = b.x * s.normal[0].xyz + b.y * s.normal[1].xyz + b.z * s.normal[2].xyz;
+    f.uv = b.x * s.uv[0] + b.y * s.uv[1] + b.z * s.uv[2];
+    f.material = bitcast<u32>(s.normal[0].w);
+    let color = clamp(shade(f), vec4<f32>(0.0), vec4<f32>(1.0));
     return Frag(node.depth, color, link);
 }
 

@@ -57,7 +57,8 @@ fn key_alpha(key: u32) -> f32 {
 }
 
 @fragment @early_depth_test(force)
-fn fs_store(in: VsOut) {
+fn fs_store(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }
@@ -167,7 +168,8 @@ fn place(px: u32, z: f32, a: f32) -> Placed {
 }
 
 @fragment @early_depth_test(force)
-fn fs_shade(in: VsOut) {
+fn fs_shade(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }
@@ -204,7 +206,8 @@ struct Shade {
 }
 
 @fragment @early_depth_test(force)
-fn fs_shade_blend(in: VsOut) -> Shade {
+fn fs_shade_blend(raw: VsOut) -> Shade {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         discard;
     }

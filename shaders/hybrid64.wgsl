@@ -44,7 +44,8 @@ fn add_tail(acc: u32, packed: u64) {
 }
 
 @fragment @early_depth_test(force)
-fn fs_insert(in: VsOut) {
+fn fs_insert(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }

@@ -55,7 +55,8 @@ fn cs_init(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 
 @fragment @early_depth_test(force)
-fn fs_peel(in: VsOut) {
+fn fs_peel(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) {
         return;
     }

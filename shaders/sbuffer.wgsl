@@ -30,7 +30,8 @@ fn fs_count(in: VsOut) {
 }
 
 @fragment @early_depth_test(force)
-fn fs_capture(in: VsOut) {
+fn fs_capture(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) {
         return;
     }

@@ -33,7 +33,8 @@ fn covers(prim: u32, px: u32, s: u32, alpha: f32) -> bool {
 }
 
 @fragment @early_depth_test(force)
-fn fs_depth(in: VsOut) {
+fn fs_depth(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }
@@ -55,7 +56,8 @@ struct Accum {
 }
 
 @fragment
-fn fs_accum(in: VsOut) -> Accum {
+fn fs_accum(raw: VsOut) -> Accum {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         discard;
     }

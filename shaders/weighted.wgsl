@@ -16,7 +16,8 @@ struct Accum {
 }
 
 @fragment
-fn fs_sum(in: VsOut) -> Accum {
+fn fs_sum(raw: VsOut) -> Accum {
+    let in = shaded(raw);
     if in.color.a <= 0.0 { discard; }
     let a = in.color.a;
     return Accum(vec4<f32>(in.color.rgb * a, a), vec4<f32>(1.0, 0.0, 0.0, 0.0));
@@ -35,7 +36,8 @@ fn wboit_weight(z: f32, w: f32, a: f32) -> f32 {
 }
 
 @fragment
-fn fs_wboit(in: VsOut) -> Accum {
+fn fs_wboit(raw: VsOut) -> Accum {
+    let in = shaded(raw);
     if in.color.a <= 0.0 { discard; }
     let a = in.color.a;
     let w = wboit_weight(in.clip.z, in.view_w, a);

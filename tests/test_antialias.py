@@ -109,9 +109,15 @@ def test_every_exact_method_antialiases_to_the_same_image(renderer, method):
     assert np.abs(frame.image - exact.image).max() <= 2e-6
 
 
-def test_the_antialiasing_benchmark_reports_ratios_to_one_sample():
+def test_the_antialiasing_benchmark_reports_ratios_to_one_sample(monkeypatch):
+    from oit import scenes
     from oit.bench import antialias, harness
 
+    # Glass unlit, as it was: coverage masks shade once per pixel (as multisampling does), so
+    # lit glass's highlights, which vary inside a pixel, move coverage away from four sample
+    # frames by more than the 0.01 checked here (0.018 measured at 16 x 16).
+    lit_glass = scenes.SCENES["glass"]
+    monkeypatch.setitem(scenes.SCENES, "glass", lambda **kw: scenes.unlit(lit_glass(**kw)))
     result = antialias.antialias(["glass"], ["abuffer", "hybrid"], sizes=[16], samples=(4,), repeat=1, quick=True,
                              show_progress=False)
     rows = {(r["method"], r["antialias"], r["mode"]): r for r in result.rows}

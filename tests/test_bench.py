@@ -423,3 +423,20 @@ def test_cli_scale_writes_tables_and_no_plots(tmp_path):
     table = (out / "scale.md").read_text()
     assert table.startswith("Adapter: ") and "## Slopes" in table and "slope: the least-squares slope" in table
     assert not list(out.glob("*.png"))
+
+
+# ---- shading cost
+
+def test_shading_cost_sweep_keeps_the_image_and_measures_each_method():
+    from oit.bench import shading
+
+    result = shading.shading_cost(["glass"], ["abuffer", "compact_abuffer", "hybrid"], sizes=[24], costs=(8,), repeat=1,
+                                  quick=True, show_progress=False)
+    rows = result.rows
+    assert [(r["method"], r["shading_cost"]) for r in rows] == [(m, c) for m in ("abuffer", "compact_abuffer", "hybrid")
+                                                              for c in (0, 8)]
+    for r in rows:
+        assert r["status"] == "ok" and r["same_image"] is True, r
+        assert math.isfinite(r["ms_per_100"]) and r["wall_ms"] > 0
+    assert {r["method"]: r["shadings"] for r in rows} == {"abuffer": "1", "compact_abuffer": "stored only (deferred)",
+                                                          "hybrid": "2"}

@@ -46,15 +46,15 @@ def test_exact_methods_with_hundreds_of_layers(renderer, method):
 
 
 def test_compact_abuffer_saves_memory_when_triangles_cover_many_pixels(renderer):
-    # A few large triangles: fragments per triangle far above 96 / 12 = 8, where the compact
-    # A-buffer's 12-byte nodes beat 24-byte ones despite 96 bytes of shading per triangle.
+    # A few large triangles: fragments per triangle far above 176 / 12 = 15, where the compact
+    # A-buffer's 12-byte nodes beat 24-byte ones despite 176 bytes of shading data per triangle.
     scene = build_scene([layer(z, (0.5, 0.5, 0.5, 0.3)) for z in (0.2, 0.4, 0.6, 0.8)])
     r = renderer(64, 64)
     full = r.render(scene, IDENTITY, "abuffer").stats
     compact = r.render(scene, IDENTITY, "compact_abuffer").stats
     fragments = full["fragments"]
     # Node pools: 24 vs 12 bytes a fragment; the rest (heads, sweep state) is the same.
-    assert full["memory_bytes"] - compact["memory_bytes"] == 12 * fragments - 96 * 8
+    assert full["memory_bytes"] - compact["memory_bytes"] == 12 * fragments - 176 * 8
 
 
 def test_pall_allocates_a_conservative_bound(renderer):

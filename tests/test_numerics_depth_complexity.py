@@ -153,3 +153,21 @@ def test_adaptive_is_right_or_refuses_near_its_loop_limit(renderer, nodes, depth
     if loop_limited(r):
         assert outcomes[-1] == "refused"
         assert outcomes == sorted(outcomes, key=lambda o: o == "refused")  # refused only past a threshold
+
+
+def test_deferred_shading_of_deep_pixels_keeps_within_the_loop_budget(renderer):
+    # compact_abuffer shades each fragment at resolve (docs/shading.md): the light loop and
+    # the shading-cost loop count in the sorted resolve's step budget on llvmpipe, so a deep
+    # lit pixel still resolves completely, equal to the A-buffer, which shades at capture.
+    rng = np.random.default_rng(2)
+    scene = oit.Scene()
+    for z in rng.permutation(np.linspace(0.01, 0.99, 3000)):
+        positions = np.array([[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]], dtype=np.float32)
+        color = (*rng.uniform(0, 1, 3), rng.uniform(0.001, 0.01))
+        scene.add_mesh(positions, [[0, 1, 2], [0, 2, 3]], color, normals=np.tile([0.0, 0.3, -1.0], (4, 1)), specular=0.3)
+    r = renderer(2, 2)
+    for cost in (0, 64):
+        exact = r.render(scene, oit.Camera(np.eye(4)), "abuffer", shading_cost=cost, background=tuple(BG))
+        frame = r.render(scene, oit.Camera(np.eye(4)), "compact_abuffer", shading_cost=cost, background=tuple(BG))
+        assert np.abs(frame.image - exact.image).max() <= 2e-6
+        assert frame.stats["extra"]["resolve_sweeps"] > 2

@@ -147,7 +147,7 @@ def test_a_1080p_frame_of_full_screen_layers_in_tiles_equals_the_float64_composi
 # ---- geometry in chunks
 
 
-# Not pall and compact_abuffer: their per-triangle buffers (16 and 96 bytes a triangle) must fit
+# Not pall and compact_abuffer: their per-triangle buffers (16 and 176 bytes a triangle) must fit
 # one binding, a limit of the triangles they can take, refused by name past it.
 @pytest.mark.parametrize("name", ["abuffer", "hybrid", "sorted", "wboit", "depth_peeling", "adaptive"])
 def test_geometry_past_a_binding_is_drawn_in_chunks_with_the_same_image(name):

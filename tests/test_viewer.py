@@ -90,6 +90,24 @@ def assert_matches(shot: np.ndarray, frame_image: np.ndarray) -> None:
         f"{(diff > 0).sum()} of {diff.size} pixels differ, by up to {diff.max()} levels"
 
 
+def test_scene_files_keep_surfaces_and_lights(tmp_path):
+    built = scenes.glass(detail=8)
+    path = tmp_path / "glass.oitscene"
+    scenefile.save_scene(built, path)
+    meshes, camera, _ = scenefile.load_scene(path)
+    lights, ambient = scenefile.load_lights(path)
+    assert path.read_bytes()[8:12] == (2).to_bytes(4, "little")
+    assert [m.surface["shading"] for m in meshes] == ["smooth", "flat", "smooth", "smooth"]
+    assert len(lights) == 2 and ambient == pytest.approx(built.ambient)
+    r = oit.Renderer(24, 24)
+    same = scenefile.scene_of(meshes, lights, ambient)
+    assert np.array_equal(r.render(same, camera).image, r.render(built.scene, built.camera).image)
+    # Without surfaces or lights, the file stays version 1 (older viewers read it).
+    plain = [scenes.MeshArrays(m.positions, m.indices, m.colors, m.opaque) for m in built.meshes]
+    scenefile.save_scene(plain, path)
+    assert path.read_bytes()[8:12] == (1).to_bytes(4, "little")
+
+
 def test_scene_file_round_trip(tmp_path):
     built = scenes.glass(detail=8)
     path = tmp_path / "glass.oitscene"

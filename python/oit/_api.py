@@ -44,6 +44,82 @@ _U32_MAX = 2 ** 32 - 1
 _I64_MAX = 2 ** 63 - 1
 
 
+def _number(value: Any, name: str) -> float:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a number, got {type(value).__name__}")
+    v = float(value)
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {v}")
+    return v
+
+
+def _vector(value: Any, n: int, name: str) -> np.ndarray:
+    a = _float_array(value, name)
+    if a.shape != (n,):
+        raise ValueError(f"{name} must be {n} numbers, got shape {a.shape}")
+    return a
+
+
+SHADINGS = ("unlit", "flat", "smooth")
+
+
+def _texture(texture: Any) -> np.ndarray:
+    """(h, w, 4) float32 linear RGBA: uint8 is decoded from sRGB (alpha stays linear)."""
+    t = np.asarray(texture)
+    if t.ndim != 3 or t.shape[2] != 4 or t.shape[0] == 0 or t.shape[1] == 0:
+        raise ValueError(f"texture must have shape (h, w, 4) (straight RGBA), got {t.shape}: add an alpha channel "
+                         "of 1 (or 255) to an RGB image")
+    if t.dtype == np.uint8:
+        out = t.astype(np.float64) / 255.0
+        out[..., :3] = _srgb_to_linear(out[..., :3])
+        return np.ascontiguousarray(out, dtype=np.float32)
+    out = _float_array(t, "texture")
+    if out.min() < 0.0 or out.max() > 1.0:
+        raise ValueError(f"a float texture must be linear RGBA in [0, 1], got values in [{out.min():g}, {out.max():g}]: "
+                         "clip it, or pass uint8 sRGB")
+    return out
+
+
+def _surface(n: int, normals: Any, uvs: Any, texture: Any, shading: str | None, specular: float, shininess: float,
+             opacity: float, two_sided: bool) -> dict[str, Any]:
+    """The keyword arguments of the native add_mesh that describe the surface, checked."""
+    out: dict[str, Any] = {}
+    if normals is not None:
+        nrm = _float_array(normals, "normals")
+        if nrm.shape != (n, 3):
+            raise ValueError(f"normals must have shape ({n}, 3) (one per vertex), got {nrm.shape}")
+        zero = np.flatnonzero(~np.any(nrm, axis=1))
+        if len(zero):
+            raise ValueError(f"normals[{zero[0]}] is zero: pass unit vertex normals, or none to have them computed")
+        out["normals"] = nrm
+    if uvs is not None:
+        uv = _float_array(uvs, "uvs")
+        if uv.shape != (n, 2):
+            raise ValueError(f"uvs must have shape ({n}, 2) (one (u, v) per vertex), got {uv.shape}")
+        out["uvs"] = uv
+    if texture is not None:
+        if uvs is None:
+            raise ValueError("a texture needs uvs: pass one (u, v) per vertex")
+        out["texture"] = _texture(texture)
+    if shading is None:
+        shading = "smooth" if normals is not None else "unlit"
+    if not isinstance(shading, str) or shading not in SHADINGS:
+        raise ValueError(f"shading must be one of {SHADINGS}, got {shading!r}")
+    out["shading"] = shading
+    for name, v in (("specular", specular), ("shininess", shininess), ("opacity", opacity)):
+        out[name] = _number(v, name)
+    if out["specular"] < 0:
+        raise ValueError(f"specular must be >= 0, got {specular}")
+    if out["shininess"] <= 0:
+        raise ValueError(f"shininess must be > 0, got {shininess}")
+    if not 0.0 <= out["opacity"] <= 1.0:
+        raise ValueError(f"opacity must be in [0, 1], got {opacity}")
+    if not isinstance(two_sided, (bool, np.bool_)):
+        raise TypeError(f"two_sided must be a bool, got {type(two_sided).__name__}")
+    out["two_sided"] = bool(two_sided)
+    return out
+
+
 class Scene:
     """Meshes in submission order. Transparent meshes are composited by the chosen method;
     opaque meshes render first and occlude what lies behind them."""
@@ -51,12 +127,24 @@ class Scene:
     def __init__(self) -> None:
         self._native = _oit.Scene()
 
-    def add_mesh(self, positions: Any, indices: Any, colors: Any, opaque: bool = False) -> int:
+    def add_mesh(self, positions: Any, indices: Any, colors: Any, opaque: bool = False, *, normals: Any = None,
+                 uvs: Any = None, texture: Any = None, shading: str | None = None, specular: float = 0.0,
+                 shininess: float = 32.0, opacity: float = 1.0, two_sided: bool = True) -> int:
         """Adds a triangle mesh and returns its index.
 
         positions: (n, 3) float; indices: (m, 3) non-negative integers below n (converted to
         uint32 after range checks); colors: (n, 4) per vertex or (4,) for the whole mesh,
         straight (not premultiplied) linear RGBA in [0, 1].
+
+        The surface (docs/shading.md): `normals` (n, 3) per vertex, `uvs` (n, 2) per vertex,
+        `texture` (h, w, 4) straight RGBA -- float in [0, 1] taken as linear, or uint8 taken as
+        sRGB color with linear alpha -- sampled bilinearly with repeat wrap, row 0 at v = 0.
+        `shading`: "unlit" (the vertex color), "flat" (the triangle's normal) or "smooth"
+        (interpolated vertex normals, computed angle-weighted when `normals` is None); the
+        default is "smooth" when `normals` is given, else "unlit". `specular` >= 0 and
+        `shininess` > 0 weigh a Blinn-Phong highlight; `opacity` in [0, 1] multiplies alpha;
+        `two_sided` turns the normal towards the viewer (else the back is lit as the front's
+        reverse side, and stays drawn).
         """
         pos = _rows(_float_array(positions, "positions"), 3, "positions")
         idx = np.asarray(indices)
@@ -84,7 +172,47 @@ class Scene:
             )
         if not isinstance(opaque, (bool, np.bool_)):
             raise TypeError(f"opaque must be a bool, got {type(opaque).__name__}")
-        return self._native.add_mesh(pos, idx, col, bool(opaque))
+        surface = _surface(len(pos), normals, uvs, texture, shading, specular, shininess, opacity, two_sided)
+        return self._native.add_mesh(pos, idx, col, bool(opaque), **surface)
+
+    def add_light(self, direction: Sequence[float], color: Sequence[float] = (1.0, 1.0, 1.0), intensity: float = 1.0) -> int:
+        """Adds a directional light travelling along `direction` (world space: L is
+        -normalize(direction)) with linear RGB `color` times `intensity`; returns its index. With
+        no light added, one white headlight travels along the camera's view direction."""
+        d = _vector(direction, 3, "direction")
+        if not np.any(d):
+            raise ValueError("light direction must be non-zero: it is the direction in which the light travels")
+        c = _vector(color, 3, "color")
+        if c.min() < 0:
+            raise ValueError(f"light color must be linear RGB >= 0, got {tuple(c)}")
+        i = _number(intensity, "intensity")
+        if i < 0:
+            raise ValueError(f"light intensity must be >= 0, got {i}")
+        if len(self.lights) >= _CONSTANTS["MAX_LIGHTS"]:
+            raise ValueError(f"a scene holds at most {_CONSTANTS['MAX_LIGHTS']} lights: merge some")
+        return self._native.add_light(tuple(d), tuple(c), i)
+
+    def clear_lights(self) -> None:
+        """Removes every light added (the headlight shines again)."""
+        self._native.clear_lights()
+
+    @property
+    def lights(self) -> list[tuple[tuple[float, ...], tuple[float, ...], float]]:
+        """(direction, color, intensity) of each light added."""
+        return [(tuple(d), tuple(c), i) for d, c, i in self._native.lights]
+
+    @property
+    def ambient(self) -> tuple[float, float, float]:
+        """The ambient light, linear RGB added to every lit fragment's diffuse term (default 0)."""
+        a = self._native.ambient
+        return (a[0], a[1], a[2])
+
+    @ambient.setter
+    def ambient(self, rgb: Sequence[float]) -> None:
+        a = _vector(rgb, 3, "ambient")
+        if a.min() < 0:
+            raise ValueError(f"ambient must be linear RGB >= 0, got {tuple(a)}")
+        self._native.set_ambient(tuple(a))
 
     def set_mesh_alpha(self, mesh: int, alpha: float) -> None:
         """Sets every vertex alpha of one mesh."""
@@ -104,62 +232,167 @@ class Scene:
         return self._native.triangle_count
 
     @classmethod
-    def from_trimesh(cls, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False) -> Scene:
-        """A scene from a trimesh Trimesh or Scene. Colors come from vertex colors, face
-        colors or material alpha when present (sRGB 8-bit colors are linearized); `color`
-        (RGB or RGBA) and `alpha` override them."""
+    def from_trimesh(cls, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False,
+                     *, shading: str = "smooth", specular: float = 0.0, shininess: float = 32.0,
+                     two_sided: bool = True) -> Scene:
+        """A scene from a trimesh Trimesh or Scene, lit (docs/shading.md). Colors come from
+        vertex colors, face colors or the material (sRGB 8-bit colors are linearized; a PBR
+        baseColorFactor is linear, as glTF has it); texture visuals bring their UVs and image
+        (PBR baseColorTexture or the material image). glTF alphaMode is honoured: OPAQUE gives
+        an opaque mesh, MASK keeps what passes alphaCutoff (alpha 0 or 1, per texel), BLEND
+        and meshes without one are transparent. `color` (RGB or RGBA) and `alpha` override
+        the colors; `shading` ("smooth" with the mesh's vertex normals by default, "flat" or
+        "unlit"), `specular`, `shininess` and `two_sided` apply to every mesh."""
         scene = cls()
-        scene.add_trimesh(obj, alpha=alpha, color=color, opaque=opaque)
+        scene.add_trimesh(obj, alpha=alpha, color=color, opaque=opaque, shading=shading, specular=specular,
+                          shininess=shininess, two_sided=two_sided)
         return scene
 
-    def add_trimesh(self, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False) -> None:
+    def add_trimesh(self, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False,
+                    *, shading: str = "smooth", specular: float = 0.0, shininess: float = 32.0,
+                    two_sided: bool = True) -> None:
         import trimesh
 
+        if shading not in SHADINGS:
+            raise ValueError(f"shading must be one of {SHADINGS}, got {shading!r}")
         meshes = obj.dump() if isinstance(obj, trimesh.Scene) else [obj]
         for m in meshes:
             if not isinstance(m, trimesh.Trimesh):
                 continue
-            positions, faces, colors = _trimesh_arrays(m)
+            t = _trimesh_arrays(m)
+            colors = t.colors
             if color is not None:
                 c = np.asarray(color, dtype=np.float64)
                 if c.shape not in ((3,), (4,)):
                     raise ValueError(f"color must be RGB or RGBA, got shape {c.shape}")
-                colors = np.tile(np.append(c, colors[:, 3:4].mean() if c.shape == (3,) else c[3])[:4], (len(positions), 1))
+                colors = np.tile(np.append(c, colors[:, 3:4].mean() if c.shape == (3,) else c[3])[:4], (len(t.positions), 1))
             if alpha is not None:
                 if not 0.0 <= float(alpha) <= 1.0:
                     raise ValueError(f"alpha must be in [0, 1], got {alpha}")
                 colors[:, 3] = float(alpha)
-            self.add_mesh(positions, faces, colors, opaque=opaque)
+            self.add_mesh(t.positions, t.faces, colors, opaque=opaque or t.opaque,
+                          normals=t.normals if shading == "smooth" else None, uvs=t.uvs, texture=t.texture,
+                          shading=shading, specular=specular, shininess=shininess, two_sided=two_sided)
 
 
 def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
 
 
-def _trimesh_arrays(m: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+@dataclass
+class _TrimeshArrays:
+    positions: np.ndarray
+    faces: np.ndarray
+    colors: np.ndarray  # linear straight RGBA per vertex
+    normals: np.ndarray | None = None
+    uvs: np.ndarray | None = None  # row 0 of the texture at v = 0 (trimesh's v flipped)
+    texture: np.ndarray | None = None  # uint8 sRGB or float linear (h, w, 4)
+    opaque: bool = False
+
+
+def _unit_normals(n: Any, count: int) -> np.ndarray | None:
+    """Vertex normals with zero or non-finite rows replaced by +z (unreferenced vertices)."""
+    try:
+        n = np.array(n, dtype=np.float64)
+    except Exception:
+        return None
+    if n.shape != (count, 3):
+        return None
+    length = np.linalg.norm(n, axis=1)
+    bad = ~np.isfinite(length) | (length < 1e-12)
+    n[bad] = (0.0, 0.0, 1.0)
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def _rgba_image(image: Any) -> np.ndarray | None:
+    if image is None:
+        return None
+    try:
+        a = np.asarray(image.convert("RGBA") if hasattr(image, "convert") else image)
+    except Exception:
+        return None
+    if a.ndim == 2:
+        a = np.stack([a, a, a, np.full_like(a, 255 if a.dtype == np.uint8 else 1)], -1)
+    if a.ndim != 3 or a.shape[2] not in (3, 4) or a.size == 0:
+        return None
+    if a.shape[2] == 3:
+        a = np.concatenate([a, np.full((*a.shape[:2], 1), 255 if a.dtype == np.uint8 else 1, a.dtype)], -1)
+    return np.array(a, order="C")  # a writable copy: alphaMode edits it
+
+
+def _trimesh_arrays(m: Any) -> _TrimeshArrays:
     positions = np.asarray(m.vertices, dtype=np.float32)
     faces = np.asarray(m.faces, dtype=np.int64)
     rgba = np.tile([0.8, 0.8, 0.8, 1.0], (len(positions), 1))
+    # Normals the file brought (trimesh computes missing ones slowly without scipy: the core
+    # computes them instead, angle-weighted, when none are passed).
+    cache = getattr(m, "_cache", None)
+    has_normals = cache is not None and "vertex_normals" in cache and len(faces)
+    normals = _unit_normals(m.vertex_normals, len(positions)) if has_normals else None
+    uvs = texture = None
+    opaque = False
     visual = getattr(m, "visual", None)
     kind = getattr(visual, "kind", None)
+    linear_rgb = False
     if kind == "vertex":
         rgba = np.asarray(visual.vertex_colors, dtype=np.float64) / 255.0
     elif kind == "face":
         # One color per face: split vertices so that each face keeps its own color.
         fc = np.asarray(visual.face_colors, dtype=np.float64) / 255.0
-        positions = positions[faces.reshape(-1)]
+        corner = faces.reshape(-1)
+        if normals is None and len(faces):
+            from .geometry import vertex_normals
+
+            normals = _unit_normals(vertex_normals(positions, faces), len(positions))
+        positions = positions[corner]
+        normals = normals[corner] if normals is not None else None
         faces = np.arange(len(positions)).reshape(-1, 3)
         rgba = np.repeat(fc, 3, axis=0)
     elif kind == "texture" and hasattr(visual, "material"):
         mat = visual.material
         base = getattr(mat, "baseColorFactor", None)
-        if base is None:
+        if base is not None:
+            linear_rgb = True  # glTF: the factor is linear
+        else:
             base = getattr(mat, "main_color", None)
         if base is not None:
-            rgba = np.tile(np.asarray(base, dtype=np.float64) / (255.0 if np.max(base) > 1 else 1.0), (len(positions), 1))
+            base = np.asarray(base, dtype=np.float64)
+            base = base / (255.0 if base.max() > 1 else 1.0)
+            rgba = np.tile(np.append(base, 1.0)[:4] if base.shape == (3,) else base, (len(positions), 1))
+        image = getattr(mat, "baseColorTexture", None)
+        if image is None:
+            image = getattr(mat, "image", None)
+        uv = getattr(visual, "uv", None)
+        if image is not None and uv is not None and np.shape(uv) == (len(positions), 2):
+            texture = _rgba_image(image)
+            if texture is not None:
+                if not linear_rgb:
+                    # A plain material's diffuse color (trimesh's default grey when the file has
+                    # none) is not applied over its image, as trimesh's viewer shows it.
+                    rgba[:, :3] = 1.0
+                uvs = np.asarray(uv, dtype=np.float64).copy()
+                uvs[:, 1] = 1.0 - uvs[:, 1]  # trimesh's v points up the image; row 0 is v = 0 here
+                uvs = uvs.astype(np.float32)
+        mode = str(getattr(mat, "alphaMode", None) or "").upper()
+        if mode == "OPAQUE":
+            opaque = True
+            rgba[:, 3] = 1.0
+            if texture is not None:
+                texture[..., 3] = 255 if texture.dtype == np.uint8 else 1.0
+        elif mode == "MASK":
+            cutoff = getattr(mat, "alphaCutoff", None)
+            cutoff = 0.5 if cutoff is None else float(cutoff)
+            if texture is not None:
+                # Per texel (bilinear filtering then softens the cut's edges over a texel).
+                a = texture[..., 3].astype(np.float64) / (255.0 if texture.dtype == np.uint8 else 1.0)
+                texture[..., 3] = np.where(a * rgba[0, 3] >= cutoff, 255 if texture.dtype == np.uint8 else 1.0, 0)
+                rgba[:, 3] = 1.0
+            else:
+                rgba[:, 3] = np.where(rgba[:, 3] >= cutoff, 1.0, 0.0)
     rgba = rgba.copy()
-    rgba[:, :3] = _srgb_to_linear(rgba[:, :3])
-    return positions, faces, rgba
+    if not linear_rgb:
+        rgba[:, :3] = _srgb_to_linear(rgba[:, :3])
+    return _TrimeshArrays(positions, faces, np.clip(rgba, 0.0, 1.0), normals, uvs, texture, opaque)
 
 
 class Camera:
@@ -340,13 +573,15 @@ class Renderer:
 
     def render(self, scene: Scene, camera: Camera, method: str = "abuffer",
                background: Sequence[float] = (1.0, 1.0, 1.0), antialias: int = 1, antialias_mode: str = "frames",
-               **params: Any) -> Frame:
+               shading_cost: int = 0, **params: Any) -> Frame:
         """Renders `scene` with `method` (see `oit.methods()`); parameters go as keywords.
         `antialias` S in (1, 2, 4, 8, 16): S samples a pixel on the standard pattern. With
         antialias_mode "frames" each sample is a frame of its own with the method's buffers
         reused, averaged (any method; memory as at one sample, time about S times); with
         "coverage" (abuffer, S = 4) the transparent geometry is rasterized once, multisampled,
-        and each stored fragment keeps its sample mask (docs/methods.md, "Antialiasing")."""
+        and each stored fragment keeps its sample mask (docs/methods.md, "Antialiasing").
+        `shading_cost` N: every shaded fragment evaluates N extra lights whose result is
+        discarded, so the image is unchanged and shading costs more (docs/shading.md)."""
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be an oit.Scene, got {type(scene).__name__}")
         if not isinstance(camera, Camera):
@@ -356,8 +591,11 @@ class Renderer:
         bg = _background(background)
         if not isinstance(antialias_mode, str):
             raise TypeError(f"antialias_mode must be 'frames' or 'coverage', got {antialias_mode!r}")
+        cost = _int(shading_cost, "shading_cost", "an int (extra light evaluations per fragment)")
+        if not 0 <= cost <= 65536:
+            raise ValueError(f"shading_cost must be in [0, 65536], got {cost}")
         image, dc, stats, bound = self._native.render(scene._native, camera.view_proj, method, bg, params,
-                                                      _antialias(antialias), antialias_mode)
+                                                      _antialias(antialias), antialias_mode, cost)
         stats["adapter"] = self.adapter_info["name"]
         if bound is not None:
             stats["error_bound_max"] = float(bound.max()) if bound.size else 0.0

@@ -68,8 +68,29 @@ class Scene:
         indices: npt.NDArray[np.uint32],
         colors: npt.NDArray[np.float32],
         opaque: bool,
+        normals: npt.NDArray[np.float32] | None = None,
+        uvs: npt.NDArray[np.float32] | None = None,
+        texture: npt.NDArray[np.float32] | None = None,
+        shading: str = "unlit",
+        specular: float = 0.0,
+        shininess: float = 32.0,
+        opacity: float = 1.0,
+        two_sided: bool = True,
     ) -> int:
-        """positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32."""
+        """positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
+        surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
+        shading "unlit", "flat" or "smooth"."""
+    def add_light(self, direction: tuple[float, float, float], color: tuple[float, float, float], intensity: float) -> int:
+        """A directional light travelling along `direction` (world space); returns its index."""
+    def clear_lights(self) -> None: ...
+    @property
+    def lights(self) -> list[tuple[list[float], list[float], float]]:
+        """(direction, color, intensity) per light."""
+    @property
+    def ambient(self) -> list[float]: ...
+    def set_ambient(self, rgb: tuple[float, float, float]) -> None: ...
+    def mesh_surfaces(self) -> list[tuple[str, bool]]:
+        """(shading, textured) per mesh."""
     def set_mesh_alpha(self, mesh: int, alpha: float) -> None: ...
     @property
     def mesh_count(self) -> int: ...
@@ -99,6 +120,7 @@ class Renderer:
         params: dict[str, _ParamValue],
         antialias: int = 1,
         antialias_mode: str = "frames",
+        shading_cost: int = 0,
     ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32], dict[str, Any], npt.NDArray[np.float32] | None]:
         """Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict,
         error bound (h, w) float32 or None)."""

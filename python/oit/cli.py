@@ -87,6 +87,14 @@ def _add_render(p: argparse.ArgumentParser) -> None:
                    help="linear RGB in [0, 1] (default: white)")
     p.add_argument("--param", type=parse_param, action="append", default=[], metavar="NAME=VALUE",
                    help="a method parameter; repeat for several")
+    p.add_argument("--shading", choices=("smooth", "flat", "unlit"), default="smooth",
+                   help="smooth (the mesh's vertex normals), flat or unlit (default: %(default)s; docs/shading.md)")
+    p.add_argument("--light", type=float, nargs=3, action="append", default=[], metavar=("DX", "DY", "DZ"),
+                   help="a white directional light travelling along DX DY DZ (world space); repeat for several "
+                        "(default: a headlight along the view)")
+    p.add_argument("--ambient", type=_unit_float, nargs=3, metavar=("R", "G", "B"), default=(0.1, 0.1, 0.1),
+                   help="ambient light, linear RGB (default: %(default)s)")
+    p.add_argument("--specular", type=float, default=0.25, help="Blinn-Phong highlight weight (default: %(default)s)")
     p.add_argument("--adapter", default=None, help="substring of the adapter name (default: OIT_ADAPTER or the best one)")
 
 
@@ -101,7 +109,12 @@ def _render(args: argparse.Namespace) -> int:
     mesh = trimesh.load(args.file, force="mesh")
     if len(mesh.faces) == 0:
         raise ValueError(f"{args.file} has no triangles")
-    scene = Scene.from_trimesh(mesh, alpha=args.alpha)
+    if args.specular < 0:
+        raise ValueError(f"--specular must be >= 0, got {args.specular}")
+    scene = Scene.from_trimesh(mesh, alpha=args.alpha, shading=args.shading, specular=args.specular)
+    for light in args.light:
+        scene.add_light(light)
+    scene.ambient = tuple(args.ambient)
     width, height = args.size
     camera = Camera.fit(mesh.vertices, aspect=width / height)
     params: dict[str, Any] = dict(args.param)
@@ -114,7 +127,9 @@ def _render(args: argparse.Namespace) -> int:
     write_png(output, frame.image[..., :3])
     s = frame.stats
     gpu = f"{s['gpu_time_ms']:.2f} ms" if s.get("gpu_time_ms") is not None else "n/a (no timestamp queries)"
-    print(f"{args.file}: {scene.triangle_count} triangles, alpha {args.alpha}, {width} x {height}, method {s['method']}")
+    lights = f"{len(args.light)} lights" if args.light else "headlight"
+    print(f"{args.file}: {scene.triangle_count} triangles, alpha {args.alpha}, {args.shading} shading ({lights}), "
+          f"{width} x {height}, method {s['method']}")
     print(f"  params: {s['params'] or '{}'}")
     print(f"  fragments {s['fragments']}, max depth complexity {s['max_depth_complexity']}, "
           f"overflow {s['overflow_fragments']}")

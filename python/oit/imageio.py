@@ -100,3 +100,27 @@ def mosaic(rows: Sequence[Sequence[np.ndarray]], gap: int = 4, fill: Sequence[fl
         for j, tile in enumerate(row):
             out[i * (h + gap):i * (h + gap) + h, j * (w + gap):j * (w + gap) + w] = tile
     return out
+
+
+def label(image: np.ndarray, text: str, scale: int = 1) -> np.ndarray:
+    """`image` (h, w, 3) linear RGB with `text` written in its top-left corner, white on a dark
+    outline so that it reads on any tile. Uses Pillow's built-in font; without Pillow the
+    image is returned as it is."""
+    try:
+        from PIL import Image, ImageDraw, ImageFont
+    except ImportError:
+        return image
+    h, w = image.shape[:2]
+    try:
+        font = ImageFont.load_default(size=10 * scale)
+    except TypeError:  # Pillow < 10.1: one bitmap size
+        font = ImageFont.load_default()
+    mask = Image.new("L", (w, h), 0)
+    outline = Image.new("L", (w, h), 0)
+    at = (3 * scale, 2 * scale)
+    ImageDraw.Draw(mask).text(at, text, fill=255, font=font)
+    ImageDraw.Draw(outline).text(at, text, fill=255, font=font, stroke_width=max(1, scale), stroke_fill=255)
+    m = np.asarray(mask, dtype=np.float64)[..., None] / 255.0
+    o = np.asarray(outline, dtype=np.float64)[..., None] / 255.0
+    out = np.asarray(image, dtype=np.float64) * (1.0 - o) + 0.02 * o
+    return out * (1.0 - m) + 1.0 * m

@@ -243,3 +243,36 @@ def write_scale(rows: list[dict], fits: list[dict], out: str) -> list[str]:
               f"{sweep} sweep ({mine[0]['scene']}): time against {mine[0]['x_name']}, on {adapter}")
         paths.append(path)
     return paths
+
+
+def shading_cost(rows: list[dict], path: str) -> None:
+    """oit.bench.shading's figure: one panel per scene and size, each method's time against the
+    shading cost N (extra light evaluations per shaded fragment), labelled with its slope."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    key = "gpu_ms" if ok and all(math.isfinite(r["gpu_ms"]) for r in ok) else "wall_ms"
+    panels = list(dict.fromkeys((r["scene"], r["size"]) for r in rows))
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.4), squeeze=False)
+    for ax, (scene, size) in zip(axes.flat, panels):
+        for method in dict.fromkeys(r["method"] for r in rows):
+            pts = sorted((r["shading_cost"], r[key]) for r in ok if (r["scene"], r["size"], r["method"]) == (scene, size, method))
+            if not pts:
+                continue
+            slope = next(r["ms_per_100"] for r in ok if (r["scene"], r["size"], r["method"]) == (scene, size, method))
+            ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", markersize=4,
+                    label=f"{method} ({slope:.2f} ms / 100)")
+        ax.set_xlabel("shading cost N (extra light evaluations a shaded fragment)")
+        ax.set_ylabel("GPU time (ms, log)" if key == "gpu_ms" else "wall time per frame (ms, log)")
+        ax.set_yscale("log")  # peeling's many passes would squash the other lines
+        ax.set_title(f"{scene} {size}", fontsize=9)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
+    adapter = next((r["adapter"] for r in rows if r["adapter"]), "")
+    fig.suptitle(f"Shading cost: time as each shaded fragment costs more, on {adapter}", fontsize=10, x=0.02, ha="left")
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -7,9 +7,17 @@ layout (docs/viewer.md; crates/oit-viewer/src/scenefile.rs reads it), all little
     b"OITSCENE", version u32 = 1, width u32, height u32 (0: no size),
     camera kind u32: 0 none | 1 view-projection, 16 f64 row-major | 2 look-at, 12 f64:
         eye xyz, target xyz, up xyz, fov_y (degrees), near, far
-    mesh count u32, then per mesh: flags u32 (bit 0: opaque), name length u32, name UTF-8,
-        vertices n u32, triangles m u32, positions n*3 f32, colors n*4 f32 (straight linear
-        RGBA), indices m*3 u32
+    mesh count u32, then per mesh: flags u32 (bit 0: opaque, bit 1: a surface follows),
+        name length u32, name UTF-8, vertices n u32, triangles m u32, positions n*3 f32,
+        colors n*4 f32 (straight linear RGBA), indices m*3 u32, and with bit 1 (version 2):
+        shading u32 (0 unlit, 1 flat, 2 smooth), two-sided u32, specular, shininess, opacity
+        f32, normals count u32 (0 or n) and n*3 f32, UV count u32 (0 or n) and n*2 f32,
+        texture height h u32 and width w u32 (0 0: none) and h*w*4 f32 linear RGBA
+    version 2 only, after the meshes: light count u32, per light direction xyz, color rgb,
+        intensity (7 f32); ambient rgb (3 f32)
+
+A file is written as version 1 when no mesh has a surface and there are no lights or
+ambient term, so that older readers still read unlit scenes.
 """
 
 from __future__ import annotations
@@ -25,10 +33,11 @@ import numpy as np
 from ._api import Camera, Scene
 from .scenes import BuiltScene, MeshArrays
 
-__all__ = ["LookAt", "save_scene", "load_scene", "scene_of", "MAGIC", "VERSION"]
+__all__ = ["LookAt", "save_scene", "load_scene", "load_lights", "scene_of", "MAGIC", "VERSION"]
 
 MAGIC = b"OITSCENE"
-VERSION = 1
+VERSION = 2
+SHADING_CODES = {"unlit": 0, "flat": 1, "smooth": 2}
 
 
 @dataclass(frozen=True)
@@ -51,19 +60,25 @@ SceneLike = Union[BuiltScene, Sequence[MeshArrays]]
 
 
 def save_scene(scene: SceneLike, path: str | os.PathLike, camera: Camera | LookAt | None = None,
-               size: tuple[int, int] | None = None, names: Sequence[str] | None = None) -> None:
-    """Writes `scene` (a BuiltScene or a list of MeshArrays) with `camera` (default: the
-    BuiltScene's) and `size` (default: the BuiltScene's) to `path`."""
+               size: tuple[int, int] | None = None, names: Sequence[str] | None = None,
+               lights: Sequence[tuple[Any, Any, float]] | None = None, ambient: Sequence[float] | None = None) -> None:
+    """Writes `scene` (a BuiltScene or a list of MeshArrays) with `camera`, `size`, `lights`
+    and `ambient` (default: the BuiltScene's) to `path`."""
     if isinstance(scene, Scene):
         raise TypeError("an oit.Scene keeps its arrays in the engine: pass the BuiltScene from oit.scenes, "
                         "or the meshes as a list of oit.scenes.MeshArrays")
     if isinstance(scene, BuiltScene):
         camera = scene.camera if camera is None else camera
         size = scene.size if size is None else size
+        lights = scene.lights if lights is None else lights
+        ambient = scene.ambient if ambient is None else ambient
         meshes = list(scene.meshes)
     else:
         meshes = list(scene)
-    out = [MAGIC, struct.pack("<3I", VERSION, *(size or (0, 0)))]
+    lights = list(lights or [])
+    ambient = tuple(float(a) for a in (ambient if ambient is not None else (0.0, 0.0, 0.0)))
+    version = 2 if lights or any(ambient) or any(m.surface for m in meshes) else 1
+    out = [MAGIC, struct.pack("<3I", version, *(size or (0, 0)))]
     if camera is None:
         out.append(struct.pack("<I", 0))
     elif isinstance(camera, LookAt):
@@ -82,14 +97,31 @@ def save_scene(scene: SceneLike, path: str | os.PathLike, camera: Camera | LookA
         if len(col) != len(pos):
             raise ValueError(f"mesh {i}: {len(col)} colors for {len(pos)} vertices")
         name = (names[i] if names else f"mesh {i}").encode()
-        out += [struct.pack("<2I", int(bool(m.opaque)), len(name)), name, struct.pack("<2I", len(pos), len(idx)),
+        flags = int(bool(m.opaque)) | (2 if m.surface else 0)
+        out += [struct.pack("<2I", flags, len(name)), name, struct.pack("<2I", len(pos), len(idx)),
                 pos.tobytes(), col.tobytes(), idx.tobytes()]
+        if m.surface:
+            out.append(_surface_bytes(m.surface, len(pos)))
+    if version == 2:
+        out.append(struct.pack("<I", len(lights)))
+        for d, c, intensity in lights:
+            out.append(struct.pack("<7f", *map(float, d), *map(float, c), float(intensity)))
+        out.append(struct.pack("<3f", *ambient))
     with open(path, "wb") as f:
         f.write(b"".join(out))
 
 
 def load_scene(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | None]:
     """Reads a scene file back: (meshes as MeshArrays, Camera or LookAt or None, size or None)."""
+    return _load(path)[:3]
+
+
+def load_lights(path: str | os.PathLike) -> tuple[list, tuple[float, float, float]]:
+    """A scene file's lights ((direction, color, intensity) each) and ambient term."""
+    return _load(path)[3:]
+
+
+def _load(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | None, list, tuple[float, float, float]]:
     with open(path, "rb") as f:
         data = f.read()
     if data[:8] != MAGIC:
@@ -97,8 +129,8 @@ def load_scene(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | No
     at = 8
     version, w, h, kind = struct.unpack_from("<4I", data, at)
     at += 16
-    if version != VERSION:
-        raise ValueError(f"{path}: scene file version {version}; this reads version {VERSION}")
+    if version not in (1, VERSION):
+        raise ValueError(f"{path}: scene file version {version}; this reads versions 1 and {VERSION}")
     camera: Any = None
     if kind == 1:
         camera = Camera(np.frombuffer(data, "<f8", 16, at).reshape(4, 4))
@@ -121,13 +153,69 @@ def load_scene(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | No
         at += n * 16
         idx = np.frombuffer(data, "<u4", m * 3, at).reshape(m, 3)
         at += m * 12
-        meshes.append(MeshArrays(pos, idx, col, bool(flags & 1)))
-    return meshes, camera, ((w, h) if w and h else None)
+        surface: dict[str, Any] = {}
+        if flags & 2:
+            surface, at = _read_surface(data, at, n)
+        meshes.append(MeshArrays(pos, idx, col, bool(flags & 1), surface))
+    lights: list = []
+    ambient = (0.0, 0.0, 0.0)
+    if version == 2:
+        (count,) = struct.unpack_from("<I", data, at)
+        at += 4
+        for _ in range(count):
+            v = struct.unpack_from("<7f", data, at)
+            lights.append((tuple(v[0:3]), tuple(v[3:6]), v[6]))
+            at += 28
+        ambient = struct.unpack_from("<3f", data, at)
+    return meshes, camera, ((w, h) if w and h else None), lights, tuple(ambient)
 
 
-def scene_of(meshes: Sequence[MeshArrays]) -> Scene:
-    """An oit.Scene of the same meshes (for rendering a loaded file with the library)."""
+def scene_of(meshes: Sequence[MeshArrays], lights: Sequence[tuple[Any, Any, float]] = (),
+             ambient: Sequence[float] = (0.0, 0.0, 0.0)) -> Scene:
+    """An oit.Scene of the same meshes, surfaces and lights (for rendering a loaded file with
+    the library)."""
     scene = Scene()
     for m in meshes:
-        scene.add_mesh(m.positions, m.indices, m.colors, opaque=m.opaque)
+        scene.add_mesh(m.positions, m.indices, m.colors, opaque=m.opaque, **m.surface)
+    for d, c, i in lights:
+        scene.add_light(d, c, i)
+    scene.ambient = tuple(ambient)
     return scene
+
+
+def _surface_bytes(surface: dict[str, Any], n: int) -> bytes:
+    from ._api import _surface
+
+    s = _surface(n, surface.get("normals"), surface.get("uvs"), surface.get("texture"), surface.get("shading"),
+                 surface.get("specular", 0.0), surface.get("shininess", 32.0), surface.get("opacity", 1.0),
+                 surface.get("two_sided", True))
+    out = [struct.pack("<2I3f", SHADING_CODES[s["shading"]], int(s["two_sided"]), s["specular"], s["shininess"], s["opacity"])]
+    for key, width in (("normals", 3), ("uvs", 2)):
+        a = s.get(key)
+        out.append(struct.pack("<I", 0 if a is None else n))
+        if a is not None:
+            out.append(np.ascontiguousarray(a, dtype="<f4").reshape(n, width).tobytes())
+    t = s.get("texture")
+    out.append(struct.pack("<2I", *((0, 0) if t is None else t.shape[:2])))
+    if t is not None:
+        out.append(np.ascontiguousarray(t, dtype="<f4").tobytes())
+    return b"".join(out)
+
+
+def _read_surface(data: bytes, at: int, n: int) -> tuple[dict[str, Any], int]:
+    code, two_sided, specular, shininess, opacity = struct.unpack_from("<2I3f", data, at)
+    at += 20
+    surface: dict[str, Any] = {"shading": {v: k for k, v in SHADING_CODES.items()}[code], "two_sided": bool(two_sided),
+                               "specular": specular, "shininess": shininess, "opacity": opacity}
+    for key, width in (("normals", 3), ("uvs", 2)):
+        (count,) = struct.unpack_from("<I", data, at)
+        at += 4
+        if count:
+            surface[key] = np.frombuffer(data, "<f4", count * width, at).reshape(count, width)
+            at += count * width * 4
+    h, w = struct.unpack_from("<2I", data, at)
+    at += 8
+    if h and w:
+        surface["texture"] = np.frombuffer(data, "<f4", h * w * 4, at).reshape(h, w, 4)
+        at += h * w * 16
+    return surface, at

@@ -10,6 +10,19 @@ struct FrameUniform {
     // storage is indexed within it, and passes are scissored to it.
     tile_origin: vec2<u32>,
     tile_size: vec2<u32>,
+    // Shading (common/shading.wgsl): the inverse view-projection for a pixel's eye direction,
+    // ambient RGB (w = 0, the factor of the shading-cost loop's result), then x = whether any
+    // mesh is shaded, y = the light count, z = the shading-cost loop count.
+    inv_view_proj: mat4x4<f32>,
+    ambient: vec4<f32>,
+    shading: vec4<u32>,
+    lights: array<Light, MAX_LIGHTS>,
+}
+
+// Mirrors oit_core::gpu_types::GpuLight: unit L (towards the light) and color times intensity.
+struct Light {
+    to_light: vec4<f32>,
+    radiance: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> frame: FrameUniform;
@@ -26,6 +39,10 @@ struct Chunk {
     pad1: u32,
 }
 @group(0) @binding(4) var<uniform> chunk: Chunk;
+// Two vec4 a vertex where the scene is shaded: (unit normal, material index bits), (u, v, 0, 0).
+@group(0) @binding(5) var<storage, read> attributes: array<vec4<f32>>;
+// The material table, then every texture's texels (common/shading.wgsl); the same in every chunk.
+@group(0) @binding(6) var<storage, read> surfaces: array<vec4<f32>>;
 
 struct VsOut {
     @builtin(position) @invariant clip: vec4<f32>,
@@ -34,18 +51,36 @@ struct VsOut {
     @location(1) @interpolate(flat) prim: u32,
     // Clip w, interpolated: the view distance under a perspective camera (1 for orthographic).
     @location(2) view_w: f32,
+    // Shaded scenes only (zero otherwise): the shading normal (flat meshes are uploaded with
+    // a vertex per corner carrying the face normal), UVs and the mesh's material.
+    @location(3) normal: vec3<f32>,
+    @location(4) uv: vec2<f32>,
+    @location(5) @interpolate(flat) material: u32,
 }
 
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     let v = indices[vi];
-    let p = vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
+    let p = scene_position(v);
     var out: VsOut;
     out.clip = frame.view_proj * vec4<f32>(p, 1.0);
     out.color = colors[v];
     out.prim = chunk.first_triangle + vi / 3u;
     out.view_w = out.clip.w;
+    out.normal = vec3<f32>(0.0);
+    out.uv = vec2<f32>(0.0);
+    out.material = 0u;
+    if frame.shading.x != 0u {
+        let a = attributes[2u * v];
+        out.material = bitcast<u32>(a.w);
+        out.normal = a.xyz;
+        out.uv = attributes[2u * v + 1u].xy;
+    }
     return out;
+}
+
+fn scene_position(v: u32) -> vec3<f32> {
+    return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
 }
 
 // Index of a fragment's pixel in per-pixel storage: row-major within the tile.
@@ -68,3 +103,4 @@ fn compute_pixel(gid: vec3<u32>) -> u32 {
     }
     return gid.y * frame.tile_size.x + gid.x;
 }
+//!include common/shading.wgsl

@@ -29,7 +29,8 @@ fn frag_less(a: Frag, b: Frag) -> bool {
 //!include common/select.wgsl
 
 @fragment @early_depth_test(force)
-fn fs_capture(in: VsOut) {
+fn fs_capture(raw: VsOut) {
+    let in = shaded(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }

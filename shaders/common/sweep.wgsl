@@ -46,11 +46,12 @@ const MERGING: u32 = 2u;
 const MULTI: u32 = 0x100u;
 // Steps per node loaded into a run (the loop, the pool switch), per node relinked (the loop,
 // append's switch), per merge step (its own switch, two fragments, the link, the append), and
-// per fragment composited from the list.
-const LOAD_STEPS: u32 = 2u;
+// per fragment composited from the list; FRAG_STEPS (injected) is what turning a node into a
+// fragment adds (compact_abuffer shades it). oit_core::method::lists::StepCosts mirrors them.
+const LOAD_STEPS: u32 = 2u + FRAG_STEPS;
 const LINK_STEPS: u32 = 2u;
-const MERGE_STEPS: u32 = 6u;
-const COMPOSITE_STEPS: u32 = 4u + PIXEL_SAMPLES;
+const MERGE_STEPS: u32 = 6u + 2u * FRAG_STEPS;
+const COMPOSITE_STEPS: u32 = 4u + PIXEL_SAMPLES + FRAG_STEPS;
 
 struct Frag {
     depth: f32,

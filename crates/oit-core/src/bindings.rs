@@ -35,9 +35,9 @@ pub fn samples_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 }
 
 pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let storage = |binding| wgpu::BindGroupLayoutEntry {
+    let storage_in = |binding, visibility| wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE,
+        visibility,
         ty: wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only: true },
             has_dynamic_offset: false,
@@ -45,16 +45,19 @@ pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         },
         count: None,
     };
+    let storage = |binding| storage_in(binding, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE);
     let uniform = |binding| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
         count: None,
     };
-    // The frame uniform, positions, colors, indices, and the chunk's place in the scene.
+    // The frame uniform, positions, colors, indices, the chunk's place in the scene, the
+    // vertex attributes of shading, and the material table that fragments shade with.
+    let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("scene"),
-        entries: &[uniform(0), storage(1), storage(2), storage(3), uniform(4)],
+        entries: &[uniform(0), storage(1), storage(2), storage(3), uniform(4), storage(5), storage_in(6, all)],
     })
 }
 

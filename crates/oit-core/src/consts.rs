@@ -56,4 +56,11 @@ pub const SHARED: &[Const] = &[
     Const::F32("TAU_SCALE", TAU_SCALE),
     Const::F32("TAU2_SCALE", TAU2_SCALE),
     Const::F32("QUANT_SCALE", QUANT_SCALE),
+    Const::U32("MAX_LIGHTS", crate::shading::MAX_LIGHTS),
+    Const::U32("SHADING_MODE", crate::shading::SHADING_MODE),
+    Const::U32("SHADING_UNLIT", crate::shading::Shading::Unlit as u32),
+    Const::U32("SHADING_FLAT", crate::shading::Shading::Flat as u32),
+    Const::U32("SHADING_SMOOTH", crate::shading::Shading::Smooth as u32),
+    Const::U32("TWO_SIDED", crate::shading::TWO_SIDED),
+    Const::U32("TEXTURED", crate::shading::TEXTURED),
 ];

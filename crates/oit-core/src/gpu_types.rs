@@ -15,6 +15,36 @@ pub struct FrameUniform {
     /// The screen tile a pass renders: per-pixel storage is indexed within it.
     pub tile_origin: [u32; 2],
     pub tile_size: [u32; 2],
+    /// The inverse of `view_proj`: the eye direction of a pixel (shaders/common/shading.wgsl).
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// Ambient RGB; w is 0, a factor the shading-cost loop's result is multiplied by.
+    pub ambient: [f32; 4],
+    /// Whether any mesh is shaded (0: every fragment keeps its vertex color), the light
+    /// count, the shading-cost loop count, unused.
+    pub shading: [u32; 4],
+    pub lights: [GpuLight; crate::shading::MAX_LIGHTS as usize],
+}
+
+/// Mirrors `Light` in `shaders/common/scene.wgsl`: unit L (towards the light) and radiance.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuLight {
+    pub to_light: [f32; 4],
+    pub radiance: [f32; 4],
+}
+
+/// Mirrors `Material` in `shaders/common/shading.wgsl`: one record of the material table.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuMaterial {
+    pub specular: f32,
+    pub shininess: f32,
+    pub opacity: f32,
+    /// `Shading::code()`, plus TWO_SIDED (bit 8) and TEXTURED (bit 9).
+    pub flags: u32,
+    /// The first texel in the table, the texture's width and height.
+    pub texture: [u32; 3],
+    pub pad: u32,
 }
 
 /// Mirrors `Node` in `shaders/abuffer.wgsl`: depth, next index, straight RGBA.
@@ -67,12 +97,16 @@ pub struct CompactNode {
     pub prim: u32,
 }
 
-/// Mirrors `PrimShading` in `shaders/compact_abuffer.wgsl`: clip-space corners and colors.
+/// Mirrors `PrimShading` in `shaders/compact_abuffer.wgsl`: clip-space corners and colors,
+/// and the corners' shading normals (material index in w) and UVs.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct PrimShading {
     pub clip: [[f32; 4]; 3],
     pub color: [[f32; 4]; 3],
+    pub normal: [[f32; 4]; 3],
+    pub uv: [[f32; 2]; 3],
+    pub pad: [f32; 2],
 }
 
 /// Mirrors `Block` in `shaders/pall.wgsl`: a triangle's node block and pixel box.

@@ -17,6 +17,7 @@ pub mod resources;
 mod scan;
 pub mod scene;
 pub mod shader;
+pub mod shading;
 mod targets;
 pub mod tiles;
 mod timer;
@@ -30,3 +31,4 @@ pub use method::{
 pub use reference::{reference, reference_antialiased, ReferenceImage};
 pub use renderer::{coverage_methods, shared_context, Frame, Renderer, Stats, COVERAGE_SAMPLES};
 pub use scene::{Camera, Mesh, Scene};
+pub use shading::{Light, Material, Shading, Texture, MAX_LIGHTS};

@@ -1,7 +1,8 @@
 //! The CPU float64 reference: a ray through each pixel center between the near and far
 //! planes, every intersection found with a BVH (obvhs), sorted by depth and composited
-//! front to back in f64; the nearest opaque hit ends the ray. The edge and tie rule is in
-//! docs/methods.md ("The reference").
+//! front to back in f64; the nearest opaque hit ends the ray. Each hit is shaded with the
+//! model of src/shading.rs at its ray barycentrics (perspective-correct). The edge and tie
+//! rule is in docs/methods.md ("The reference").
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3A};
 use obvhs::aabb::Aabb;
@@ -11,6 +12,7 @@ use obvhs::{Boundable, BvhBuildParams};
 
 use crate::error::{invalid, Result};
 use crate::scene::{Camera, Scene};
+use crate::shading::{self, Lighting, Material, Shading};
 
 /// A pixel center closer than this to a triangle edge (in pixels) is ambiguous: the
 /// rasterizer snaps vertices to 1/256 pixel, so its coverage there can differ.
@@ -31,6 +33,10 @@ pub struct ReferenceImage {
 struct Tri {
     v: [DVec3; 3],
     c: [DVec4; 3],
+    /// Shading normals (the face normal's for flat shading) and UVs of the corners.
+    n: [DVec3; 3],
+    uv: [DVec2; 3],
+    mesh: usize,
     opaque: bool,
     /// Vertex positions in pixels when all three are in front of the eye (w > 0).
     screen: Option<[DVec2; 3]>,
@@ -130,13 +136,21 @@ pub fn reference_antialiased(
     }
     let offsets = crate::antialias::sample_offsets(antialias)?;
     let mut tris = Vec::new();
-    for m in scene.meshes() {
+    for (mesh, m) in scene.meshes().iter().enumerate() {
         for ix in &m.indices {
             let v = ix.map(|i| DVec3::from(m.positions[i as usize].map(|x| x as f64)));
             let c = ix.map(|i| DVec4::from(m.colors[i as usize].map(|x| x as f64)));
-            tris.push(Tri { v, c, opaque: m.opaque, screen: None });
+            let n = match m.material.shading {
+                Shading::Flat => [(v[1] - v[0]).cross(v[2] - v[0]).normalize(); 3],
+                _ if m.normals.is_empty() => [DVec3::ZERO; 3],
+                _ => ix.map(|i| DVec3::from(m.normals[i as usize].map(|x| x as f64))),
+            };
+            let uv = if m.uvs.is_empty() { [DVec2::ZERO; 3] } else { ix.map(|i| DVec2::from(m.uvs[i as usize].map(|x| x as f64))) };
+            tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None });
         }
     }
+    let materials: Vec<&Material> = scene.meshes().iter().map(|m| &m.material).collect();
+    let looks = |camera: &Camera| Looks { materials: &materials, lighting: scene.lighting(camera), shaded: scene.shaded() };
     // The BVH is f32: pad each box so that rounding cannot drop a triangle the f64 test hits,
     // and by a thousandth of the scene, so that a pixel center just outside a triangle (within
     // the edge margin, where the rasterizer's snapping may cover it) still reaches the edge test.
@@ -154,11 +168,12 @@ pub fn reference_antialiased(
         .collect();
     let bvh = if tris.is_empty() { None } else { Some(build_bvh2(&bounds, BvhBuildParams::fast_build(), &mut Default::default())) };
     if offsets.len() == 1 {
-        return Ok(trace_frame(&mut tris, bvh.as_ref(), camera, width, height, background));
+        return Ok(trace_frame(&mut tris, bvh.as_ref(), camera, &looks(camera), width, height, background));
     }
     let mut out: Option<ReferenceImage> = None;
     for offset in &offsets {
-        let r = trace_frame(&mut tris, bvh.as_ref(), &camera.jittered(*offset, width, height), width, height, background);
+        let jittered = camera.jittered(*offset, width, height);
+        let r = trace_frame(&mut tris, bvh.as_ref(), &jittered, &looks(&jittered), width, height, background);
         match &mut out {
             None => out = Some(r),
             Some(o) => {
@@ -174,8 +189,24 @@ pub fn reference_antialiased(
     Ok(out)
 }
 
+/// What the hits are shaded with: each mesh's material, the lights under the frame's camera.
+struct Looks<'a> {
+    materials: &'a [&'a Material],
+    lighting: Lighting,
+    /// Whether any mesh is shaded (else a hit keeps its interpolated color).
+    shaded: bool,
+}
+
 /// One reference frame of the pixel centers under `camera`, through the scene's BVH.
-fn trace_frame(tris: &mut [Tri], bvh: Option<&Bvh2>, camera: &Camera, width: u32, height: u32, background: [f64; 3]) -> ReferenceImage {
+fn trace_frame(
+    tris: &mut [Tri],
+    bvh: Option<&Bvh2>,
+    camera: &Camera,
+    looks: &Looks<'_>,
+    width: u32,
+    height: u32,
+    background: [f64; 3],
+) -> ReferenceImage {
     let vp = camera.view_proj;
     let inv = vp.inverse();
     let (wf, hf) = (width as f64, height as f64);
@@ -215,7 +246,7 @@ fn trace_frame(tris: &mut [Tri], bvh: Option<&Bvh2>, camera: &Camera, width: u32
                         let mut hits: Vec<Hit> = Vec::new();
                         let mut edge = false;
                         if let Some(bvh) = bvh {
-                            trace(bvh, tris, o, d, center, &vp, &mut hits, &mut edge);
+                            trace(bvh, tris, looks, o, d, center, &vp, &mut hits, &mut edge);
                         }
                         let (rgba, n, tie) = composite(&mut hits, background);
                         img[4 * k..4 * k + 4].copy_from_slice(&rgba);
@@ -253,7 +284,8 @@ fn report_progress<T>(workers: &[std::thread::ScopedJoinHandle<'_, T>], rows_don
 }
 
 #[allow(clippy::too_many_arguments)]
-fn trace(bvh: &Bvh2, tris: &[Tri], o: DVec3, d: DVec3, center: DVec2, vp: &DMat4, hits: &mut Vec<Hit>, edge: &mut bool) {
+fn trace(bvh: &Bvh2, tris: &[Tri], looks: &Looks<'_>, o: DVec3, d: DVec3, center: DVec2, vp: &DMat4, hits: &mut Vec<Hit>, edge: &mut bool) {
+    let to_eye = -d.normalize();
     let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()), -1e-3, 1.0 + 1e-3);
     bvh.ray_traverse_anyhit(ray, |_, id| {
         let t = &tris[bvh.primitive_indices[id] as usize];
@@ -278,7 +310,20 @@ fn trace(bvh: &Bvh2, tris: &[Tri], o: DVec3, d: DVec3, center: DVec2, vp: &DMat4
         if inside && (0.0..1.0).contains(&tt) {
             let p = o + d * tt;
             let c = *vp * p.extend(1.0);
-            let color = t.c[0] * (1.0 - u - v) + t.c[1] * u + t.c[2] * v;
+            let w = 1.0 - u - v;
+            let mut color = t.c[0] * w + t.c[1] * u + t.c[2] * v;
+            if looks.shaded {
+                let surface = shading::Surface {
+                    color,
+                    normal: t.n[0] * w + t.n[1] * u + t.n[2] * v,
+                    uv: t.uv[0] * w + t.uv[1] * u + t.uv[2] * v,
+                    to_eye,
+                    material: looks.materials[t.mesh],
+                };
+                let (shaded, grazing) = shading::shade(&surface, &looks.lighting);
+                color = shaded;
+                *edge |= grazing;
+            }
             hits.push(Hit { z: c.z / c.w, color, opaque: t.opaque });
         }
     });

@@ -10,12 +10,13 @@ use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::cache::Layout;
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
-use crate::gpu_types::FrameUniform;
+use crate::gpu_types::{FrameUniform, GpuLight};
 use crate::method::{self, AntialiasMode, FrameCtx, Limits, Method, MethodInfo, MethodReport, ParamValue, Params, Tiling};
 use crate::passes;
 use crate::pipeline;
 use crate::scene::{Camera, Scene};
 use crate::shader;
+use crate::shading::{Light, Lighting, MAX_LIGHTS};
 use crate::targets::{read_buffer, read_rows, SampleTargets, Targets};
 use crate::tiles::{self, Footprint, Tile};
 use crate::timer::PassTimer;
@@ -140,6 +141,10 @@ pub struct Renderer {
     memory_budget: Option<u64>,
     /// Made at the first coverage-mask frame.
     coverage: Option<Coverage>,
+    /// The lights and ambient term of the scene being rendered (the frame uniform's).
+    lights: (Vec<Light>, [f32; 3]),
+    /// Extra light evaluations per shaded fragment that leave its color unchanged (docs/shading.md).
+    shading_cost: u32,
 }
 
 /// One device per adapter choice, shared by every renderer in the process.
@@ -187,7 +192,20 @@ impl Renderer {
             limits,
             memory_budget: None,
             coverage: None,
+            lights: (Vec::new(), [0.0; 3]),
+            shading_cost: 0,
         })
+    }
+
+    /// Makes every shaded fragment evaluate `count` extra lights whose sum is multiplied by 0
+    /// (in a uniform the compiler cannot see through): the image is unchanged and the cost of
+    /// shading grows (docs/shading.md, "Shading cost").
+    pub fn set_shading_cost(&mut self, count: u32) -> Result<()> {
+        if count > 1 << 16 {
+            return Err(invalid!("shading_cost must be in [0, 65536] light evaluations, got {count}"));
+        }
+        self.shading_cost = count;
+        Ok(())
     }
 
     /// Sizes method buffers as if the adapter bound at most `bytes` per storage binding
@@ -278,6 +296,7 @@ impl Renderer {
             }
         }
         self.upload(scene)?;
+        self.lights = (scene.lights().to_vec(), scene.ambient());
         if offsets.len() == 1 || coverage {
             let mut frame = self.render_sample(camera, info, &params, background, coverage)?;
             frame.stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -386,6 +405,7 @@ impl Renderer {
                     frame_uniform: &self.shared.uniform,
                     limits: self.limits,
                     coverage: cov.map(|c| &c.targets),
+                    shading_cost: self.shading_cost,
                 };
                 let r = method.render(&mut cx)?;
                 if let Some(short) = r.pool_short {
@@ -544,6 +564,13 @@ impl Renderer {
 
     /// Writes the frame uniform for `camera` and the screen tile `tile`.
     fn set_uniform(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3], tile: Tile) {
+        let lighting = Lighting::new(&self.lights.0, self.lights.1, camera);
+        let mut lights = [GpuLight::default(); MAX_LIGHTS as usize];
+        for (g, (l, radiance)) in lights.iter_mut().zip(&lighting.lights) {
+            g.to_light = l.as_vec3().extend(0.0).to_array();
+            g.radiance = radiance.as_vec3().extend(0.0).to_array();
+        }
+        let a = lighting.ambient.as_vec3();
         let uniform = FrameUniform {
             view_proj: camera.matrix_f32().to_cols_array_2d(),
             background: [bg[0], bg[1], bg[2], 0.0],
@@ -552,6 +579,10 @@ impl Renderer {
             seed: 0,
             tile_origin: [tile.x, tile.y],
             tile_size: [tile.width, tile.height],
+            inv_view_proj: camera.view_proj.inverse().as_mat4().to_cols_array_2d(),
+            ambient: [a.x, a.y, a.z, 0.0],
+            shading: [scene.shaded as u32, lighting.lights.len() as u32, self.shading_cost, 0],
+            lights,
         };
         self.gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
     }

@@ -5,14 +5,19 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::{DMat4, DVec4, Mat4};
 
 use crate::error::{invalid, Result};
+use crate::shading::{self, Light, Lighting, Material, Shading, MAX_LIGHTS};
 
-/// A triangle mesh with straight (not premultiplied) linear RGBA per vertex.
+/// A triangle mesh with straight (not premultiplied) linear RGBA per vertex, and its surface:
+/// unit vertex normals and UVs (empty when not given) and a material (src/shading.rs).
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
     pub indices: Vec<[u32; 3]>,
     pub colors: Vec<[f32; 4]>,
     pub opaque: bool,
+    pub normals: Vec<[f32; 3]>,
+    pub uvs: Vec<[f32; 2]>,
+    pub material: Material,
 }
 
 impl Mesh {
@@ -42,7 +47,33 @@ impl Mesh {
                 n
             ));
         }
-        Ok(Self { positions, indices, colors, opaque })
+        Ok(Self { positions, indices, colors, opaque, ..Default::default() })
+    }
+
+    /// Gives the mesh a surface. Normals are renormalized; with `Shading::Smooth` and no
+    /// normals they are computed (angle-weighted); a texture needs UVs.
+    pub fn with_surface(mut self, normals: Option<Vec<[f32; 3]>>, uvs: Option<Vec<[f32; 2]>>, material: Material) -> Result<Self> {
+        material.validate()?;
+        let n = self.positions.len();
+        self.normals = match normals {
+            Some(v) => shading::check_normals(v, n)?,
+            None if material.shading == Shading::Smooth => shading::vertex_normals(&self.positions, &self.indices),
+            None => Vec::new(),
+        };
+        if let Some(uv) = &uvs {
+            if uv.len() != n {
+                return Err(invalid!("uvs has {} rows but positions has {n}: pass one (u, v) per vertex", uv.len()));
+            }
+            if let Some(i) = uv.iter().position(|t| t.iter().any(|x| !x.is_finite())) {
+                return Err(invalid!("uvs[{i}] = {:?} is not finite", uv[i]));
+            }
+        }
+        if material.texture.is_some() && uvs.is_none() {
+            return Err(invalid!("a texture needs uvs: pass one (u, v) per vertex"));
+        }
+        self.uvs = uvs.unwrap_or_default();
+        self.material = material;
+        Ok(self)
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -56,6 +87,8 @@ static NEXT_SCENE_ID: AtomicU64 = AtomicU64::new(1);
 #[derive(Debug)]
 pub struct Scene {
     meshes: Vec<Mesh>,
+    lights: Vec<Light>,
+    ambient: [f32; 3],
     id: u64,
     revision: u64,
 }
@@ -68,13 +101,61 @@ impl Default for Scene {
 
 impl Clone for Scene {
     fn clone(&self) -> Self {
-        Self { meshes: self.meshes.clone(), id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed), revision: 0 }
+        Self {
+            meshes: self.meshes.clone(),
+            lights: self.lights.clone(),
+            ambient: self.ambient,
+            id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed),
+            revision: 0,
+        }
     }
 }
 
 impl Scene {
     pub fn new() -> Self {
-        Self { meshes: Vec::new(), id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed), revision: 0 }
+        Self { meshes: Vec::new(), lights: Vec::new(), ambient: [0.0; 3], id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed), revision: 0 }
+    }
+
+    /// Adds a directional light (at most MAX_LIGHTS); with none, a headlight shines.
+    pub fn add_light(&mut self, light: Light) -> Result<usize> {
+        if self.lights.len() as u32 >= MAX_LIGHTS {
+            return Err(invalid!("a scene holds at most {MAX_LIGHTS} lights: merge some"));
+        }
+        self.lights.push(light);
+        Ok(self.lights.len() - 1)
+    }
+
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    pub fn clear_lights(&mut self) {
+        self.lights.clear();
+    }
+
+    /// The ambient term, linear RGB (default black).
+    pub fn set_ambient(&mut self, rgb: [f32; 3]) -> Result<()> {
+        if rgb.iter().any(|c| !(c.is_finite() && *c >= 0.0)) {
+            return Err(invalid!("ambient {rgb:?} must be three finite linear RGB values >= 0"));
+        }
+        self.ambient = rgb;
+        Ok(())
+    }
+
+    pub fn ambient(&self) -> [f32; 3] {
+        self.ambient
+    }
+
+    /// Whether any mesh has a material other than plain unlit (else fragments keep their
+    /// vertex colors, bit for bit).
+    pub fn shaded(&self) -> bool {
+        self.meshes.iter().any(|m| !m.material.is_plain())
+    }
+
+    /// Lights (L, radiance) and ambient under `camera`: the scene's lights, or one white
+    /// headlight travelling along the view direction when it has none.
+    pub fn lighting(&self, camera: &Camera) -> Lighting {
+        Lighting::new(&self.lights, self.ambient, camera)
     }
 
     pub fn add_mesh(&mut self, mesh: Mesh) -> usize {

@@ -12,6 +12,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("BATCH", 32),
     Const::U32("RUN", 32),
     Const::U32("STEP_BUDGET", 32_768),
+    Const::U32("FRAG_STEPS", 0),
     Const::U32("K", 8),
     Const::U32("PER_PIXEL", 0),
     Const::U32("TAIL", 1),

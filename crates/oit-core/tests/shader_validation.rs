@@ -1,7 +1,7 @@
 //! Every WGSL file parses and validates with naga (no GPU needed), and the structs shared
 //! with Rust have the sizes naga computes.
 
-use oit_core::gpu_types::{Alloc, CompactNode, CoverageNode, FrameUniform, PallBlock, PoolNode, PrimNode, PrimShading};
+use oit_core::gpu_types::{Alloc, CompactNode, CoverageNode, FrameUniform, GpuLight, PallBlock, PoolNode, PrimNode, PrimShading};
 use oit_core::shader::{compose, entry_files, DEFAULT_CONSTS};
 
 fn validate(path: &str) -> naga::Module {
@@ -33,6 +33,7 @@ fn struct_size(module: &naga::Module, name: &str) -> u32 {
 fn layout_sizes() {
     let m = validate("abuffer.wgsl");
     assert_eq!(struct_size(&m, "FrameUniform") as usize, std::mem::size_of::<FrameUniform>());
+    assert_eq!(struct_size(&m, "Light") as usize, std::mem::size_of::<GpuLight>());
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<PoolNode>());
     assert_eq!(struct_size(&m, "Alloc") as usize, std::mem::size_of::<Alloc>());
     let m = validate("adaptive.wgsl");

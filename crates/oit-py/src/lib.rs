@@ -4,7 +4,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -68,17 +68,83 @@ impl Scene {
         Self { inner: oit_core::Scene::new() }
     }
 
-    /// positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32.
+    /// positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
+    /// surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
+    /// shading "unlit", "flat" or "smooth".
+    #[pyo3(signature = (positions, indices, colors, opaque, normals=None, uvs=None, texture=None, shading="unlit",
+                        specular=0.0, shininess=32.0, opacity=1.0, two_sided=true))]
+    #[allow(clippy::too_many_arguments)]
     fn add_mesh(
         &mut self,
         positions: PyReadonlyArray2<'_, f32>,
         indices: PyReadonlyArray2<'_, u32>,
         colors: PyReadonlyArray2<'_, f32>,
         opaque: bool,
+        normals: Option<PyReadonlyArray2<'_, f32>>,
+        uvs: Option<PyReadonlyArray2<'_, f32>>,
+        texture: Option<PyReadonlyArray3<'_, f32>>,
+        shading: &str,
+        specular: f32,
+        shininess: f32,
+        opacity: f32,
+        two_sided: bool,
     ) -> PyResult<usize> {
         let mesh = oit_core::Mesh::new(rows(&positions, "positions")?, rows(&indices, "indices")?, rows(&colors, "colors")?, opaque)
             .map_err(Error::from)?;
+        let texture = match texture {
+            Some(t) => {
+                let a = t.as_array();
+                let (h, w, c) = a.dim();
+                if c != 4 {
+                    return Err(PyValueError::new_err(format!("texture must have shape (h, w, 4), got ({h}, {w}, {c})")));
+                }
+                let flat: Vec<f32> = a.iter().copied().collect();
+                let texels = flat.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+                Some(oit_core::Texture::new(w as u32, h as u32, texels).map_err(Error::from)?)
+            }
+            None => None,
+        };
+        let material = oit_core::Material {
+            shading: oit_core::Shading::from_name(shading).map_err(Error::from)?,
+            specular,
+            shininess,
+            opacity,
+            two_sided,
+            texture,
+        };
+        let normals = normals.map(|n| rows(&n, "normals")).transpose()?;
+        let uvs = uvs.map(|u| rows(&u, "uvs")).transpose()?;
+        let mesh = mesh.with_surface(normals, uvs, material).map_err(Error::from)?;
         Ok(self.inner.add_mesh(mesh))
+    }
+
+    /// A directional light travelling along `direction` (world space); returns its index.
+    fn add_light(&mut self, direction: [f32; 3], color: [f32; 3], intensity: f32) -> Res<usize> {
+        Ok(self.inner.add_light(oit_core::Light::new(direction, color, intensity)?)?)
+    }
+
+    fn clear_lights(&mut self) {
+        self.inner.clear_lights();
+    }
+
+    /// (direction, color, intensity) per light.
+    #[getter]
+    fn lights(&self) -> Vec<([f32; 3], [f32; 3], f32)> {
+        self.inner.lights().iter().map(|l| (l.direction, l.color, l.intensity)).collect()
+    }
+
+    #[getter]
+    fn ambient(&self) -> [f32; 3] {
+        self.inner.ambient()
+    }
+
+    fn set_ambient(&mut self, rgb: [f32; 3]) -> Res<()> {
+        Ok(self.inner.set_ambient(rgb)?)
+    }
+
+    /// (shading, textured) per mesh.
+    fn mesh_surfaces(&self) -> Vec<(&'static str, bool)> {
+        self.inner.meshes().iter().map(|m| (m.material.shading.name(), m.material.texture.is_some())).collect()
     }
 
     fn set_mesh_alpha(&mut self, mesh: i64, alpha: f32) -> Res<()> {
@@ -239,7 +305,7 @@ impl Renderer {
 
     /// Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict,
     /// error bound (h, w) float32 or None).
-    #[pyo3(signature = (scene, view_proj, method, background, params, antialias=1, antialias_mode="frames"))]
+    #[pyo3(signature = (scene, view_proj, method, background, params, antialias=1, antialias_mode="frames", shading_cost=0))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -251,6 +317,7 @@ impl Renderer {
         params: Bound<'py, PyDict>,
         antialias: u32,
         antialias_mode: &str,
+        shading_cost: u32,
     ) -> PyResult<Bound<'py, PyAny>> {
         let mode = match antialias_mode {
             "frames" => oit_core::AntialiasMode::Frames,
@@ -264,6 +331,7 @@ impl Renderer {
         let frame = py
             .detach(|| {
                 let mut r = self.inner.lock().unwrap_or_else(|p| p.into_inner());
+                r.set_shading_cost(shading_cost)?;
                 r.render_antialiased(inner_scene, &camera, method, &plist, bg, antialias, mode)
             })
             .map_err(Error::from)?;

@@ -57,6 +57,9 @@ impl ScreenshotJob {
 pub struct ViewerApp {
     pub settings: Settings,
     pub meshes: Vec<MeshControl>,
+    /// The scene file's lights (none: the headlight) and ambient term.
+    pub lights: Vec<oit_core::Light>,
+    pub ambient: [f32; 3],
     pub camera: ViewCamera,
     pub title: String,
     pub show_panel: bool,
@@ -93,10 +96,14 @@ impl ViewerApp {
     /// The app on a given engine context (tests build it on their own egui-wgpu device).
     pub fn with_gpu(gpu: Result<Arc<GpuContext>, String>, data: SceneData, settings: Settings, title: String) -> Self {
         let camera = ViewCamera::new(data.camera.as_ref(), &data.meshes);
+        let mut settings = settings;
+        settings.ambient = data.ambient;
         let meshes = data.meshes.into_iter().map(|m| MeshControl::new(m.name, m.mesh)).collect();
         Self {
             settings,
             meshes,
+            lights: data.lights,
+            ambient: data.ambient,
             camera,
             title,
             show_panel: true,
@@ -145,8 +152,18 @@ impl ViewerApp {
         }
         let mut scene = Scene::new();
         for m in self.meshes.iter().filter(|m| m.visible && (self.settings.show_opaque || !m.original.opaque)) {
-            scene.add_mesh(m.mesh());
+            let mut mesh = m.mesh();
+            if !self.settings.lit {
+                mesh.material = Default::default();
+            }
+            scene.add_mesh(mesh);
         }
+        if !self.settings.headlight {
+            for l in &self.lights {
+                scene.add_light(*l).expect("at most MAX_LIGHTS lights, as the scene file had");
+            }
+        }
+        scene.set_ambient(self.settings.ambient).expect("a valid ambient term, as the scene file had");
         self.scene = scene;
         self.built_rev = self.scene_rev;
     }
@@ -356,6 +373,18 @@ impl ViewerApp {
                     s.show_opaque = b;
                     self.meshes_changed();
                 }
+                Action::SetLit(b) => {
+                    s.lit = b;
+                    self.meshes_changed();
+                }
+                Action::SetHeadlight(b) => {
+                    s.headlight = b;
+                    self.meshes_changed();
+                }
+                Action::SetAmbient(g) => {
+                    s.ambient = [g.clamp(0.0, 1.0); 3];
+                    self.meshes_changed();
+                }
                 Action::SetMeshVisible(i, b) => {
                     if let Some(m) = self.meshes.get_mut(i) {
                         m.visible = b;
@@ -385,6 +414,7 @@ impl ViewerApp {
             adapter: self.gpu.as_ref().ok().map(|g| g.info.name.as_str()),
             settings: &self.settings,
             meshes: &self.meshes,
+            lights: self.lights.len(),
             camera_at_home: self.camera.is_home(),
             status: &self.status,
             frame: self.frame.as_ref(),

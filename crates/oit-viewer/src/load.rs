@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DMat4, DVec3};
-use oit_core::Mesh;
+use oit_core::{Material, Mesh, Shading};
 
 use crate::scenefile::{self, NamedMesh, SceneData};
 
@@ -21,6 +21,9 @@ pub fn load_all(paths: &[PathBuf], alpha: Option<f32>) -> Result<SceneData, Stri
         let mut part = load(path, alpha)?;
         out.camera = out.camera.or(part.camera);
         out.size = out.size.or(part.size);
+        if out.lights.is_empty() && out.ambient == [0.0; 3] {
+            (out.lights, out.ambient) = (part.lights, part.ambient);
+        }
         out.meshes.append(&mut part.meshes);
     }
     if out.meshes.is_empty() {
@@ -63,8 +66,14 @@ pub fn load(path: &Path, alpha: Option<f32>) -> Result<SceneData, String> {
     Ok(scene)
 }
 
+/// Meshes from a mesh file, lit as `python -m oit render` lights them: smooth shading with
+/// computed normals, a little specular, the headlight and a dim ambient term (docs/shading.md).
 fn meshes_only(meshes: Vec<NamedMesh>) -> SceneData {
-    SceneData { meshes, camera: None, size: None }
+    let lit = |m: NamedMesh| {
+        let material = Material { shading: Shading::Smooth, specular: 0.25, ..Default::default() };
+        NamedMesh { name: m.name, mesh: m.mesh.with_surface(None, None, material).expect("a valid material") }
+    };
+    SceneData { meshes: meshes.into_iter().map(lit).collect(), ambient: [0.1; 3], ..Default::default() }
 }
 
 fn srgb_to_linear(c: f32) -> f32 {

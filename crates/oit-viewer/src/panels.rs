@@ -15,6 +15,8 @@ pub struct PanelData<'a> {
     pub adapter: Option<&'a str>,
     pub settings: &'a Settings,
     pub meshes: &'a [MeshControl],
+    /// The scene's own lights (0: the headlight).
+    pub lights: usize,
     pub camera_at_home: bool,
     pub status: &'a str,
     pub frame: Option<&'a Frame>,
@@ -38,8 +40,27 @@ pub fn side_panel(ui: &mut egui::Ui, p: &PanelData<'_>) -> Vec<Action> {
     ui.separator();
     stats_section(ui, &s, p);
     ui.separator();
+    lighting_section(ui, &mut s, p.lights, &mut out);
+    ui.separator();
     meshes_section(ui, &mut s, p.meshes, &mut out);
     out
+}
+
+/// Shading on or off, the scene's lights or the headlight, a grey ambient term (docs/shading.md).
+fn lighting_section(ui: &mut egui::Ui, s: &mut Settings, lights: usize, out: &mut Vec<Action>) {
+    if ui.checkbox(&mut s.lit, "lit (off: vertex colors only)").changed() {
+        out.push(Action::SetLit(s.lit));
+    }
+    if lights > 0 {
+        let text = format!("headlight instead of the scene's {lights} light{}", if lights == 1 { "" } else { "s" });
+        if ui.checkbox(&mut s.headlight, text).changed() {
+            out.push(Action::SetHeadlight(s.headlight));
+        }
+    }
+    let mut grey = s.ambient.iter().sum::<f32>() / 3.0;
+    if ui.add(egui::Slider::new(&mut grey, 0.0..=1.0).text("ambient")).changed() {
+        out.push(Action::SetAmbient(grey));
+    }
 }
 
 fn method_section(ui: &mut egui::Ui, s: &mut Settings, out: &mut Vec<Action>) {

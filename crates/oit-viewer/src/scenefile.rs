@@ -4,10 +4,11 @@
 
 use std::path::Path;
 
-use oit_core::Mesh;
+use oit_core::{Light, Material, Mesh, Shading, Texture};
 
 pub const MAGIC: &[u8; 8] = b"OITSCENE";
-pub const VERSION: u32 = 1;
+/// The newest version; a file without surfaces, lights or ambient term is written as 1.
+pub const VERSION: u32 = 2;
 
 /// A camera as a scene file stores it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,6 +33,9 @@ pub struct SceneData {
     pub meshes: Vec<NamedMesh>,
     pub camera: Option<CameraSpec>,
     pub size: Option<(u32, u32)>,
+    /// Directional lights (none: the headlight) and the ambient term (docs/shading.md).
+    pub lights: Vec<Light>,
+    pub ambient: [f32; 3],
 }
 
 struct Reader<'a> {
@@ -50,6 +54,10 @@ impl<'a> Reader<'a> {
     fn u32(&mut self, what: &str) -> Result<u32, String> {
         Ok(u32::from_le_bytes(self.take(4, what)?.try_into().unwrap()))
     }
+    fn f32s<const N: usize>(&mut self, what: &str) -> Result<[f32; N], String> {
+        let b = self.take(4 * N, what)?;
+        Ok(std::array::from_fn(|i| f32::from_le_bytes(b[4 * i..4 * i + 4].try_into().unwrap())))
+    }
     fn f64s<const N: usize>(&mut self, what: &str) -> Result<[f64; N], String> {
         let b = self.take(8 * N, what)?;
         Ok(std::array::from_fn(|i| f64::from_le_bytes(b[8 * i..8 * i + 8].try_into().unwrap())))
@@ -67,8 +75,8 @@ pub fn parse(data: &[u8]) -> Result<SceneData, String> {
         return Err("not an oit scene file (it does not start with OITSCENE)".into());
     }
     let version = r.u32("the version")?;
-    if version != VERSION {
-        return Err(format!("scene file version {version}; this viewer reads version {VERSION}"));
+    if version != 1 && version != VERSION {
+        return Err(format!("scene file version {version}; this viewer reads versions 1 and {VERSION}"));
     }
     let (w, h) = (r.u32("the size")?, r.u32("the size")?);
     let size = (w > 0 && h > 0).then_some((w, h));
@@ -102,13 +110,57 @@ pub fn parse(data: &[u8]) -> Result<SceneData, String> {
         let positions: Vec<[f32; 3]> = r.array(n, "positions")?;
         let colors: Vec<[f32; 4]> = r.array(n, "colors")?;
         let indices: Vec<[u32; 3]> = r.array(m, "indices")?;
-        let mesh = Mesh::new(positions, indices, colors, flags & 1 != 0).map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
+        let mut mesh = Mesh::new(positions, indices, colors, flags & 1 != 0).map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
+        if flags & 2 != 0 {
+            mesh = read_surface(&mut r, mesh, n).map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
+        }
         meshes.push(NamedMesh { name: if name.is_empty() { format!("mesh {i}") } else { name }, mesh });
+    }
+    let (mut lights, mut ambient) = (Vec::new(), [0.0; 3]);
+    if version == 2 {
+        for _ in 0..r.u32("the light count")? {
+            let v: [f32; 7] = r.f32s("a light")?;
+            lights.push(Light::new([v[0], v[1], v[2]], [v[3], v[4], v[5]], v[6]).map_err(|e| e.to_string())?);
+        }
+        ambient = r.f32s("the ambient term")?;
     }
     if r.at != data.len() {
         return Err(format!("{} bytes after the last mesh", data.len() - r.at));
     }
-    Ok(SceneData { meshes, camera, size })
+    Ok(SceneData { meshes, camera, size, lights, ambient })
+}
+
+/// A mesh's surface (flags bit 1): shading, two-sidedness, specular, shininess, opacity, then
+/// optional normals, UVs and texture.
+fn read_surface(r: &mut Reader<'_>, mesh: Mesh, n: usize) -> Result<Mesh, String> {
+    let shading = match r.u32("the shading")? {
+        0 => Shading::Unlit,
+        1 => Shading::Flat,
+        2 => Shading::Smooth,
+        k => return Err(format!("unknown shading {k} (0: unlit, 1: flat, 2: smooth)")),
+    };
+    let two_sided = r.u32("two-sidedness")? != 0;
+    let [specular, shininess, opacity] = r.f32s("the material")?;
+    let count = |r: &mut Reader<'_>, what: &str| -> Result<usize, String> {
+        match r.u32(what)? as usize {
+            0 => Ok(0),
+            c if c == n => Ok(c),
+            c => Err(format!("{c} {what} for {n} vertices")),
+        }
+    };
+    let k = count(r, "normals")?;
+    let normals: Option<Vec<[f32; 3]>> = (k > 0).then(|| r.array(k, "normals")).transpose()?;
+    let k = count(r, "uvs")?;
+    let uvs: Option<Vec<[f32; 2]>> = (k > 0).then(|| r.array(k, "uvs")).transpose()?;
+    let (h, w) = (r.u32("the texture height")?, r.u32("the texture width")?);
+    let texture = if h > 0 && w > 0 {
+        let texels = r.array((h as usize).saturating_mul(w as usize), "texels")?;
+        Some(Texture::new(w, h, texels).map_err(|e| e.to_string())?)
+    } else {
+        None
+    };
+    let material = Material { shading, specular, shininess, opacity, two_sided, texture };
+    mesh.with_surface(normals, uvs, material).map_err(|e| e.to_string())
 }
 
 pub fn read(path: &Path) -> Result<SceneData, String> {
@@ -123,7 +175,10 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
     let f64s = |out: &mut Vec<u8>, v: &[f64]| v.iter().for_each(|x| out.extend(x.to_le_bytes()));
     out.extend(MAGIC);
     let (w, h) = scene.size.unwrap_or((0, 0));
-    u32s(&mut out, &[VERSION, w, h]);
+    let surfaced = |m: &Mesh| !m.material.is_plain() || !m.normals.is_empty() || !m.uvs.is_empty();
+    let version =
+        if scene.lights.is_empty() && scene.ambient == [0.0; 3] && !scene.meshes.iter().any(|m| surfaced(&m.mesh)) { 1 } else { VERSION };
+    u32s(&mut out, &[version, w, h]);
     match scene.camera {
         None => u32s(&mut out, &[0]),
         Some(CameraSpec::Matrix(m)) => {
@@ -138,12 +193,37 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
     }
     u32s(&mut out, &[scene.meshes.len() as u32]);
     for m in &scene.meshes {
-        u32s(&mut out, &[m.mesh.opaque as u32, m.name.len() as u32]);
+        let surface = surfaced(&m.mesh);
+        u32s(&mut out, &[m.mesh.opaque as u32 | if surface { 2 } else { 0 }, m.name.len() as u32]);
         out.extend(m.name.as_bytes());
         u32s(&mut out, &[m.mesh.positions.len() as u32, m.mesh.indices.len() as u32]);
         out.extend(bytemuck::cast_slice(&m.mesh.positions));
         out.extend(bytemuck::cast_slice(&m.mesh.colors));
         out.extend(bytemuck::cast_slice(&m.mesh.indices));
+        if surface {
+            let mat = &m.mesh.material;
+            u32s(&mut out, &[mat.shading.code(), mat.two_sided as u32]);
+            out.extend(bytemuck::cast_slice(&[mat.specular, mat.shininess, mat.opacity]));
+            u32s(&mut out, &[m.mesh.normals.len() as u32]);
+            out.extend(bytemuck::cast_slice(&m.mesh.normals));
+            u32s(&mut out, &[m.mesh.uvs.len() as u32]);
+            out.extend(bytemuck::cast_slice(&m.mesh.uvs));
+            match &mat.texture {
+                Some(t) => {
+                    u32s(&mut out, &[t.height, t.width]);
+                    out.extend(bytemuck::cast_slice(&t.texels));
+                }
+                None => u32s(&mut out, &[0, 0]),
+            }
+        }
+    }
+    if version == VERSION {
+        u32s(&mut out, &[scene.lights.len() as u32]);
+        for l in &scene.lights {
+            out.extend(bytemuck::cast_slice(&[l.direction, l.color].concat()));
+            out.extend(l.intensity.to_le_bytes());
+        }
+        out.extend(bytemuck::cast_slice(&scene.ambient));
     }
     out
 }
@@ -164,7 +244,7 @@ mod tests {
         let mut identity = [[0.0; 4]; 4];
         (0..4).for_each(|i| identity[i][i] = 1.0);
         for camera in [None, Some(look), Some(CameraSpec::Matrix(identity))] {
-            let scene = SceneData { meshes: vec![triangle(false), triangle(true)], camera, size: Some((64, 32)) };
+            let scene = SceneData { meshes: vec![triangle(false), triangle(true)], camera, size: Some((64, 32)), ..Default::default() };
             let back = parse(&encode(&scene)).unwrap();
             assert_eq!(back.camera, camera);
             assert_eq!(back.size, Some((64, 32)));
@@ -199,6 +279,27 @@ mod tests {
         assert_eq!(tri.colors, [[1.0, 0.0, 0.0, 0.25], [0.0, 1.0, 0.0, 0.5], [0.0, 0.0, 1.0, 0.75]]);
         assert_eq!(tri.indices, [[0, 1, 2]]);
         assert!(encode(&scene) == bytes, "the viewer writes the file's bytes back");
+    }
+
+    #[test]
+    fn surfaces_and_lights_round_trip_as_version_2() {
+        let mut lit = triangle(false);
+        let material = Material { shading: Shading::Smooth, specular: 0.5, opacity: 0.75, ..Default::default() };
+        let texture = Texture::new(1, 2, vec![[1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.5]]).unwrap();
+        lit.mesh = lit.mesh.with_surface(None, Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), material).unwrap();
+        lit.mesh.material.texture = Some(texture);
+        let light = Light::new([0.0, -1.0, -1.0], [1.0, 0.5, 0.25], 0.8).unwrap();
+        let scene = SceneData { meshes: vec![lit, triangle(true)], lights: vec![light], ambient: [0.1, 0.2, 0.3], ..Default::default() };
+        let bytes = encode(&scene);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
+        let back = parse(&bytes).unwrap();
+        let (m, plain) = (&back.meshes[0].mesh, &back.meshes[1].mesh);
+        assert_eq!((m.material.shading, m.material.specular, m.material.opacity), (Shading::Smooth, 0.5, 0.75));
+        assert_eq!(m.normals, scene.meshes[0].mesh.normals);
+        assert_eq!(m.material.texture.as_ref().unwrap().texels[1], [0.0, 0.0, 1.0, 0.5]);
+        assert!(plain.material.is_plain() && plain.opaque);
+        assert_eq!((back.lights[0].direction, back.lights[0].intensity, back.ambient), ([0.0, -1.0, -1.0], 0.8, [0.1, 0.2, 0.3]));
+        assert_eq!(encode(&back), bytes);
     }
 
     #[test]

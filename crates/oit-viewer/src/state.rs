@@ -46,6 +46,11 @@ pub struct Settings {
     pub antialias: u32,
     /// Coverage masks instead of sample frames (abuffer at 4 samples).
     pub coverage: bool,
+    /// Shading (docs/shading.md): off draws every mesh unlit (its vertex colors); `headlight`
+    /// replaces the scene's lights with the one along the view; the ambient term, linear RGB.
+    pub lit: bool,
+    pub headlight: bool,
+    pub ambient: [f32; 3],
 }
 
 impl Settings {
@@ -70,6 +75,9 @@ impl Settings {
             render_scale: 1.0,
             antialias: 1,
             coverage: false,
+            lit: true,
+            headlight: false,
+            ambient: [0.0; 3],
         }
     }
 
@@ -139,6 +147,10 @@ pub enum Action {
     SetCoverage(bool),
     SetRenderScale(f32),
     SetShowOpaque(bool),
+    SetLit(bool),
+    SetHeadlight(bool),
+    /// A grey ambient term.
+    SetAmbient(f32),
     /// Mesh `index`: visible or not.
     SetMeshVisible(usize, bool),
     /// Mesh `index`: its alpha (or the factor on its alphas).

@@ -33,7 +33,7 @@ fn scene() -> SceneData {
             quad(-0.6, 0.6, [0.25, 0.25, 0.3, 1.0], true),
         ],
         camera: Some(CameraSpec::LookAt { eye: [0.4, 0.3, 3.0], target: [0.0; 3], up: [0.0, 1.0, 0.0], fov_y: 45.0, near: 1.0, far: 5.0 }),
-        size: None,
+        ..Default::default()
     }
 }
 

@@ -1,5 +1,6 @@
 """The bench's command line (`python -m oit bench`, also `python -m oit.bench`): the main sweep
-(oit.bench.results) or, instead of it, the experiments (--temporal, --auto, --antialias, --scale), and
+(oit.bench.results) or, instead of it, the experiments (--temporal, --auto, --antialias, --scale,
+--shading-cost), and
 the tables and plots they write into --out."""
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from .figure7 import figure7_table
 from .harness import QUICK_SIZE, write_tables
 from .results import COLUMNS, run
 from .scale import SCALE_METHODS, SWEEPS, parse_size, scale, write_scale
+from .shading import SHADING_COLUMNS, SHADING_COSTS, SHADING_METHODS, shading_cost
 from .temporal import TEMPORAL_COLUMNS, TEMPORAL_FRAMES, TEMPORAL_STEP_DEG, temporal
 
 
@@ -59,6 +61,12 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="--scale: frame sizes of the resolution sweep (default: 256 512 1024 1920x1080 3840x2160)")
     ap.add_argument("--scale-strands", type=int, nargs="+", default=None,
                     help="--scale: hair strands of the triangle sweep, 32 triangles each (default: 6000 25000 100000 400000)")
+    ap.add_argument("--shading-cost", action="store_true",
+                    help="instead of the method sweep: time as shading a fragment costs more, each method (default: "
+                         f"{', '.join(SHADING_METHODS)}) at --costs extra light evaluations per shaded fragment "
+                         "(shading.csv, shading.md, shading.png; docs/shading.md)")
+    ap.add_argument("--costs", type=int, nargs="+", default=list(SHADING_COSTS),
+                    help="--shading-cost: extra light evaluations per fragment (default: %(default)s; 0 is always added)")
     ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
                     help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
 
@@ -84,7 +92,18 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
-    if a.temporal or a.auto or a.antialias or a.scale:
+    if a.temporal or a.auto or a.antialias or a.scale or a.shading_cost:
+        if a.shading_cost:
+            if any(c < 0 for c in a.costs):
+                raise ValueError(f"--costs must be >= 0, got {a.costs}")
+            result = shading_cost(a.scenes, a.methods, a.sizes, tuple(a.costs), repeat, a.quick)
+            write_tables(a.out, "shading", result, SHADING_COLUMNS)
+            if not _plots_missing(a):
+                from .. import plots
+
+                path = os.path.join(a.out, "shading.png")
+                plots.shading_cost(result.rows, path)
+                print(f"wrote {path}")
         if a.scale:
             result = scale(a.scale_sweeps, a.methods, a.scale_sizes, a.scale_strands, a.scale_layers, repeat, a.quick)
             fits = write_scale(a.out, result)

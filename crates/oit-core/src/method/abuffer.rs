@@ -40,6 +40,7 @@ impl ABuffer {
                 node_bytes: std::mem::size_of::<PoolNode>() as u64,
                 state_words: STATE_WORDS,
                 samples: 1,
+                shades_at_resolve: false,
                 aux: Aux::None,
             },
         );
@@ -60,6 +61,7 @@ impl Method for ABuffer {
                             node_bytes: std::mem::size_of::<CoverageNode>() as u64,
                             state_words: state_words(c.samples),
                             samples: c.samples,
+                            shades_at_resolve: false,
                             aux: Aux::None,
                         },
                     )

@@ -37,6 +37,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 node_bytes: std::mem::size_of::<PrimNode>() as u64,
                 state_words: 0,
                 samples: 1,
+                shades_at_resolve: false,
                 aux: Aux::None,
             },
         )))

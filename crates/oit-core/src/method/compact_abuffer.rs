@@ -1,7 +1,7 @@
 //! `compact_abuffer`: the compact A-buffer (Kerzner et al. 2013). Nodes hold depth and the
-//! triangle index only (12 bytes); each triangle's shading data (clip-space corners and
-//! colors, 96 bytes) is written once by a compute pass and the resolve shades each fragment
-//! from it (shaders/compact_abuffer.wgsl).
+//! triangle index only (12 bytes); each triangle's shading data (clip-space corners, colors,
+//! normals, material and UVs: 176 bytes) is written once by a compute pass and the resolve
+//! shades each fragment from it, deferred (shaders/compact_abuffer.wgsl, docs/shading.md).
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
@@ -20,9 +20,9 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { formula: "12 B/fragment + 68 B/pixel + 96 B/triangle" },
+    memory: Memory::Scene { formula: "12 B/fragment + 68 B/pixel + 176 B/triangle" },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 12, per_triangle: 96 },
+    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 12, per_triangle: 176 },
     create: |gpu, limits| {
         Box::new(Compact(ListMethod::new(
             gpu,
@@ -32,6 +32,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 node_bytes: std::mem::size_of::<CompactNode>() as u64,
                 state_words: STATE_WORDS,
                 samples: 1,
+                shades_at_resolve: true,
                 aux: Aux::PerTriangle(std::mem::size_of::<PrimShading>() as u64),
             },
         )))

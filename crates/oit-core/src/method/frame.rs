@@ -48,6 +48,8 @@ pub(crate) struct FrameCtx<'a> {
     /// A coverage-mask frame's per-sample targets (only methods that take coverage masks
     /// see one).
     pub coverage: Option<&'a SampleTargets>,
+    /// Extra light evaluations each shaded fragment does (`Renderer::set_shading_cost`).
+    pub shading_cost: u32,
 }
 
 impl<'a> FrameCtx<'a> {
@@ -285,6 +287,7 @@ impl FrameCtx<'_> {
             frame_uniform: self.frame_uniform,
             limits: self.limits,
             coverage: self.coverage,
+            shading_cost: self.shading_cost,
         }
     }
 

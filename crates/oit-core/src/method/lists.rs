@@ -204,6 +204,7 @@ pub(crate) struct ListMethod {
     aux: Aux,
     /// The prefix sum over binding 7, for `Aux::PixelOffsets`, and the pixels it is for.
     scan: Option<(u64, Scan)>,
+    shades_at_resolve: bool,
 }
 
 struct Pipelines {
@@ -224,6 +225,9 @@ pub(crate) struct ListLayout {
     pub state_words: u64,
     /// Samples a pixel of the sorted resolve (common/sweep.wgsl); unused without sweeps.
     pub samples: u32,
+    /// Whether turning a node into a fragment shades it (compact_abuffer): its loop
+    /// iterations then count in the resolve's step budget.
+    pub shades_at_resolve: bool,
     /// What binding 7 holds, and so which passes run before capture.
     pub aux: Aux,
 }
@@ -245,6 +249,7 @@ impl ListMethod {
             consts: Vec::new(),
             pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.aux),
             sweeps: (layout.state_words > 0).then_some(layout.samples),
+            shades_at_resolve: layout.shades_at_resolve,
             aux: layout.aux,
             scan: None,
         }
@@ -256,11 +261,21 @@ impl ListMethod {
     }
 
     /// This frame's pipelines, from the device's cache.
-    fn pipelines(&self, cx: &FrameCtx<'_>, run: u32) -> Pipelines {
+    /// What a step of the sorted resolve costs in this frame.
+    fn step_costs(&self, cx: &FrameCtx<'_>) -> StepCosts {
+        // shading.wgsl's `shade`: its light loop, the shading-cost loop, and a margin for its
+        // other loops, each of which llvmpipe's limiter counts once even when skipped.
+        let frag = if self.shades_at_resolve { 4 + crate::shading::MAX_LIGHTS as u64 + cx.shading_cost as u64 } else { 0 };
+        let run = (cx.max_depth_complexity as u64).min(RUN as u64);
+        StepCosts { samples: self.sweeps.unwrap_or(1) as u64, frag, run }
+    }
+
+    fn pipelines(&self, cx: &FrameCtx<'_>, run: u32, costs: StepCosts, budget: u64) -> Pipelines {
         let mut consts = self.pool.consts().to_vec();
         consts.push(Const::U32("BATCH", BATCH));
         consts.push(Const::U32("RUN", run));
-        consts.push(Const::U32("STEP_BUDGET", step_budget(cx.gpu) as u32));
+        consts.push(Const::U32("STEP_BUDGET", budget as u32));
+        consts.push(Const::U32("FRAG_STEPS", costs.frag as u32));
         consts.extend(self.consts.iter().copied());
         let shader = ShaderKey::new(self.shader, &consts);
         let compute = |entry| cx.compute_pipeline(&shader, entry, POOL_LAYOUT);
@@ -313,7 +328,9 @@ impl ListMethod {
             (false, 0) => pixels.min(self.pool.max_nodes()),
             (false, c) => c,
         };
-        let sweeps = self.sweeps.map_or([0; 3], |samples| resolve_dispatches(cx.gpu, cx.max_depth_complexity as u64, samples as u64));
+        let costs = self.step_costs(cx);
+        let budget = if self.sweeps.is_some() { step_budget(cx.gpu, costs)? } else { 1 };
+        let sweeps = if self.sweeps.is_some() { resolve_dispatches(cx.max_depth_complexity as u64, costs, budget) } else { [0; 3] };
         let triangles = cx.scene.transparent.triangles as u64;
         self.pool.reserve(cx.gpu, initial, pixels, triangles, tiled)?;
         if self.aux == Aux::PixelOffsets && self.scan.as_ref().is_none_or(|(p, _)| *p != pixels) {
@@ -323,7 +340,7 @@ impl ListMethod {
         let targets_group = cx.targets_group();
         loop {
             cx.timer.reset();
-            let p = self.pipelines(cx, run_length(cx.max_depth_complexity as u64));
+            let p = self.pipelines(cx, run_length(cx.max_depth_complexity as u64), costs, budget);
             let group = self.pool.group.as_ref().expect("reserved above");
             let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
             self.pool.clear(cx.gpu, &mut enc);
@@ -405,41 +422,80 @@ pub(crate) const fn state_words(samples: u32) -> u64 {
 /// Bytes a pixel of a sorted-resolve method keeps besides its pool: its head and sweep state.
 pub(crate) const PIXEL_BYTES: u64 = 4 + 4 * STATE_WORDS;
 
-/// Steps one invocation of the sorted resolve takes before it pauses until the next dispatch:
-/// on llvmpipe, whose loop limiter counts them, its limit less the largest unit of work (a
-/// run of RUN sorted and composited, under 1,000); large elsewhere. The image does not
-/// depend on it.
-pub fn step_budget(gpu: &GpuContext) -> u64 {
-    if loop_limited(gpu) {
-        LLVMPIPE_LOOP_LIMIT - 4096
-    } else {
-        1 << 22
+/// What one step of the sorted resolve costs on llvmpipe's loop limiter (the constants of
+/// shaders/common/sweep.wgsl, which this mirrors): `frag` is what turning a node into a
+/// fragment adds (compact_abuffer shades it there: its lights and the shading-cost loop);
+/// `run` the fragments a run holds in this frame (RUN, or the deepest list when shorter).
+#[derive(Clone, Copy, Debug)]
+pub struct StepCosts {
+    pub samples: u64,
+    pub frag: u64,
+    pub run: u64,
+}
+
+impl StepCosts {
+    fn load(self) -> u64 {
+        2 + self.frag
+    }
+    const LINK: u64 = 2;
+    fn merge(self) -> u64 {
+        6 + 2 * self.frag
+    }
+    fn composite(self) -> u64 {
+        4 + self.samples + self.frag
+    }
+
+    /// A run loaded, insertion-sorted and relinked or composited: the largest unit of work
+    /// between two checks of the budget.
+    fn run(self) -> u64 {
+        let run = self.run;
+        self.load() * (run + 1) + run.saturating_sub(1) * (run + 2) / 2 + run * Self::LINK.max(2 + self.samples)
+    }
+
+    fn largest_unit(self) -> u64 {
+        self.run().max(self.merge()).max(self.composite())
     }
 }
 
-/// Steps of each phase of the sorted resolve (shaders/common/sweep.wgsl, whose step counts
-/// this mirrors) after its first dispatch, on a pixel of n fragments at `samples` samples, at
-/// most: the further runs of RUN loaded, insertion-sorted and relinked; ceil(log2(runs))
-/// merge passes of two steps a node and two a pair; the composite walk. Zero for a list of
-/// one run, which the first dispatch composites.
-pub fn resolve_steps(n: u64, samples: u64) -> [u64; 3] {
-    const LOAD: u64 = 3;
-    const LINK: u64 = 2;
-    const MERGE: u64 = 6;
+/// Steps one invocation of the sorted resolve takes before it pauses until the next dispatch:
+/// on llvmpipe, whose loop limiter counts them, its limit less the largest unit of work; large
+/// elsewhere. The image does not depend on it.
+pub fn step_budget(gpu: &GpuContext, costs: StepCosts) -> Result<u64> {
+    if !loop_limited(gpu) {
+        return Ok(1 << 22);
+    }
+    // The first dispatch does one unit; a deeper frame's dispatches need room for several.
+    let unit = costs.largest_unit();
+    let room = if costs.run < RUN as u64 { LLVMPIPE_LOOP_LIMIT } else { LLVMPIPE_LOOP_LIMIT / 2 };
+    if unit > room {
+        return Err(OitError::Unsupported(format!(
+            "the exact resolve needs {unit} loop iterations for one unit of work here (a fragment shaded at resolve with \
+             {} iterations), and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: lower shading_cost or use \
+             abuffer, which shades at capture",
+            costs.frag
+        )));
+    }
+    Ok(LLVMPIPE_LOOP_LIMIT - unit)
+}
+
+/// Steps of each phase of the sorted resolve after its first dispatch, on a pixel of n
+/// fragments, at most: the further runs of RUN; ceil(log2(runs)) merge passes of two steps a
+/// node and two a pair; the composite walk. Zero for a list of one run, which the first
+/// dispatch composites.
+pub fn resolve_steps(n: u64, costs: StepCosts) -> [u64; 3] {
     let run = RUN as u64;
     if n <= run {
         return [0; 3];
     }
-    let sort = LOAD * (run + 1) + (run - 1) * (run + 2) / 2 + LINK * run;
     let runs = n.div_ceil(run);
     let passes = runs.next_power_of_two().ilog2() as u64;
-    [(runs - 1) * sort, passes * MERGE * (2 * n + 2 * runs), (n + 1) * (4 + samples)]
+    [(runs - 1) * costs.run(), passes * costs.merge() * (2 * n + 2 * runs), (n + 1) * costs.composite()]
 }
 
 /// Dispatches of each phase after `cs_sort` (runs, merge, composite) that finish a frame
 /// whose deepest pixel has n fragments.
-pub fn resolve_dispatches(gpu: &GpuContext, n: u64, samples: u64) -> [u32; 3] {
-    resolve_steps(n, samples).map(|steps| steps.div_ceil(step_budget(gpu)) as u32)
+pub fn resolve_dispatches(n: u64, costs: StepCosts, budget: u64) -> [u32; 3] {
+    resolve_steps(n, costs).map(|steps| steps.div_ceil(budget) as u32)
 }
 
 /// Refuses a frame whose deepest pixel the one-invocation replay of a submission-order

@@ -32,6 +32,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 node_bytes: std::mem::size_of::<PoolNode>() as u64,
                 state_words: STATE_WORDS,
                 samples: 1,
+                shades_at_resolve: false,
                 aux: Aux::PerTriangle(std::mem::size_of::<PallBlock>() as u64),
             },
         )))
