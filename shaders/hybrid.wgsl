@@ -58,7 +58,7 @@ fn key_alpha(key: u32) -> f32 {
 
 @fragment @early_depth_test(force)
 fn fs_store(raw: VsOut) {
-    let in = shaded(raw);
+    let in = shaded_alpha(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }

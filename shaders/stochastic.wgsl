@@ -34,7 +34,7 @@ fn covers(prim: u32, px: u32, s: u32, alpha: f32) -> bool {
 
 @fragment @early_depth_test(force)
 fn fs_depth(raw: VsOut) {
-    let in = shaded(raw);
+    let in = shaded_alpha(raw);
     if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }

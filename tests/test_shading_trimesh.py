@@ -93,3 +93,16 @@ def test_render_cli_lights_and_flat_shading(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "oit", "render", str(path), "--shading", "phong"], cwd=tmp_path,
                          capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and "phong" in bad.stderr
+
+
+def test_a_mesh_from_shared_data_shows_its_shape(shared_data):
+    # As `python -m oit render` loads it: trimesh, then from_trimesh with the defaults.
+    mesh = trimesh.load(shared_data / "suzanne.obj", force="mesh")
+    scene = oit.Scene.from_trimesh(mesh, alpha=1.0)
+    camera = oit.Camera.fit(mesh.vertices)
+    lit = oit.Renderer(48, 48).render(scene, camera).image
+    flat = oit.Renderer(48, 48).render(oit.Scene.from_trimesh(mesh, alpha=1.0, shading="unlit"), camera).image
+    covered = flat[..., 3] > 0.99
+    assert covered.mean() > 0.2
+    assert np.ptp(flat[..., 0][covered]) < 1e-5  # unlit: one flat grey silhouette
+    assert np.std(lit[..., 0][covered]) > 0.05  # lit: the shape shows

@@ -43,6 +43,17 @@ fn shading_cost(n: vec3<f32>, v: vec3<f32>, count: u32) -> f32 {
     return sum;
 }
 
+// The vertex color times the texture, alpha times opacity: all that alpha depends on.
+fn surface_base(in: VsOut, m0: vec4<f32>) -> vec4<f32> {
+    var base = in.color;
+    if (bitcast<u32>(m0.w) & TEXTURED) != 0u {
+        let m1 = bitcast<vec4<u32>>(surfaces[2u * in.material + 1u]);
+        base = base * texture_sample(m1.x, vec2<i32>(m1.yz), in.uv);
+    }
+    base.a = base.a * m0.z;
+    return base;
+}
+
 fn shade(in: VsOut) -> vec4<f32> {
     if frame.shading.x == 0u {
         if frame.shading.z == 0u {
@@ -53,12 +64,7 @@ fn shade(in: VsOut) -> vec4<f32> {
     }
     let m0 = surfaces[2u * in.material];
     let flags = bitcast<u32>(m0.w);
-    var base = in.color;
-    if (flags & TEXTURED) != 0u {
-        let m1 = bitcast<vec4<u32>>(surfaces[2u * in.material + 1u]);
-        base = base * texture_sample(m1.x, vec2<i32>(m1.yz), in.uv);
-    }
-    base.a = base.a * m0.z;
+    let base = surface_base(in, m0);
     let v = to_eye(in.clip.xy);
     var extra = 0.0;
     if frame.shading.z != 0u {
@@ -89,5 +95,15 @@ fn shade(in: VsOut) -> vec4<f32> {
 fn shaded(raw: VsOut) -> VsOut {
     var out = raw;
     out.color = shade(raw);
+    return out;
+}
+
+// The fragment with its shaded alpha (the same bits as shade()'s) and its vertex RGB: for
+// passes that read only alpha (hybrid's k-TAB store, stochastic's depth pass), no lights.
+fn shaded_alpha(raw: VsOut) -> VsOut {
+    var out = raw;
+    if frame.shading.x != 0u {
+        out.color.a = surface_base(raw, surfaces[2u * raw.material]).a;
+    }
     return out;
 }

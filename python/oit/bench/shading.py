@@ -1,8 +1,8 @@
 """`python -m oit bench --shading-cost`: how each method's time grows with the cost of shading a
 fragment. `Renderer.render(..., shading_cost=N)` makes every shaded fragment evaluate N extra
 lights whose result is discarded (the image is unchanged), so the slope of time against N is
-the number of fragment shadings a method does per frame: every fragment once, twice (two
-geometry passes that shade), once a peel, or only the stored ones (deferred shading)."""
+the number of fragment shadings a method does per frame: every fragment once (after an
+alpha-only pass, for the two-pass methods), once a peel, or only the stored ones (deferred)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from .harness import Progress, Result, scene_jobs, timed
 SHADING_METHODS = ("abuffer", "compact_abuffer", "hybrid", "ktab", "hybrid64", "wboit", "stochastic", "depth_peeling")
 SHADING_COSTS = (0, 64, 256, 1024)
 # How many times each method shades a fragment (docs/shading.md, "How often each method shades").
-SHADINGS_PER_FRAGMENT = {"hybrid": "2", "ktab": "2", "stochastic": "2", "depth_peeling": "1 a peel",
+SHADINGS_PER_FRAGMENT = {"hybrid": "1 + alpha", "ktab": "1 + alpha", "stochastic": "1 + alpha", "depth_peeling": "1 a peel",
                          "dual_depth_peeling": "1 a peel", "compact_abuffer": "stored only (deferred)",
                          "auto": "estimate + its method's"}
 
