@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from .. import scenes as scene_lib
 from .antialias import AA_COLUMNS, AA_METHODS, AA_SAMPLES, antialias
 from .auto import AUTO_COLUMNS, AUTO_MAX_K, AUTO_TOLERANCES, auto_vs_fixed
+from .claims import CLAIM_COLUMNS, run_claims
 from .figure7 import figure7_table
 from .harness import QUICK_SIZE, write_tables
 from .results import COLUMNS, run
@@ -67,6 +68,10 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                          "(shading.csv, shading.md, shading.png; docs/shading.md)")
     ap.add_argument("--costs", type=int, nargs="+", default=list(SHADING_COSTS),
                     help="--shading-cost: extra light evaluations per fragment (default: %(default)s; 0 is always added)")
+    ap.add_argument("--claims", action="store_true",
+                    help="instead of the method sweep: the seeds' claims measured on this engine, each with a verdict "
+                         "(claims.csv, claims.md; docs/claims.md); the quick ones only unless --full")
+    ap.add_argument("--full", action="store_true", help="--claims: also the claims that need full-size scenes (minutes)")
     ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
                     help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
 
@@ -92,6 +97,9 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
+    if a.claims:
+        write_tables(a.out, "claims", run_claims(full=a.full), CLAIM_COLUMNS)
+        return 0
     if a.temporal or a.auto or a.antialias or a.scale or a.shading_cost:
         if a.shading_cost:
             if any(c < 0 for c in a.costs):
