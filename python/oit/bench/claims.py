@@ -95,6 +95,66 @@ def weighted_by_opacity() -> tuple[str, str]:
     return "; ".join(out) + " (10 layers, mean error against the A-buffer)", HOLDS if ok else FAILS
 
 
+def weighted_sum_saturates() -> tuple[str, str]:
+    built = _layers(0.5)
+    rgb = {m: _render(built, m).image[..., :3] for m in ("wsum", "wavg")}
+    text = "; ".join(f"{m}: channels from {v.min():.2f} to {v.max():.2f}" for m, v in rgb.items())
+    out_of_range = lambda v: v.min() < 0.0 or v.max() > 1.0  # noqa: E731
+    verdict = HOLDS if out_of_range(rgb["wsum"]) and not out_of_range(rgb["wavg"]) else FAILS
+    return f"ten layers at alpha 0.5 over the white background: {text} (a color is in [0, 1])", verdict
+
+
+def wboit_against_wavg() -> tuple[str, str]:
+    out, better = [], True
+    for alpha in (0.1, 0.5, 0.9):
+        built = _layers(alpha)
+        e = {m: _mean_err(built, m) for m in ("wboit", "wavg")}
+        out.append(f"alpha {alpha}: wboit {e['wboit']:.4f}, wavg {e['wavg']:.4f}")
+        better &= e["wboit"] < e["wavg"]
+    return "; ".join(out) + " (ten full-screen layers, mean error against the A-buffer)", HOLDS if better else FAILS
+
+
+def filter_order_independent() -> tuple[str, str]:
+    rng = np.random.default_rng(6)
+    colors = [(*rng.uniform(0, 1, 3), rng.uniform(0.1, 0.9)) for _ in range(8)]
+    images = []
+    for order in (range(8), reversed(range(8))):
+        scene = Scene()
+        for i in order:
+            z = 0.1 + 0.1 * i
+            quad = np.array([[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]], np.float32)
+            scene.add_mesh(quad, [[0, 1, 2], [0, 2, 3]], colors[i])
+        images.append(Renderer(8, 8).render(scene, Camera(np.eye(4)), "filter").image)
+    same = np.array_equal(images[0], images[1])
+    diff = float(np.abs(images[0] - images[1]).max())
+    return f"eight filter layers drawn in two orders: images {'bit-identical' if same else f'differ by {diff:.2e}'}", \
+        HOLDS if diff <= 1e-6 else FAILS
+
+
+def hybrid_two_passes() -> tuple[str, str]:
+    built = scene_lib.stacks(layers=12, size=(8, 8), seed=7)
+    geometry = {"hybrid": ("store", "shade"), "hybrid64": ("insert",)}
+    out, ok = [], True
+    for method, expected in geometry.items():
+        passes = list(_render(built, method, k=4).stats["pass_times_ms"])
+        found = [p for p in passes if p in expected]
+        out.append(f"{method}: passes {', '.join(passes)} ({len(found)} over the geometry)")
+        ok &= len(found) == len(expected)
+    return "; ".join(out), HOLDS if ok else FAILS
+
+
+def list_memory_linear() -> tuple[str, str]:
+    points = []
+    for layers in (4, 16, 64):
+        built = scene_lib.stacks(layers=layers, size=(16, 16), seed=8)
+        f = _render(built, "abuffer")
+        points.append((f.stats["fragments"], f.stats["memory_bytes"]))
+    slopes = [(m2 - m1) / (f2 - f1) for (f1, m1), (f2, m2) in zip(points, points[1:])]
+    text = ", ".join(f"{f} fragments: {m / 1024:.0f} KiB" for f, m in points)
+    text += f"; {slopes[0]:.1f} and {slopes[1]:.1f} bytes a fragment more"
+    return text, HOLDS if all(abs(s - 24) < 1e-9 for s in slopes) else FAILS
+
+
 def pall_memory() -> tuple[str, str]:
     built = scene_lib.glass(detail=16)
     r = Renderer(64, 64)
@@ -181,6 +241,17 @@ CLAIMS: list[Claim] = [
     Claim("RTR-stoch", "RTR 5.5", "stochastic transparency's noise falls with more samples", True, stochastic_noise),
     Claim("RTR-weighted", "RTR 5.5, weighted average", "nearly opaque objects give poor results ... works well for highly "
           "transparent surfaces and particles", True, weighted_by_opacity),
+    Claim("RTR-wsum", "RTR 5.5, weighted sum", "the weighted sum saturates and can go negative; the weighted average avoids it",
+          True,
+          weighted_sum_saturates),
+    Claim("RTR-wboit", "RTR 5.5, weighted blended OIT", "WB-OIT gives a more convincing result than the weighted average", True,
+          wboit_against_wavg),
+    Claim("RTR-filter", "RTR 5.5, transmission", "colour filtering (multiplying by the transmittance) is order-independent", True,
+          filter_order_independent),
+    Claim("HT-passes", "Maule et al. 2013, §3", "hybrid transparency runs in two geometry passes (a single-pass HT awaits 64-bit "
+          "atomics)", True, hybrid_two_passes),
+    Claim("KZ-linear", "Kerzner et al. 2013", "a linked-list A-buffer's memory grows linearly with the fragment count", True,
+          list_memory_linear),
     Claim("KZ-mem", "Kerzner et al. 2013", "PALL uses more memory than per-pixel linked lists", True, pall_memory),
     Claim("KZ-compact", "Kerzner et al. 2013, Fig. 1", "the compact A-buffer uses less memory than the regular one when "
           "fragments outnumber primitives", True, compact_memory),
