@@ -1,7 +1,7 @@
-//! Float accumulation targets shared by the blended methods (`wsum`, `wavg`, `wboit`,
+//! Float render targets shared by the blended methods (`wsum`, `wavg`, `wboit`,
 //! `stochastic`): premultiplied color summed into RGBA32F and a companion R32F target (a
 //! count, or revealage multiplied down), drawn by one blended geometry pass and read by a
-//! full-screen resolve.
+//! full-screen resolve. hybrid's blended tail (ktab.rs) keeps its four targets the same way.
 
 use super::frame::FrameCtx;
 use crate::cache::Layout;
@@ -53,45 +53,65 @@ pub fn memory_bytes(pixels: u64) -> u64 {
     pixels * TARGET_BYTES
 }
 
-/// The accumulation targets of one frame size, and the group a resolve reads them through.
-pub(crate) struct AccumTargets {
+/// Float render targets of the frame's size that a geometry pass blends into and a resolve
+/// reads back as textures: the blended methods' two (`ACCUM_FORMAT`, `AUX_FORMAT`) and
+/// hybrid's blended tail's four (ktab.rs). Tiles of a frame share them, each drawing its part.
+pub(crate) struct FloatTargets {
     size: (u32, u32),
-    accum: wgpu::TextureView,
-    aux: wgpu::TextureView,
-    /// The two targets as textures at `bindings` (the layout `Layout::Textures(bindings)`).
+    views: Vec<wgpu::TextureView>,
+    /// The targets as textures at `bindings` (the layout `Layout::Textures(bindings)`).
     pub group: wgpu::BindGroup,
 }
 
-fn target(device: &wgpu::Device, size: (u32, u32), format: wgpu::TextureFormat) -> wgpu::TextureView {
-    crate::targets::texture(
-        device,
-        "accumulation",
-        size.0,
-        size.1,
-        format,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-    )
-    .create_view(&Default::default())
-}
-
-impl AccumTargets {
-    /// The targets in `slot`, made anew when the frame size changed; the resolve reads them at
-    /// `bindings` of group 2.
-    pub fn ensure<'s>(slot: &'s mut Option<AccumTargets>, cx: &FrameCtx<'_>, bindings: &'static [u32]) -> &'s AccumTargets {
+impl FloatTargets {
+    /// The targets of `formats` in `slot`, made anew when the frame size changed; a resolve
+    /// reads them at `bindings` of its group.
+    pub fn ensure<'s>(
+        slot: &'s mut Option<FloatTargets>,
+        cx: &FrameCtx<'_>,
+        formats: &[wgpu::TextureFormat],
+        bindings: &'static [u32],
+    ) -> &'s FloatTargets {
         let size = (cx.targets.width, cx.targets.height);
         if slot.as_ref().is_none_or(|t| t.size != size) {
-            let d = &cx.gpu.device;
-            let (accum, aux) = (target(d, size, ACCUM_FORMAT), target(d, size, AUX_FORMAT));
-            let resources = [wgpu::BindingResource::TextureView(&accum), wgpu::BindingResource::TextureView(&aux)];
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+            let views: Vec<wgpu::TextureView> = formats
+                .iter()
+                .map(|&f| {
+                    crate::targets::texture(&cx.gpu.device, "float target", size.0, size.1, f, usage).create_view(&Default::default())
+                })
+                .collect();
+            let resources: Vec<wgpu::BindingResource<'_>> = views.iter().map(wgpu::BindingResource::TextureView).collect();
             let group = cx.group(Layout::Textures(bindings), &resources);
-            *slot = Some(AccumTargets { size, accum, aux, group });
+            *slot = Some(FloatTargets { size, views, group });
         }
         slot.as_ref().expect("made above")
     }
 
-    /// Records the accumulation pass (timed as "accumulate"): `pipeline` over the transparent
-    /// geometry, tested against the opaque depth, scissored to the tile, with `groups` bound
-    /// at 1, 2, ...
+    /// The targets as a pass's color attachments, each cleared to its value in `clears`.
+    pub fn attachments(&self, clears: &[wgpu::Color]) -> Vec<Option<wgpu::RenderPassColorAttachment<'_>>> {
+        self.views
+            .iter()
+            .zip(clears)
+            .map(|(view, &clear)| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+                })
+            })
+            .collect()
+    }
+
+    /// The blended methods' two targets: accumulated color and the companion.
+    pub fn accumulation<'s>(slot: &'s mut Option<FloatTargets>, cx: &FrameCtx<'_>, bindings: &'static [u32]) -> &'s FloatTargets {
+        Self::ensure(slot, cx, &[ACCUM_FORMAT, AUX_FORMAT], bindings)
+    }
+
+    /// Records the blended methods' accumulation pass (timed as "accumulate"): `pipeline` over
+    /// the transparent geometry, tested against the opaque depth, scissored to the tile, with
+    /// `groups` bound at 1, 2, ...
     pub fn accumulate(
         &self,
         cx: &mut FrameCtx<'_>,
@@ -101,18 +121,11 @@ impl AccumTargets {
         groups: &[&wgpu::BindGroup],
     ) {
         let aux_clear = if aux == Aux::Reveal { wgpu::Color::WHITE } else { wgpu::Color::TRANSPARENT };
-        let attach = |view, clear| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
-            })
-        };
+        let attachments = self.attachments(&[wgpu::Color::TRANSPARENT, aux_clear]);
         let (depth, scene) = (&cx.targets.depth, cx.scene);
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("accumulate"),
-            color_attachments: &[attach(&self.accum, wgpu::Color::TRANSPARENT), attach(&self.aux, aux_clear)],
+            color_attachments: &attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: depth, depth_ops: None, stencil_ops: None }),
             timestamp_writes: cx.timer.render_pass("accumulate"),
             occlusion_query_set: None,

@@ -3,7 +3,7 @@
 //! second geometry pass, composite. Accumulation in fixed point, so that frames do not depend
 //! on fragment order (docs/methods.md, "hybrid"). Each pixel gets a uniform k or its own slots.
 
-use super::accum::ADD;
+use super::accum::{FloatTargets, ADD};
 use super::frame::{FrameCtx, MethodReport};
 use crate::cache::{Layout, ShaderKey};
 use crate::error::{OitError, Result};
@@ -80,51 +80,12 @@ fn blend_targets() -> Vec<Option<wgpu::ColorTargetState>> {
         .collect()
 }
 
-/// The blended sums' targets at the frame's size (tiles draw into their own part), and the
-/// group the final pass reads them through.
-struct BlendSums {
-    size: (u32, u32),
-    views: Vec<wgpu::TextureView>,
-    group: wgpu::BindGroup,
-}
-
-impl BlendSums {
-    fn ensure<'s>(slot: &'s mut Option<BlendSums>, cx: &FrameCtx<'_>) -> &'s BlendSums {
-        let size = (cx.targets.width, cx.targets.height);
-        if slot.as_ref().is_none_or(|t| t.size != size) {
-            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-            let views: Vec<wgpu::TextureView> = BLEND_FORMATS
-                .iter()
-                .map(|&f| crate::targets::texture(&cx.gpu.device, "hybrid sums", size.0, size.1, f, usage).create_view(&Default::default()))
-                .collect();
-            let resources: Vec<wgpu::BindingResource<'_>> = views.iter().map(wgpu::BindingResource::TextureView).collect();
-            let group = cx.group(Layout::Textures(BLEND_BINDINGS), &resources);
-            *slot = Some(BlendSums { size, views, group });
-        }
-        slot.as_ref().expect("made above")
-    }
-
-    fn attachments(&self) -> Vec<Option<wgpu::RenderPassColorAttachment<'_>>> {
-        self.views
-            .iter()
-            .map(|view| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
-                })
-            })
-            .collect()
-    }
-}
-
 pub(crate) struct KTab {
     /// Whether fragments behind the core form the tail (hybrid) or are discarded (ktab).
     tail: bool,
     buffers: Option<StorageGroup>,
     overflow: Option<Counter>,
-    blend: Option<BlendSums>,
+    blend: Option<FloatTargets>,
 }
 
 impl KTab {
@@ -196,10 +157,10 @@ impl KTab {
                 cx.resolve(&mut enc, "final", &cx.resolve_pipeline(&shader, "fs_final", own, true), &b.group, true);
             }
             Sums::Blend => {
-                let targets = BlendSums::ensure(&mut self.blend, cx);
+                let targets = FloatTargets::ensure(&mut self.blend, cx, &BLEND_FORMATS, BLEND_BINDINGS);
                 let groups = vec![Layout::Scene, Layout::Targets, own];
                 let shade = cx.draw_pipeline(&shader, "fs_shade_blend", groups, blend_targets(), crate::pipeline::depth_test_only());
-                cx.capture_into(&mut enc, "shade", &shade, &b.group, &targets.attachments());
+                cx.capture_into(&mut enc, "shade", &shade, &b.group, &targets.attachments(&[wgpu::Color::TRANSPARENT; 4]));
                 let fin = cx.resolve_pipeline_groups(&shader, "fs_final_blend", &[own, Layout::Textures(BLEND_BINDINGS)], true);
                 cx.resolve_groups(&mut enc, "final", &fin, &[&b.group, &targets.group], true);
             }

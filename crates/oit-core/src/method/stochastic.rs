@@ -2,7 +2,7 @@
 //! `samples` coverage samples per pixel kept in a storage buffer: a stochastic depth pass,
 //! an accumulation pass and a resolve (shaders/stochastic.wgsl). Deterministic for a seed.
 
-use super::accum::{accumulation_targets, AccumTargets, Aux};
+use super::accum::{accumulation_targets, Aux, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
@@ -47,7 +47,7 @@ pub fn memory_bytes(pixels: u64, samples: u64) -> u64 {
 
 struct Stochastic {
     samples: Option<StorageGroup>,
-    targets: Option<AccumTargets>,
+    targets: Option<FloatTargets>,
 }
 
 impl Method for Stochastic {
@@ -58,7 +58,7 @@ impl Method for Stochastic {
         cx.check_per_pixel(&format!("stochastic with {samples} samples"), 4 * samples as u64)?;
         let b = StorageGroup::ensure(&mut self.samples, cx.gpu, &[("stochastic samples", pixels * samples as u64 * 4)], &[]);
         // The accumulation targets are read only by the resolve, at bindings 1 and 2 of its group.
-        let w = AccumTargets::ensure(&mut self.targets, cx, &[1, 2]);
+        let w = FloatTargets::accumulation(&mut self.targets, cx, &[1, 2]);
         let shader = ShaderKey::new("stochastic.wgsl", &[Const::U32("SAMPLES", samples)]);
         let own = b.layout();
         let depth = cx.capture_pipeline(&shader, "fs_depth", own);

@@ -1,7 +1,7 @@
 //! `wsum`, `wavg` and `wboit`: one geometry pass with additive (and, for wboit's revealage,
 //! multiplicative) blending into two float targets, then a full-screen resolve.
 
-use super::accum::{accumulation_targets, memory_bytes, AccumTargets, Aux};
+use super::accum::{accumulation_targets, memory_bytes, Aux, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
@@ -60,7 +60,7 @@ const MEMORY: Memory = Memory::Frame { formula: "W·H·20", bytes: |px, _| memor
 
 struct Weighted {
     kind: Kind,
-    targets: Option<AccumTargets>,
+    targets: Option<FloatTargets>,
 }
 
 impl Weighted {
@@ -82,7 +82,7 @@ impl Method for Weighted {
         const TEXTURES: Layout = Layout::Textures(&[0, 1]);
         let accumulate = cx.draw_pipeline(&shader, fs, vec![Layout::Scene], accumulation_targets(aux), pipeline::depth_test_only());
         let resolve = cx.resolve_pipeline(&shader, resolve_fs, TEXTURES, false);
-        let w = AccumTargets::ensure(&mut self.targets, cx, &[0, 1]); // TEXTURES' bindings
+        let w = FloatTargets::accumulation(&mut self.targets, cx, &[0, 1]); // TEXTURES' bindings
         let mut enc = cx.encoder();
         w.accumulate(cx, &mut enc, aux, &accumulate, &[]);
         cx.resolve(&mut enc, "resolve", &resolve, &w.group, false);
