@@ -6,6 +6,8 @@ from __future__ import annotations
 import os
 import re
 
+import pytest
+
 from oit.bench.claims import CLAIMS, run_claims
 
 DOC = os.path.join(os.path.dirname(__file__), "..", "docs", "claims.md")
@@ -36,3 +38,8 @@ def test_quick_claims_still_read_as_written():
     for r in result.rows:
         assert re.search(r"\d", r["measured"]), r  # a measurement, not a word
         assert r["verdict"] == rows[r["id"]], (r["id"], r["measured"], rows[r["id"]])
+
+
+def test_unknown_claim_is_named():
+    with pytest.raises(ValueError, match="no claim XX-none"):
+        run_claims(only=["XX-none"])

@@ -72,6 +72,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="instead of the method sweep: the seeds' claims measured on this engine, each with a verdict "
                          "(claims.csv, claims.md; docs/claims.md); the quick ones only unless --full")
     ap.add_argument("--full", action="store_true", help="--claims: also the claims that need full-size scenes (minutes)")
+    ap.add_argument("--only", nargs="+", default=None, metavar="ID",
+                    help="--claims: just these claims, quick or full (ids as in docs/claims.md)")
     ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
                     help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
 
@@ -98,7 +100,7 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
     if a.claims:
-        write_tables(a.out, "claims", run_claims(full=a.full), CLAIM_COLUMNS)
+        write_tables(a.out, "claims", run_claims(full=a.full, only=a.only), CLAIM_COLUMNS)
         return 0
     if a.temporal or a.auto or a.antialias or a.scale or a.shading_cost:
         if a.shading_cost:

@@ -19,12 +19,15 @@ CLAIM_COLUMNS = [("id", "{}"), ("source", "{}"), ("claim", "{}"), ("measured", "
 
 
 def run_claims(full: bool = False, only: list[str] | None = None) -> Result:
-    """Measures the quick claims (and, with `full`, all of them); a claim whose measurement
-    raises is a row that says so."""
+    """Measures the claims named in `only`, or else the quick claims (and, with `full`, all of
+    them); a claim whose measurement raises is a row that says so."""
+    unknown = sorted(set(only or ()) - {c.id for c in CLAIMS})
+    if unknown:
+        raise ValueError(f"no claim {', '.join(unknown)}; the claims are {', '.join(c.id for c in CLAIMS)}")
     result = Result(rows=[])
     adapter = Renderer(1, 1).adapter_info["name"]
     for c in CLAIMS:
-        if (only and c.id not in only) or not (c.quick or full):
+        if (c.id not in only) if only else not (c.quick or full):
             continue
         try:
             measured, verdict = c.measure()

@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
-from ... import Renderer
+import statistics
+from functools import partial
+
+from ... import Renderer, methods
 from ... import scenes as scene_lib
-from ..harness import image_errors
-from .common import FAILS, HOLDS, Claim, median_ms
+from ..harness import QUICK_SCENE_ARGS, image_errors, timed
+from .common import FAILS, HOLDS, NOT_HERE, TIE, TOL, Claim, median_ms, render
+
+
+def _passes(method: str) -> list[str]:
+    return next(m["passes"] for m in methods() if m["name"] == method)
 
 
 def adaptive_quality() -> tuple[str, str]:
@@ -19,7 +26,7 @@ def adaptive_quality() -> tuple[str, str]:
         errs[n] = image_errors(image, exact.image, covered, flip=False)["mean_err"]
     text = (", ".join(f"{n} nodes {e:.4f}" for n, e in errs.items()) + " mean error against the A-buffer (smoke, 64²); "
             "'close': within 1/255 (0.0039)")
-    return text, HOLDS if max(errs.values()) <= 1 / 255 else FAILS
+    return text, HOLDS if max(errs.values()) <= TOL else FAILS
 
 
 def adaptive_vs_abuffer_time() -> tuple[str, str]:
@@ -51,6 +58,75 @@ def adaptive_vs_stochastic_time() -> tuple[str, str]:
     return "; ".join(out), HOLDS if min(ratios) >= 2 else FAILS
 
 
+def nodes_tradeoff() -> tuple[str, str]:
+    built = scene_lib.smoke(**QUICK_SCENE_ARGS["smoke"])
+    r = Renderer(*built.size)
+    exact = r.render(built.scene, built.camera, "abuffer")
+    errs, ms = [], []
+    for n in (1, 2, 4, 8, 16):
+        frame, gpu, _ = timed(partial(r.render, built.scene, built.camera, "adaptive", nodes=n), 3)
+        errs.append(image_errors(frame.image, exact.image, exact.depth_complexity > 0, flip=False)["mean_err"])
+        ms.append(statistics.median(gpu))
+    falls = all(a > b for a, b in zip(errs, errs[1:]))
+    text = ("smoke (150 particles) at 512², adaptive by nodes: mean error against the A-buffer, GPU median of 3: " + ", ".join(
+        f"{n}: {e:.4f}, {t:.0f} ms" for n, e, t in zip((1, 2, 4, 8, 16), errs, ms)) + f"; 16 nodes take {ms[-1] / ms[0]:.2f}× "
+        "1 node's time; holds if the error falls at every step and the time grows by more than 30 % from 1 to 16 nodes (less is "
+        "a tie on lavapipe: no performance to trade)")
+    return text, HOLDS if falls and ms[-1] > TIE * ms[0] else FAILS
+
+
+def any_geometry() -> tuple[str, str]:
+    out, lost = [], []
+    for name in scene_lib.SHOWCASE:
+        built = scene_lib.SCENES[name](**QUICK_SCENE_ARGS.get(name, {}))
+        r = Renderer(64, 64)
+        exact = r.render(built.scene, built.camera, "abuffer")
+        errs = [image_errors(r.render(built.scene, built.camera, m, **p).image, exact.image, exact.depth_complexity > 0,
+                             flip=False)["mean_err"] for m, p in (("adaptive", {"nodes": 8}), ("unsorted", {}))]
+        lost += [name] if errs[0] >= errs[1] and errs[0] > 0 else []
+        out.append(f"{name} {errs[0]:.4f} ({errs[1]:.4f})")
+    return ("thinned scenes at 64², mean error against the A-buffer of adaptive with 8 nodes (plain alpha blending's): "
+            + ", ".join(out) + "; holds if it runs on every scene and beats alpha blending there"
+            + (f"; it runs everywhere but loses on {', '.join(lost)}" if lost else "")), FAILS if lost else HOLDS
+
+
+def bounded_visibility() -> tuple[str, str]:
+    points = []
+    for layers in (4, 16, 64):
+        f = render(scene_lib.stacks(layers=layers, size=(16, 16), seed=8), "adaptive", nodes=8)
+        points.append((f.stats["fragments"], f.stats["memory_bytes"]))
+    (f1, m1), (f2, m2) = points[0], points[-1]
+    text = (", ".join(f"{f} fragments: {m / 1024:.1f} KiB" for f, m in points) + f" (stacks at 16², 8 nodes): {(m2 - m1) / (f2 - f1):.0f} "
+            f"B a fragment more; passes: {' + '.join(_passes('adaptive'))}. The slides' design keeps N nodes a pixel and renders "
+            "the geometry twice; this engine, like their proof of concept, captures per-pixel lists (no critical sections or "
+            "ROVs in WebGPU); holds if the memory is the same at every fragment count")
+    return text, HOLDS if len({m for _, m in points}) == 1 else FAILS
+
+
+def blending_storage() -> tuple[str, str]:
+    out, ok = [], _passes("unsorted") == ["blend"]
+    for name in ("hair", "smoke", "foliage", "glass"):
+        f = Renderer(64, 64).render(*scene_lib.SCENES[name](**QUICK_SCENE_ARGS.get(name, {})), "unsorted")
+        ok &= f.stats["memory_bytes"] == 0
+        out.append(f"{name} {f.stats['memory_bytes']} B ({f.stats['fragments']} fragments)")
+    return ("unsorted (alpha blending) at 64², thinned scenes, storage beyond the frame targets: " + ", ".join(out)
+            + f"; passes: {', '.join(_passes('unsorted'))}; speed and stability are timings, not judged in a quick claim; holds "
+            "if 0 bytes everywhere in one pass"), HOLDS if ok else FAILS
+
+
+def adaptive_throughput() -> tuple[str, str]:
+    out = []
+    for name in ("smoke", "foliage", "hair"):
+        built = scene_lib.SCENES[name](**QUICK_SCENE_ARGS[name])
+        r = Renderer(*built.size)
+        ms = median_ms(r, built, "adaptive", nodes=8)
+        frags = r.render(built.scene, built.camera, "adaptive", nodes=8).stats["fragments"]
+        out.append(f"{name} {ms:.0f} ms / {frags / 1e6:.2f} M fragments = {ms / frags * 1e6:.0f} ms a M")
+    return ("adaptive with 8 nodes, thinned scenes at 512² on lavapipe, GPU median of 3: " + "; ".join(out)
+            + " (the slides: 1.3 to 3.2 ms a M "
+            "on a 2011 GPU; a software rasterizer's absolute times say nothing of that)"), NOT_HERE
+
+
 CLAIMS: list[Claim] = [
     Claim("AT-quality", "Salvi et al. 2011, results slides", "\"high image quality\" (read as: close to the A-buffer with 4 to 16 "
           "nodes)", True, adaptive_quality),
@@ -58,4 +134,14 @@ CLAIMS: list[Claim] = [
           adaptive_vs_abuffer_time),
     Claim("AT-stoch", "Salvi et al. 2011, results slides", "\"2.5x faster than Stoc. Transp.\" (smoke), 2× (forest, hair)", False,
           adaptive_vs_stochastic_time),
+    Claim("AT-nodes", "Salvi et al. 2011, results summary slide", "\"Easy to trade-off IQ for performance by tuning node count\"",
+          False, nodes_tradeoff),
+    Claim("AT-any", "Salvi et al. 2011, results summary slide", "\"Works on any type of transparent geometry\": foliage, particles, "
+          "hair, glass", True, any_geometry),
+    Claim("AT-bounded", "Salvi et al. 2011, Adaptive Transparency slide", "\"Fixed size per-pixel visibility representation\"; "
+          "\"Render transparent geometry twice\"", True, bounded_visibility),
+    Claim("AT-blend", "Salvi et al. 2011, Alpha-Blending slide", "\"Fast and stable/predictable performance\"; \"No additional "
+          "storage required\"", True, blending_storage),
+    Claim("AT-rate", "Salvi et al. 2011, results slides", "\"21 ms - 10.6 MFragment\" (smoke), \"8 ms - 6.0 MFragment\" (forest), "
+          "\"48 ms - 15.0 MFragment\" (hair)", False, adaptive_throughput),
 ]

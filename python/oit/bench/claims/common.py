@@ -15,6 +15,8 @@ from ... import scenes as scene_lib
 from ..harness import image_errors, timed
 
 HOLDS, FAILS, NOT_HERE = "holds", "does not hold", "not measurable here"
+TOL = 1 / 255  # one 8-bit step of a color channel
+TIE = 1.3  # lavapipe's GPU times differ by up to ~30 % from run to run: a smaller ratio is a tie
 
 
 @dataclass(frozen=True)

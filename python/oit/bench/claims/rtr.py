@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
-from ... import Camera, Renderer, Scene
+from ... import Camera, Renderer, Scene, memory_bytes, methods
 from ... import scenes as scene_lib
-from .common import FAILS, HOLDS, Claim, full_screen_layers, mean_err, quad_scene, render
+from ..harness import image_errors
+from .common import FAILS, HOLDS, TOL, Claim, full_screen_layers, mean_err, median_ms, quad_scene, render
 
 
 def peeling_passes() -> tuple[str, str]:
@@ -99,6 +102,209 @@ def peeling_front_first() -> tuple[str, str]:
     return text, HOLDS if falling else FAILS
 
 
+def _layers(zs: np.ndarray, alpha: float, seed: int = 5) -> scene_lib.BuiltScene:
+    """Full-screen quads at the window depths `zs`, one alpha, random colors, shuffled (identity camera, 16²)."""
+    rng = np.random.default_rng(seed)
+    flat = lambda z: [[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]]  # noqa: E731
+    return quad_scene([(flat(z), (*rng.uniform(0, 1, 3), alpha)) for z in rng.permutation(zs)])
+
+
+def _with_alpha(built: scene_lib.BuiltScene, alpha: float) -> scene_lib.BuiltScene:
+    """A one-mesh scene (`stacks`) with every alpha set to `alpha`."""
+    mesh = built.meshes[0]
+    colors = mesh.colors.copy()
+    colors[:, 3] = alpha
+    return scene_lib.from_meshes([replace(mesh, colors=colors)], built.camera, built.size)
+
+
+def _resubmitted(built: scene_lib.BuiltScene, order) -> scene_lib.BuiltScene:
+    """`stacks` with its quads submitted in `order(depths)`, an argsort of the quads' depths."""
+    mesh = built.meshes[0]
+    quads, colors = mesh.positions.reshape(-1, 4, 3), mesh.colors.reshape(-1, 4, 4)
+    o = order(quads[:, 0, 2])
+    moved = replace(mesh, positions=quads[o].reshape(-1, 3), colors=colors[o].reshape(-1, 4))
+    return scene_lib.from_meshes([moved], built.camera, built.size)
+
+
+def _distance(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.sqrt(((a[..., :3] - b[..., :3]) ** 2).sum(-1)).mean())
+
+
+def _geometry_passes(method: str) -> int:
+    return sum("(geometry)" in p for p in next(m for m in methods() if m["name"] == method)["passes"])
+
+
+def weighted_by_depth() -> tuple[str, str]:
+    depths, out, ok, errs = (2, 4, 8, 16, 32, 64), [], True, {}
+    for alpha in (0.1, 0.6):
+        built = {n: _with_alpha(scene_lib.stacks(layers=n, size=(16, 16), seed=3), alpha) for n in depths}
+        for m in ("wavg", "wboit"):
+            e = errs[m, alpha] = [mean_err(built[n], m) for n in depths]
+            out.append(f"{m} at alpha {alpha}: " + "/".join(f"{x:.3f}" for x in e))
+            ok &= all(a < b for a, b in zip(e, e[1:])) and e[0] <= 3 * TOL
+    alpha_rules = all(a < b for m in ("wavg", "wboit") for a, b in zip(errs[m, 0.1], errs[m, 0.6]))
+    text = ("; ".join(out) + f" (16² stacks of {'/'.join(map(str, depths))} layers, mean error against the A-buffer); "
+            f"error higher at alpha 0.6 than 0.1 at every depth: {'yes' if alpha_rules else 'no'} "
+            "(holds if both rise at every doubling and are within 3/255 at 2 layers, at both alphas)")
+    return text, HOLDS if ok else FAILS
+
+
+def screen_door_one_layer() -> tuple[str, str]:
+    errs = {}
+    for n in (1, 2, 4):
+        built = full_screen_layers(0.5, n)
+        door, exact = (render(built, m).image[..., :3].reshape(4, 4, 4, 4, 3).mean((1, 3)) for m in ("screen_door", "abuffer"))
+        errs[n] = _distance(door, exact)
+    text = ", ".join(f"{n} layer{'s' * (n > 1)} {e:.4f}" for n, e in errs.items())
+    ok = errs[1] <= TOL and min(errs[2], errs[4]) > 10 * TOL
+    return (f"full-screen layers at alpha 0.5 (16², every layer the same 4×4 dither pattern), mean RGB error of the 4×4 block "
+            f"means against the A-buffer: {text} (holds if one layer is within 1/255 and more miss by 10/255)"), HOLDS if ok else FAILS
+
+
+def additive_saturates() -> tuple[str, str]:
+    built = replace(scene_lib.smoke(particles=300), size=(32, 32))
+    add, exact = (render(built, m, background=(0, 0, 0)) for m in ("additive", "abuffer"))
+    covered = exact.depth_complexity > 0
+    over = float((add.image[..., :3].max(-1)[covered] > 1).mean())
+    text = (f"smoke (300 particles, 32², up to {exact.depth_complexity.max()} layers) over black: additive channels up to "
+            f"{add.image[..., :3].max():.2f}, {over:.0%} of covered pixels past 1 (white); the A-buffer's up to "
+            f"{exact.image[..., :3].max():.2f}")
+    return text, HOLDS if over > 0 and exact.image[..., :3].max() <= 1 else FAILS
+
+
+def over_needs_order() -> tuple[str, str]:
+    built = scene_lib.stacks(layers=8, size=(16, 16), seed=4)
+    e = {name: mean_err(_resubmitted(built, key), "unsorted") for name, key in
+         (("back to front", lambda z: np.argsort(-z)), ("front to back", np.argsort))}
+    text = ", ".join(f"submitted {k} {v:.4f}" for k, v in e.items())
+    return (f"over in submission order on 8-layer stacks (16²), mean error against the A-buffer: {text} "
+            "(holds if back to front is within 1/255 and front to back is not)"), \
+        HOLDS if e["back to front"] <= TOL < e["front to back"] else FAILS
+
+
+def dual_halves_passes() -> tuple[str, str]:
+    out, ok = [], True
+    for n in (3, 8, 13, 32):
+        built = scene_lib.stacks(layers=n, size=(8, 8), seed=1)
+        single, dual = (render(built, m).stats["extra"]["geometry_passes"] for m in ("depth_peeling", "dual_depth_peeling"))
+        out.append(f"{n} layers: {dual:.0f} against {single:.0f}")
+        ok &= dual - 1 == -(-n // 2) and single - 1 == n
+    return ("geometry passes of dual against single depth peeling (8² stacks): " + "; ".join(out) +
+            " (holds if ⌈n/2⌉ against n, plus one that finds nothing left)"), HOLDS if ok else FAILS
+
+
+def bucket_sort() -> tuple[str, str]:
+    errs = {n: mean_err(scene_lib.stacks(layers=n, size=(16, 16), seed=7), "bucket_peeling", buckets=32) for n in (2, 4, 8, 16, 32)}
+    per_pixel = {m: memory_bytes(m, 512, 512, **p) / 512 ** 2 for m, p in
+                 (("bucket_peeling", {"buckets": 32}), ("depth_peeling", {}), ("wboit", {}))}
+    exact, big = all(e <= TOL for e in errs.values()), per_pixel["bucket_peeling"] >= 4 * per_pixel["depth_peeling"]
+    text = ("buckets=32 on 16² stacks, mean error against the A-buffer: " + ", ".join(f"{n} layers {e:.4f}" for n, e in errs.items()) +
+            f"; memory {per_pixel['bucket_peeling']:.0f} B a pixel against depth peeling's {per_pixel['depth_peeling']:.0f} and "
+            f"WB-OIT's {per_pixel['wboit']:.0f}; {_geometry_passes('bucket_peeling')} geometry passes here (holds if every stack "
+            f"of ≤ 32 layers is within 1/255 and the memory is at least 4× depth peeling's: memory "
+            f"{'yes' if big else 'no'}, exact {'yes' if exact else 'no'})")
+    return text, HOLDS if exact and big else FAILS
+
+
+def mlab_graceful() -> tuple[str, str]:
+    deep = scene_lib.stacks(layers=16, size=(8, 8), seed=4)
+    errs = {k: mean_err(deep, "mlab", layers=k) for k in (1, 2, 4, 8)}
+    built = scene_lib.stacks(layers=8, size=(16, 16), seed=4)
+    rng = np.random.default_rng(0)
+    rough = _resubmitted(built, lambda z: np.argsort(z + rng.normal(0, 0.1, len(z))))
+    shuffled, sorted_ = mean_err(built, "mlab", layers=2), mean_err(rough, "mlab", layers=2)
+    exact_order = mean_err(_resubmitted(built, np.argsort), "mlab", layers=2)
+    per_pixel = render(deep, "mlab").stats["memory_bytes"] / 64
+    ok = all(a > b for a, b in zip(list(errs.values()), list(errs.values())[1:])) and shuffled - sorted_ >= TOL
+    text = ("16-layer stacks (8²), mean error against the A-buffer: " + ", ".join(f"layers={k} {e:.4f}" for k, e in errs.items()) +
+            f"; 8-layer stacks (16²) at layers=2: shuffled {shuffled:.4f}, roughly sorted front to back (depth + noise of "
+            f"σ 0.1) {sorted_:.4f} ({shuffled / sorted_:.1f}× lower), sorted {exact_order:.4f}; cost: it keeps every fragment, "
+            f"{per_pixel:.0f} B a pixel on the 16-layer stacks against "
+            "WB-OIT's 20 (holds if the error falls at every step and a rough sort lowers it by at least 1/255)")
+    return text, HOLDS if ok else FAILS
+
+
+def wboit_near_wavg() -> tuple[str, str]:
+    diffs = {}
+    for spread in (0.8, 0.4, 0.2, 0.1, 0.05, 0.02):
+        built = _layers(np.linspace(0.5 - spread / 2, 0.5 + spread / 2, 8), 0.3)
+        diffs[spread] = _distance(*(render(built, m).image for m in ("wboit", "wavg")))
+    values = list(diffs.values())
+    ok = all(a > b for a, b in zip(values, values[1:])) and values[-1] <= TOL
+    return ("8 full-screen layers at alpha 0.3 (16²) spread over window depths around 0.5, mean RGB distance between the "
+            "wboit and wavg images: " + ", ".join(f"spread {s} {d:.4f}" for s, d in diffs.items()) +
+            " (holds if it falls at every step and ends within 1/255)"), HOLDS if ok else FAILS
+
+
+def wboit_gradual() -> tuple[str, str]:
+    images = [render(_layers(np.linspace(0.05, 0.45, 8) + 0.01 * i, 0.3), "wboit").image for i in range(41)]
+    steps = [_distance(a, b) for a, b in zip(images, images[1:])]
+    jump = max(b / a for a, b in zip(steps, steps[1:]))
+    exact = _distance(*(render(_layers(np.linspace(0.05, 0.45, 8) + dz, 0.3), "abuffer").image for dz in (0.0, 0.4)))
+    ok = max(steps) <= TOL and jump <= 1.5
+    return (f"8 full-screen layers at alpha 0.3 (16²) moved back 40 times by 0.01 in window depth: wboit's image changes "
+            f"{min(steps):.5f} to {max(steps):.5f} a step (mean RGB distance), each at most {jump:.2f}× the one before "
+            f"(the A-buffer's image moves {exact:.5f} over the whole path; holds if every step is within 1/255 and none is "
+            "1.5× the one before)"), HOLDS if ok else FAILS
+
+
+def stochastic_memory() -> tuple[str, str]:
+    built = scene_lib.stacks(layers=20, size=(32, 32), seed=2)
+    errs = {s: mean_err(built, "stochastic", samples=s) for s in (4, 16, 64)}
+    enough = next((s for s, e in errs.items() if e <= 3 * TOL), 64)
+    per_pixel = lambda m, **p: memory_bytes(m, 32, 32, **p) / 32 ** 2  # noqa: E731
+    lists = render(built, "abuffer").stats["memory_bytes"] / 32 ** 2
+    ok = enough >= 16 and per_pixel("stochastic", samples=enough) >= 4 * per_pixel("wboit")
+    return ("20-layer stacks (32²), mean error against the A-buffer and memory a pixel: " +
+            ", ".join(f"{s} samples {e:.4f} ({per_pixel('stochastic', samples=s):.0f} B)" for s, e in errs.items()) +
+            f"; WB-OIT {per_pixel('wboit'):.0f} B, the A-buffer {lists:.0f} B (holds if no count below 16 is within 3/255 and the "
+            "memory at the first count that is, else at 64, is at least 4× WB-OIT's)"), HOLDS if ok else FAILS
+
+
+def lists_one_pass() -> tuple[str, str]:
+    out, ok = [], _geometry_passes("abuffer") == 1
+    for n in (4, 16, 64):
+        built = scene_lib.stacks(layers=n, size=(8, 8), seed=1)
+        peel = render(built, "depth_peeling").stats["extra"]["geometry_passes"]
+        out.append(f"{n} layers: {peel:.0f}")
+        ok &= peel == n + 1
+    return (f"geometry passes on 8² stacks: the A-buffer {_geometry_passes('abuffer')} (capture; sort and resolve are "
+            "full screen), depth peeling " + ", ".join(out) + " (holds if 1 against n + 1)"), HOLDS if ok else FAILS
+
+
+def peeling_slow() -> tuple[str, str]:
+    out, ratios = [], []
+    for n in (4, 32):
+        built = scene_lib.stacks(layers=n, size=(64, 64), seed=1)
+        r = Renderer(*built.size)
+        lists, peel = median_ms(r, built, "abuffer"), median_ms(r, built, "depth_peeling")
+        ratios.append(peel / lists)
+        out.append(f"{n} layers: abuffer {lists:.1f} ms, depth_peeling {peel:.1f} ms ({ratios[-1]:.1f}×)")
+    return ("median GPU time on 64² stacks: " + "; ".join(out) + " (holds if depth peeling takes at least 2× the A-buffer's "
+            "time at 32 layers)"), HOLDS if ratios[-1] >= 2 else FAILS
+
+
+def no_perfect_method() -> tuple[str, str]:
+    names = [m["name"] for m in methods()]
+    scenes = {"glass": replace(scene_lib.glass(detail=8), size=(24, 24)), "smoke": replace(scene_lib.smoke(particles=150), size=(24, 24)),
+              "stacks": scene_lib.stacks(layers=12, size=(8, 8), seed=3)}
+    out, best = [], []
+    for name, built in scenes.items():
+        exact = render(built, "abuffer")
+        good = {}
+        for m in names:
+            frame = render(built, m)
+            if image_errors(frame.image, exact.image, exact.depth_complexity > 0, flip=False)["mean_err"] <= TOL:
+                good[m] = frame.stats["memory_bytes"]
+        least = min(good.values())
+        best.append({m for m, b in good.items() if b == least})
+        out.append(f"{name} {', '.join(sorted(best[-1]))} ({least / 1024:.1f} KiB; {len(good)} methods within)")
+    everywhere = set.intersection(*best)
+    return (f"the least memory among the methods within 1/255 of the A-buffer (mean error; all {len(names)} methods; glass and "
+            f"smoke at 24², 12-layer stacks at 8²): " + "; ".join(out) + " (holds if no method is that on every scene)"), \
+        HOLDS if not everywhere else FAILS
+
+
 CLAIMS: list[Claim] = [
     Claim("RTR-peel", "RTR 5.5", "depth peeling needs one geometry pass a layer", True, peeling_passes),
     Claim("RTR-stoch", "RTR 5.5", "stochastic transparency's noise falls with more samples", True, stochastic_noise),
@@ -115,4 +321,28 @@ CLAIMS: list[Claim] = [
           "\"objects that interpenetrate are impossible to resolve on a per-mesh basis\"", True, sorting_by_centroid),
     Claim("RTR-peel-early", "RTR 5.5, depth peeling", "peeling front to back renders \"the most important transparent layers\" "
           "first, so a fixed number of passes can be specified", True, peeling_front_first),
+    Claim("RTR-depth", "RTR 5.5, weighted average", "(our issue's wording) WB-OIT and the weighted average are plausible at "
+          "low depth complexity and wrong at high; RTR: \"nearly opaque objects give poor results\"", True, weighted_by_depth),
+    Claim("RTR-door", "RTR 5.5, screen-door transparency", "\"often only one transparent object can be convincingly rendered on "
+          "one area of the screen\"", True, screen_door_one_layer),
+    Claim("RTR-additive", "RTR 5.5, additive blending", "\"for several layered semitransparent surfaces, such as smoke or fire, "
+          "additive blending has the effect of saturating the colors\"", True, additive_saturates),
+    Claim("RTR-order", "RTR 5.5, blending order", "\"when using over the transparent surfaces ... need to be rendered in "
+          "back-to-front order\"", True, over_needs_order),
+    Claim("RTR-dual", "RTR 5.5, depth peeling", "dual depth peeling strips the closest and farthest layers each pass, \"cutting "
+          "the number of rendering passes in half\"", True, dual_halves_passes),
+    Claim("RTR-bucket", "RTR 5.5, depth peeling", "\"a bucket sort method that captures up to 32 layers in a single pass ... needs "
+          "considerable memory\"", True, bucket_sort),
+    Claim("RTR-mlab", "RTR 5.5, multi-layer alpha blending", "MLAB \"gracefully degrades if memory runs out\"; \"a rough sort "
+          "order can benefit their scheme\"; \"can be expensive\"", True, mlab_graceful),
+    Claim("RTR-wboit-near", "RTR 5.5, weighted blended OIT", "\"objects close to one another ... can have nearly equal weightings "
+          "from distance, making the result little different than the weighted average\"", True, wboit_near_wavg),
+    Claim("RTR-wboit-gradual", "RTR 5.5, weighted blended OIT", "\"as the camera's distance to the transparent objects changes, "
+          "the depth weightings may then vary in effect, but this change is gradual\"", True, wboit_gradual),
+    Claim("RTR-stoch-mem", "RTR 5.5, stochastic transparency", "\"a large number of samples per pixel is needed ... as well as a "
+          "sizable amount of memory\"", True, stochastic_memory),
+    Claim("RTR-lists", "RTR 5.5, A-buffer", "linked lists capture every fragment in one pass, where depth peeling needs a pass "
+          "a layer", True, lists_one_pass),
+    Claim("RTR-peel-slow", "RTR 5.5, depth peeling", "\"while depth peeling is effective, it can be slow\"", False, peeling_slow),
+    Claim("RTR-none", "RTR 5.5, end", "\"there is no perfect solution for rendering transparent objects\"", False, no_perfect_method),
 ]
