@@ -30,7 +30,7 @@ def figure7_parts() -> tuple[str, str]:
     worst = max(cells, key=lambda c: table[c[0]][("hybrid", c[1])] / max(table[c[0]][("ktab", c[1])], 1e-12))
     text = (f"hybrid's error at most ktab's and wavg's in {wins} of {len(cells)} cells (20 and 100 fragments, 4 alpha "
             f"distributions, k = {', '.join(map(str, FIGURE7_KS))}; 400 stacks each); closest: {worst[0][0]} fragments, "
-            f"{worst[0][1]}, k={worst[1]}")
+            f"{worst[0][1]}, k={worst[1]}; rule: every cell")
     return text, HOLDS if wins == len(cells) else FAILS
 
 
@@ -39,7 +39,8 @@ def figure7_adaptive() -> tuple[str, str]:
     losses = [(cfg, k) for cfg in table for k in FIGURE7_KS if k < 16 and table[cfg][("adaptive", k)] < table[cfg][("hybrid", k)]]
     text = f"adaptive beats hybrid in {len(losses)} of {len(table) * (len(FIGURE7_KS) - 1)} cells with k < 16: " + ", ".join(
         f"{n} {a} k={k} ({table[(n, a)][('adaptive', k)]:.3f} against {table[(n, a)][('hybrid', k)]:.3f})" for (n, a), k in losses)
-    text += " (at k = 16, adaptive's exact nodes pass hybrid's 8-bit alpha floor where 16 nodes hold the stack)"
+    text += (" (at k = 16, adaptive's exact nodes pass hybrid's 8-bit alpha floor where 16 nodes hold the stack); rule: adaptive "
+             "wins only on the worst case")
     return text, HOLDS if losses and all(a == "worst" for (_, a), _ in losses) else FAILS
 
 
@@ -56,7 +57,8 @@ def hair_figure8() -> tuple[str, str]:
     text = "; ".join(f"{k}: {t:.0f} ms, {m:.1f} MiB, error {e:.4f}" for k, (t, m, e) in rows.items())
     smaller = min(rows["AT16"][1], rows["A-buffer"][1]) / rows["HT4"][1]
     faster = rows["HT4"][0] <= TIE * rows["AT16"][0]
-    return f"hair at {built.size[0]}²: {text}; HT4's memory {smaller:.1f}× smaller", HOLDS if smaller >= 8 and faster else FAILS
+    return (f"hair at {built.size[0]}²: {text}; HT4's memory {smaller:.1f}× smaller (rule: at least 8× smaller, and a time within "
+            "1.3× of AT16's)"), HOLDS if smaller >= 8 and faster else FAILS
 
 
 def dragons_figure5() -> tuple[str, str]:
@@ -64,7 +66,8 @@ def dragons_figure5() -> tuple[str, str]:
     e = {label: mean_err(built, m, **p) for label, m, p in (("HT4", "hybrid", {"k": 4}), ("AT4", "adaptive", {"nodes": 4}),
                                                                ("4-TAB", "ktab", {"k": 4}), ("WAvg", "wavg", {}),
                                                                ("HT8", "hybrid", {"k": 8}), ("AT8", "adaptive", {"nodes": 8}))}
-    text = ", ".join(f"{k} {v:.4f}" for k, v in e.items()) + f" (mean error against the A-buffer, {built.size[0]}²)"
+    text = ", ".join(f"{k} {v:.4f}" for k, v in e.items()) + f" (mean error against the A-buffer, {built.size[0]}²; rule: HT4 below " \
+        "the other three, and HT8 below AT8)"
     ok = e["HT4"] < min(e["AT4"], e["4-TAB"], e["WAvg"]) and e["HT8"] < e["AT8"]
     return text, HOLDS if ok else FAILS
 
@@ -78,7 +81,7 @@ def hybrid_memory() -> tuple[str, str]:
         rows.append(f"k={k}: paper {paper / 1024:.0f} KiB, ours {ours / 1024:.0f} KiB")
     verdict = FAILS
     return ("; ".join(rows) + " at 64² (ours: the paper's 2k words a pixel, plus 18 accumulator words instead of 2: "
-            "fixed-point sums, the tail count and the error-bound terms)"), verdict
+            "fixed-point sums, the tail count and the error-bound terms; rule: equal to Eq. 12)"), verdict
 
 
 def hybrid_two_passes() -> tuple[str, str]:
@@ -90,7 +93,7 @@ def hybrid_two_passes() -> tuple[str, str]:
         found = [p for p in passes if p in expected]
         out.append(f"{method}: passes {', '.join(passes)} ({len(found)} over the geometry)")
         ok &= len(found) == len(expected)
-    return "; ".join(out), HOLDS if ok else FAILS
+    return "; ".join(out) + " (rule: 2 for hybrid, 1 for hybrid64)", HOLDS if ok else FAILS
 
 
 def _small(built: scene_lib.BuiltScene, size: int = 64) -> scene_lib.BuiltScene:
@@ -119,7 +122,9 @@ def figure7_alphas() -> tuple[str, str]:
     a, t = shapes["constant"]
     ok &= bool(np.ptp(a) == 0 and np.allclose(t[1:] / t[:-1], 1 - a[0, 0]))  # j: a geometric transmittance
     ok &= bool(shapes["random"][0].std() > 0.25)  # a: mixed alphas (uniform in [0, 1]: 0.29)
-    return "; ".join(out) + " (scenes.stack_alphas, the stacks every Figure 7 row renders)", HOLDS if ok else FAILS
+    return "; ".join(out) + " (scenes.stack_alphas, the stacks every Figure 7 row renders; rule: " \
+        "random alphas spread (deviation above 0.25), increasing ones rise at every layer, the worst case's front half has none above " \
+        "0.05 and keeps the transmittance above 0.5, constant ones scale it by 1 − alpha a layer)", HOLDS if ok else FAILS
 
 
 def figure7_random() -> tuple[str, str]:
@@ -158,7 +163,8 @@ def figure7_adaptive_increasing() -> tuple[str, str]:
         steady &= falls and all(ranked.values())
         out.append(f"{n} fragments: adaptive {_curve(e, 'adaptive')} ({'falls at every k' if falls else 'does not fall at every k'}; "
                    f"between hybrid and ktab, or level, at {sum(ranked.values())} of {len(ranked)} k from 2 to 8)")
-    return "; ".join(out) + f" (k = {'/'.join(map(str, FIGURE7_KS))}; at k = 1 both keep the front fragment alone)", \
+    return "; ".join(out) + f" (k = {'/'.join(map(str, FIGURE7_KS))}; at k = 1 both keep the front fragment alone; " \
+        "rule: unpredictable if adaptive's error fails to fall at some k or leaves the band between hybrid's and ktab's)", \
         FAILS if steady else HOLDS
 
 
@@ -293,7 +299,7 @@ def hair_figure4() -> tuple[str, str]:
         ("HT4", "hybrid", {"k": 4}), ("AT4", "adaptive", {"nodes": 4}), ("8-TAB", "ktab", {"k": 8}), ("16-TAB", "ktab", {"k": 16}),
         ("32-TAB", "ktab", {"k": 32}), ("WAvg", "wavg", {}))}
     beaten = [k for k in e if k != "HT4" and e[k] <= e["HT4"]]
-    text = ", ".join(f"{k} {v:.4f}" for k, v in e.items()) + " (hair, 512², mean error against the A-buffer)"
+    text = ", ".join(f"{k} {v:.4f}" for k, v in e.items()) + " (hair, 512², mean error against the A-buffer; rule: HT4 below all)"
     return text + (f"; better than HT4: {', '.join(beaten)}" if beaten else ""), FAILS if beaten else HOLDS
 
 

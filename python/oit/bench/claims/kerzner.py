@@ -36,7 +36,7 @@ def list_memory_linear() -> tuple[str, str]:
         points.append((f.stats["fragments"], f.stats["memory_bytes"]))
     slopes = [(m2 - m1) / (f2 - f1) for (f1, m1), (f2, m2) in zip(points, points[1:])]
     text = ", ".join(f"{f} fragments: {m / 1024:.0f} KiB" for f, m in points)
-    text += f"; {slopes[0]:.1f} and {slopes[1]:.1f} bytes a fragment more"
+    text += f"; {slopes[0]:.1f} and {slopes[1]:.1f} bytes a fragment more (rule: the same bytes for each added fragment)"
     return text, HOLDS if all(abs(s - 24) < 1e-9 for s in slopes) else FAILS
 
 
@@ -45,7 +45,7 @@ def pall_memory() -> tuple[str, str]:
     r = Renderer(64, 64)
     pall = r.render(built.scene, built.camera, "pall").stats["memory_bytes"]
     lists = r.render(built.scene, built.camera, "abuffer").stats["memory_bytes"]
-    text = f"glass at 64²: pall {pall / 1024:.0f} KiB, abuffer {lists / 1024:.0f} KiB ({pall / lists:.1f}×)"
+    text = f"glass at 64²: pall {pall / 1024:.0f} KiB, abuffer {lists / 1024:.0f} KiB ({pall / lists:.1f}×; rule: pall larger)"
     return text, HOLDS if pall > lists else FAILS
 
 
