@@ -96,6 +96,14 @@ def test_unknown_method_is_named():
         results.run(["glass"], ["hybird"], [8], quick=True, with_peers=False, show_progress=False)
 
 
+def test_defaults_runs_each_method_once_at_the_full_size():
+    r = results.run(["glass"], ["hybrid", "abuffer"], [72], repeat=1, with_peers=False, show_progress=False, defaults=True)
+    rows = [row for row in r.rows if row["method"] in ("hybrid", "abuffer")]
+    assert sorted(row["method"] for row in rows) == ["abuffer", "hybrid"]  # hybrid's default k only, not its sweep
+    assert {row["size"] for row in rows} == {"72x72"}  # past --quick's cap of 64
+    assert rows[[row["method"] for row in rows].index("hybrid")]["params"] == "k=8 tail=exact"
+
+
 def test_sweep_follows_the_declared_ranges():
     method = {"name": "m", "params": [
         {"name": "k", "type": "int", "min": 2, "max": 12, "default": 3},

@@ -32,6 +32,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--out", default="out/bench", help="directory for the tables and the plots")
     ap.add_argument("--quick", action="store_true",
                     help=f"default parameters only, one timed render, frames of at most {QUICK_SIZE} pixels: a smoke test")
+    ap.add_argument("--defaults", action="store_true",
+                    help="each method at its default parameters only, at the full frame size (--quick also shrinks the frames)")
     ap.add_argument("--no-peers", action="store_true", help="skip the peers (pygfx, VTK) even when installed")
     ap.add_argument("--no-plots", action="store_true", help="skip the matplotlib plots")
     ap.add_argument("--figure7", action="store_true", help="also run the hybrid paper's Figure 7 experiment (400 stacks)")
@@ -146,7 +148,7 @@ def run_cli(a: argparse.Namespace) -> int:
             if over:
                 return 1
         return 0
-    result = run(a.scenes, a.methods, a.sizes, repeat, a.quick, with_peers=not a.no_peers)
+    result = run(a.scenes, a.methods, a.sizes, repeat, a.quick, with_peers=not a.no_peers, defaults=a.defaults)
     write_tables(a.out, "results", result, COLUMNS)
     if not _plots_missing(a):
         from .. import plots

@@ -44,10 +44,11 @@ def _row(scene: str, size: str, method: str, params: Params, **values: Any) -> d
 
 
 def run(scenes: list[str], methods: list[str] | None = None, sizes: list[int] | None = None, repeat: int = 5,
-        quick: bool = False, with_peers: bool = True, show_progress: bool = True) -> Result:
+        quick: bool = False, with_peers: bool = True, show_progress: bool = True, defaults: bool = False) -> Result:
     """Measures every method of oit.methods() (or those named) on each scene at each size
-    (default: the scene's own; --quick caps it at QUICK_SIZE)."""
-    plan = method_plan(methods, quick)
+    (default: the scene's own; --quick caps it at QUICK_SIZE), over a sweep of its parameters
+    or, with `defaults` (and --quick), at its default parameters only."""
+    plan = method_plan(methods, quick or defaults)
     result = Result(rows=[])
     peer_modes: list[tuple[str, str]] = []
     for library, (modes, missing, _) in peers.PEERS.items() if with_peers else ():
