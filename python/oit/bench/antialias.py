@@ -4,7 +4,6 @@ the error against the exact antialiased image."""
 from __future__ import annotations
 
 import math
-import statistics
 from functools import partial
 from typing import Any
 
@@ -12,7 +11,7 @@ import numpy as np
 
 from .._api import constants
 from .._api import methods as list_methods
-from .harness import Progress, Result, mean_rgb_distance, scene_jobs, timed
+from .harness import Progress, Result, mean_rgb_distance, medians, scene_jobs, timed
 
 AA_METHODS = ("abuffer", "hybrid", "hybrid64", "wboit", "unsorted")
 AA_SAMPLES = (1, 4, 8)
@@ -61,8 +60,7 @@ def antialias(scenes: list[str], methods: list[str] | None = None, sizes: list[i
                     result.rows.append(row)
                     progress.step(method)
                     continue
-                row.update(gpu_ms=statistics.median(gpu) if gpu else math.nan, wall_ms=statistics.median(wall),
-                           mib=frame.stats["memory_bytes"] / 2 ** 20)
+                row.update(**medians(gpu, wall), mib=frame.stats["memory_bytes"] / 2 ** 20)
                 if s_count == 1:
                     one = {k: row[k] for k in ("gpu_ms", "wall_ms", "mib")}
                 for k in ("gpu_ms", "wall_ms", "mib"):

@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import math
 import os
-import statistics
 from functools import partial
 from typing import Any, Callable
 
 import numpy as np
 
-from .harness import Progress, Result, image_errors, scene_jobs, timed
+from .harness import Progress, Result, image_errors, medians, scene_jobs, timed
 
 AUTO_TOLERANCES = (1 / 255, 4 / 255, 16 / 255)
 AUTO_MAX_K = 32
@@ -96,9 +95,9 @@ def _measured(who: str, frame: Any, gpu: list[float], wall: list[float], exact: 
               covered: np.ndarray) -> dict[str, float]:
     e = image_errors(frame.image, exact, covered, flip=False)
     all_pixels = float(np.sqrt(((frame.image[..., :3].astype(np.float64) - exact[..., :3]) ** 2).sum(-1)).max())
-    return {f"{who}_gpu_ms": statistics.median(gpu) if gpu else math.nan, f"{who}_wall_ms": statistics.median(wall),
-            f"{who}_mib": frame.stats["memory_bytes"] / 2 ** 20, f"{who}_max_abs": max_abs_error(frame.image, exact),
-            f"{who}_max_err": e["max_err"], f"{who}_max_err_all": all_pixels, f"{who}_mean_err": e["mean_err"]}
+    return {**{f"{who}_{k}": v for k, v in medians(gpu, wall).items()}, f"{who}_mib": frame.stats["memory_bytes"] / 2 ** 20,
+            f"{who}_max_abs": max_abs_error(frame.image, exact), f"{who}_max_err": e["max_err"], f"{who}_max_err_all": all_pixels,
+            f"{who}_mean_err": e["mean_err"]}
 
 
 AUTO_COLUMNS = [

@@ -10,6 +10,7 @@ import inspect
 import itertools
 import math
 import os
+import statistics
 import sys
 import time
 from collections.abc import Iterator
@@ -142,6 +143,12 @@ def timed(render: Callable[[], Any], repeat: int) -> tuple[Any, list[float], lis
         if frame.stats.get("gpu_time_ms") is not None:
             gpu.append(frame.stats["gpu_time_ms"])
     return frame, gpu, wall
+
+
+def medians(gpu: list[float], wall: list[float]) -> dict[str, float]:
+    """`timed`'s GPU and wall times as their medians, `gpu_ms` and `wall_ms` (gpu_ms NaN where
+    the adapter has no timestamp queries)."""
+    return {"gpu_ms": statistics.median(gpu) if gpu else math.nan, "wall_ms": statistics.median(wall)}
 
 
 def mean_rgb_distance(a: np.ndarray, b: np.ndarray) -> float:

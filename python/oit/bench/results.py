@@ -21,7 +21,7 @@ import numpy as np
 from .. import peers
 from .. import scenes as scene_lib
 from .._api import Renderer, memory_bytes
-from .harness import ERRORS, Params, Progress, Result, flip_missing, format_params, image_errors, method_plan, scene_jobs, timed
+from .harness import ERRORS, Params, Progress, Result, flip_missing, format_params, image_errors, medians, method_plan, scene_jobs, timed
 
 # Markdown columns and formats; every row field goes to the CSV.
 COLUMNS = [
@@ -97,8 +97,7 @@ def _run_scene(result: Result, scene_name: str, built: scene_lib.BuiltScene, ren
             continue
         s = frame.stats
         formula = memory_bytes(method, w, h, **params)
-        row = _row(scene_name, size, method, params, gpu_ms=statistics.median(gpu) if gpu else math.nan,
-                   wall_ms=statistics.median(wall), memory_mib=s["memory_bytes"] / 2 ** 20,
+        row = _row(scene_name, size, method, params, **medians(gpu, wall), memory_mib=s["memory_bytes"] / 2 ** 20,
                    formula_mib=math.nan if formula is None else formula / 2 ** 20, fragments=s["fragments"],
                    max_depth=s["max_depth_complexity"], overflow=s["overflow_fragments"], adapter=adapter)
         if exact is not None:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import inspect
 import math
 import os
-import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import partial
@@ -22,7 +21,7 @@ import numpy as np
 from .. import scenes as scene_lib
 from .._api import Renderer
 from .._api import methods as list_methods
-from .harness import QUICK_SCENE_ARGS, Progress, Result, image_errors, markdown, timed, write_csv, write_tables
+from .harness import QUICK_SCENE_ARGS, Progress, Result, image_errors, markdown, medians, timed, write_csv, write_tables
 
 SCALE_METHODS = ("unsorted", "abuffer", "hybrid", "hybrid64", "auto", "wboit", "stochastic")
 SWEEPS = ("resolution", "triangles", "depth")
@@ -150,8 +149,7 @@ def scale(sweeps: Sequence[str] = SWEEPS, methods: Sequence[str] | None = None,
             s = frame.stats
             if m == "abuffer":
                 exact = frame
-            row = _row(p, m, triangles=triangles, gpu_ms=statistics.median(gpu) if gpu else math.nan,
-                       wall_ms=statistics.median(wall), memory_mib=s["memory_bytes"] / 2 ** 20,
+            row = _row(p, m, triangles=triangles, **medians(gpu, wall), memory_mib=s["memory_bytes"] / 2 ** 20,
                        peak_mib=s["peak_memory_bytes"] / 2 ** 20, tiles=s["tiles"], chunks=s["geometry_chunks"],
                        fragments=s["fragments"], max_depth=s["max_depth_complexity"], adapter=s["adapter"])
             if exact is not None:

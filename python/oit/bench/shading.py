@@ -7,12 +7,11 @@ alpha-only pass, for the two-pass methods), once a peel, or only the stored ones
 from __future__ import annotations
 
 import math
-import statistics
 from functools import partial
 
 import numpy as np
 
-from .harness import Progress, Result, scene_jobs, timed
+from .harness import Progress, Result, medians, scene_jobs, timed
 
 SHADING_METHODS = ("abuffer", "compact_abuffer", "hybrid", "ktab", "hybrid64", "wboit", "stochastic", "depth_peeling")
 SHADING_COSTS = (0, 64, 256, 1024)
@@ -51,8 +50,7 @@ def shading_cost(scenes: list[str], methods: list[str] | None = None, sizes: lis
                     result.rows.append(row)
                     progress.step(method)
                     continue
-                row.update(gpu_ms=statistics.median(gpu) if gpu else math.nan, wall_ms=statistics.median(wall),
-                           fragments=frame.stats["fragments"])
+                row.update(**medians(gpu, wall), fragments=frame.stats["fragments"])
                 if cost == 0:
                     base = {k: row[k] for k in ("gpu_ms", "wall_ms")}
                     image0 = frame.image
