@@ -2,28 +2,17 @@
 
 from __future__ import annotations
 
-import statistics
-from functools import partial
+from dataclasses import replace
 
-from ... import Renderer, methods
+from ... import Renderer
 from ... import scenes as scene_lib
-from ..harness import QUICK_SCENE_ARGS, image_errors, timed
-from .common import FAILS, HOLDS, NOT_HERE, TIE, TOL, Claim, median_ms, render
-
-
-def _passes(method: str) -> list[str]:
-    return next(m["passes"] for m in methods() if m["name"] == method)
+from ..harness import QUICK_SCENE_ARGS
+from .common import FAILS, HOLDS, NOT_HERE, TIE, TOL, Claim, error_against, mean_err, median_ms, method_passes, render, timed_ms
 
 
 def adaptive_quality() -> tuple[str, str]:
     built = scene_lib.smoke(particles=200)
-    r = Renderer(64, 64)
-    exact = r.render(built.scene, built.camera, "abuffer")
-    covered = exact.depth_complexity > 0
-    errs = {}
-    for n in (4, 16):
-        image = r.render(built.scene, built.camera, "adaptive", nodes=n).image
-        errs[n] = image_errors(image, exact.image, covered, flip=False)["mean_err"]
+    errs = {n: mean_err(replace(built, size=(64, 64)), "adaptive", nodes=n) for n in (4, 16)}
     text = (", ".join(f"{n} nodes {e:.4f}" for n, e in errs.items()) + " mean error against the A-buffer (smoke, 64²); "
             "rule: 'close' is within 1/255 (0.0039) at 4 and at 16 nodes")
     return text, HOLDS if max(errs.values()) <= TOL else FAILS
@@ -65,9 +54,9 @@ def nodes_tradeoff() -> tuple[str, str]:
     exact = r.render(built.scene, built.camera, "abuffer")
     errs, ms = [], []
     for n in (1, 2, 4, 8, 16):
-        frame, gpu, _ = timed(partial(r.render, built.scene, built.camera, "adaptive", nodes=n), 3)
-        errs.append(image_errors(frame.image, exact.image, exact.depth_complexity > 0, flip=False)["mean_err"])
-        ms.append(statistics.median(gpu))
+        frame, t = timed_ms(r, built, "adaptive", nodes=n)
+        errs.append(error_against(frame.image, exact))
+        ms.append(t)
     falls = all(a > b for a, b in zip(errs, errs[1:]))
     text = ("smoke (150 particles) at 512², adaptive by nodes: mean error against the A-buffer, GPU median of 3: " + ", ".join(
         f"{n}: {e:.4f}, {t:.0f} ms" for n, e, t in zip((1, 2, 4, 8, 16), errs, ms)) + f"; 16 nodes take {ms[-1] / ms[0]:.2f}× "
@@ -80,10 +69,8 @@ def any_geometry() -> tuple[str, str]:
     out, lost = [], []
     for name in scene_lib.SHOWCASE:
         built = scene_lib.SCENES[name](**QUICK_SCENE_ARGS.get(name, {}))
-        r = Renderer(64, 64)
-        exact = r.render(built.scene, built.camera, "abuffer")
-        errs = [image_errors(r.render(built.scene, built.camera, m, **p).image, exact.image, exact.depth_complexity > 0,
-                             flip=False)["mean_err"] for m, p in (("adaptive", {"nodes": 8}), ("unsorted", {}))]
+        small = replace(built, size=(64, 64))
+        errs = [mean_err(small, m, **p) for m, p in (("adaptive", {"nodes": 8}), ("unsorted", {}))]
         lost += [name] if errs[0] >= errs[1] and errs[0] > 0 else []
         out.append(f"{name} {errs[0]:.4f} ({errs[1]:.4f})")
     return ("thinned scenes at 64², mean error against the A-buffer of adaptive with 8 nodes (plain alpha blending's): "
@@ -98,20 +85,20 @@ def bounded_visibility() -> tuple[str, str]:
         points.append((f.stats["fragments"], f.stats["memory_bytes"]))
     (f1, m1), (f2, m2) = points[0], points[-1]
     text = (", ".join(f"{f} fragments: {m / 1024:.1f} KiB" for f, m in points) + f" (stacks at 16², 8 nodes): {(m2 - m1) / (f2 - f1):.0f} "
-            f"B a fragment more; passes: {' + '.join(_passes('adaptive'))}. The slides' design keeps N nodes a pixel and renders "
+            f"B a fragment more; passes: {' + '.join(method_passes('adaptive'))}. The slides' design keeps N nodes a pixel and renders "
             "the geometry twice; this engine, like their proof of concept, captures per-pixel lists (no critical sections or "
             "ROVs in WebGPU); holds if the memory is the same at every fragment count")
     return text, HOLDS if len({m for _, m in points}) == 1 else FAILS
 
 
 def blending_storage() -> tuple[str, str]:
-    out, ok = [], _passes("unsorted") == ["blend"]
+    out, ok = [], method_passes("unsorted") == ["blend"]
     for name in ("hair", "smoke", "foliage", "glass"):
         f = Renderer(64, 64).render(*scene_lib.SCENES[name](**QUICK_SCENE_ARGS.get(name, {})), "unsorted")
         ok &= f.stats["memory_bytes"] == 0
         out.append(f"{name} {f.stats['memory_bytes']} B ({f.stats['fragments']} fragments)")
     return ("unsorted (alpha blending) at 64², thinned scenes, storage beyond the frame targets: " + ", ".join(out)
-            + f"; passes: {', '.join(_passes('unsorted'))}; speed and stability are timings, not judged in a quick claim; holds "
+            + f"; passes: {', '.join(method_passes('unsorted'))}; speed and stability are timings, not judged in a quick claim; holds "
             "if 0 bytes everywhere in one pass"), HOLDS if ok else FAILS
 
 

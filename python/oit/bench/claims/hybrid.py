@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
-import statistics
-from functools import cache, lru_cache, partial
+from functools import cache, lru_cache
 from typing import Any
 
 import numpy as np
@@ -12,8 +11,7 @@ import numpy as np
 from ... import Renderer, constants, memory_bytes
 from ... import scenes as scene_lib
 from ..figure7 import FIGURE7_KS, figure7_errors
-from ..harness import image_errors, timed
-from .common import FAILS, HOLDS, TIE, TOL, Claim, mean_err, median_ms, quad_scene, render
+from .common import FAILS, HOLDS, TIE, TOL, Claim, error_against, flat_quad, mean_err, median_ms, quad_scene, render, timed_ms
 
 
 @lru_cache(maxsize=1)
@@ -48,12 +46,10 @@ def hair_figure8() -> tuple[str, str]:
     built = scene_lib.hair()
     r = Renderer(*built.size)
     exact = r.render(built.scene, built.camera, "abuffer")
-    covered = exact.depth_complexity > 0
     rows = {}
     for label, method, params in (("HT4", "hybrid", {"k": 4}), ("AT16", "adaptive", {"nodes": 16}), ("A-buffer", "abuffer", {})):
-        frame, gpu, _ = timed(partial(r.render, built.scene, built.camera, method, **params), 3)
-        rows[label] = (statistics.median(gpu), frame.stats["memory_bytes"] / 2**20,
-                       image_errors(frame.image, exact.image, covered, flip=False)["mean_err"])
+        frame, t = timed_ms(r, built, method, **params)
+        rows[label] = (t, frame.stats["memory_bytes"] / 2**20, error_against(frame.image, exact))
     text = "; ".join(f"{k}: {t:.0f} ms, {m:.1f} MiB, error {e:.4f}" for k, (t, m, e) in rows.items())
     smaller = min(rows["AT16"][1], rows["A-buffer"][1]) / rows["HT4"][1]
     faster = rows["HT4"][0] <= TIE * rows["AT16"][0]
@@ -222,7 +218,7 @@ def stochastic_noise_against_hybrid() -> tuple[str, str]:
 def _probe(j: int, n: int = 20, alpha: float = 0.1) -> scene_lib.BuiltScene:
     """n full-screen layers at one alpha, all black but layer j (front to back), which is white."""
     zs = np.linspace(0.1, 0.9, n)
-    return quad_scene([([[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]], (*([1.0] * 3 if i == j else [0.0] * 3), alpha))
+    return quad_scene([(flat_quad(z), (*([1.0] * 3 if i == j else [0.0] * 3), alpha))
                        for i, z in enumerate(zs)])
 
 
@@ -274,7 +270,7 @@ def _scene(name: str) -> tuple[scene_lib.BuiltScene, Renderer, Any]:
 def _scene_err(name: str, method: str, **params) -> float:
     built, r, exact = _scene(name)
     image = r.render(built.scene, built.camera, method, **params).image
-    return image_errors(image, exact.image, exact.depth_complexity > 0, flip=False)["mean_err"]
+    return error_against(image, exact)
 
 
 def _scene_ms(name: str, method: str, **params) -> float:
@@ -389,7 +385,7 @@ def first_pass_dominates() -> tuple[str, str]:
     out, ok = [], True
     for name in scene_lib.SHOWCASE:
         built, r, _ = _scene(name)
-        passes = timed(partial(r.render, built.scene, built.camera, "hybrid", k=8), 1)[0].stats["pass_times_ms"]
+        passes = timed_ms(r, built, "hybrid", repeat=1, k=8)[0].stats["pass_times_ms"]
         share = passes["store"] / sum(passes.values())
         ok &= share >= 0.5
         out.append(f"{name} {share:.0%} (" + ", ".join(f"{p} {v:.0f}" for p, v in passes.items()) + " ms)")

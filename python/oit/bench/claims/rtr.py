@@ -6,10 +6,22 @@ from dataclasses import replace
 
 import numpy as np
 
-from ... import Camera, Renderer, Scene, memory_bytes, methods
+from ... import Renderer, memory_bytes, methods
 from ... import scenes as scene_lib
-from ..harness import image_errors
-from .common import FAILS, HOLDS, TOL, Claim, full_screen_layers, mean_err, median_ms, quad_scene, render
+from .common import (
+    FAILS,
+    HOLDS,
+    TOL,
+    Claim,
+    error_against,
+    flat_quad,
+    full_screen_layers,
+    mean_err,
+    median_ms,
+    method_passes,
+    quad_scene,
+    render,
+)
 
 
 def peeling_passes() -> tuple[str, str]:
@@ -67,14 +79,8 @@ def wboit_against_wavg() -> tuple[str, str]:
 def filter_order_independent() -> tuple[str, str]:
     rng = np.random.default_rng(6)
     colors = [(*rng.uniform(0, 1, 3), rng.uniform(0.1, 0.9)) for _ in range(8)]
-    images = []
-    for order in (range(8), reversed(range(8))):
-        scene = Scene()
-        for i in order:
-            z = 0.1 + 0.1 * i
-            quad = np.array([[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]], np.float32)
-            scene.add_mesh(quad, [[0, 1, 2], [0, 2, 3]], colors[i])
-        images.append(Renderer(8, 8).render(scene, Camera(np.eye(4)), "filter").image)
+    images = [render(replace(quad_scene([(flat_quad(0.1 + 0.1 * i), colors[i]) for i in order]), size=(8, 8)), "filter").image
+              for order in (range(8), reversed(range(8)))]
     same = np.array_equal(images[0], images[1])
     diff = float(np.abs(images[0] - images[1]).max())
     return f"eight filter layers drawn in two orders: images {'bit-identical' if same else f'differ by {diff:.2e}'} (rule: within 1e-6)", \
@@ -82,9 +88,8 @@ def filter_order_independent() -> tuple[str, str]:
 
 
 def sorting_by_centroid() -> tuple[str, str]:
-    flat = lambda z: [[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]]  # noqa: E731
     # Four separate layers submitted front to back (the worst order for plain blending).
-    separate = quad_scene([(flat(z), (z, 0.3, 1 - z, 0.5)) for z in (0.2, 0.4, 0.6, 0.8)])
+    separate = quad_scene([(flat_quad(z), (z, 0.3, 1 - z, 0.5)) for z in (0.2, 0.4, 0.6, 0.8)])
     # Two quads that cross at the middle of the frame: each is in front over half of it.
     crossing = quad_scene([([[-1, -1, 0.2], [1, -1, 0.8], [1, 1, 0.8], [-1, 1, 0.2]], (1.0, 0.2, 0.1, 0.6)),
                             ([[-1, -1, 0.8], [1, -1, 0.2], [1, 1, 0.2], [-1, 1, 0.8]], (0.1, 0.3, 1.0, 0.6))])
@@ -104,13 +109,6 @@ def peeling_front_first() -> tuple[str, str]:
     values = list(errs.values())
     falling = all(a > b for a, b in zip(values, values[1:-1])) and values[-1] < 1e-5
     return text, HOLDS if falling else FAILS
-
-
-def _layers(zs: np.ndarray, alpha: float, seed: int = 5) -> scene_lib.BuiltScene:
-    """Full-screen quads at the window depths `zs`, one alpha, random colors, shuffled (identity camera, 16²)."""
-    rng = np.random.default_rng(seed)
-    flat = lambda z: [[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]]  # noqa: E731
-    return quad_scene([(flat(z), (*rng.uniform(0, 1, 3), alpha)) for z in rng.permutation(zs)])
 
 
 def _with_alpha(built: scene_lib.BuiltScene, alpha: float) -> scene_lib.BuiltScene:
@@ -135,7 +133,7 @@ def _distance(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _geometry_passes(method: str) -> int:
-    return sum("(geometry)" in p for p in next(m for m in methods() if m["name"] == method)["passes"])
+    return sum("(geometry)" in p for p in method_passes(method))
 
 
 def weighted_by_depth() -> tuple[str, str]:
@@ -231,7 +229,7 @@ def mlab_graceful() -> tuple[str, str]:
 def wboit_near_wavg() -> tuple[str, str]:
     diffs = {}
     for spread in (0.8, 0.4, 0.2, 0.1, 0.05, 0.02):
-        built = _layers(np.linspace(0.5 - spread / 2, 0.5 + spread / 2, 8), 0.3)
+        built = full_screen_layers(0.3, zs=np.linspace(0.5 - spread / 2, 0.5 + spread / 2, 8))
         diffs[spread] = _distance(*(render(built, m).image for m in ("wboit", "wavg")))
     values = list(diffs.values())
     ok = all(a > b for a, b in zip(values, values[1:])) and values[-1] <= TOL
@@ -241,10 +239,10 @@ def wboit_near_wavg() -> tuple[str, str]:
 
 
 def wboit_gradual() -> tuple[str, str]:
-    images = [render(_layers(np.linspace(0.05, 0.45, 8) + 0.01 * i, 0.3), "wboit").image for i in range(41)]
+    images = [render(full_screen_layers(0.3, zs=np.linspace(0.05, 0.45, 8) + 0.01 * i), "wboit").image for i in range(41)]
     steps = [_distance(a, b) for a, b in zip(images, images[1:])]
     jump = max(b / a for a, b in zip(steps, steps[1:]))
-    exact = _distance(*(render(_layers(np.linspace(0.05, 0.45, 8) + dz, 0.3), "abuffer").image for dz in (0.0, 0.4)))
+    exact = _distance(*(render(full_screen_layers(0.3, zs=np.linspace(0.05, 0.45, 8) + dz), "abuffer").image for dz in (0.0, 0.4)))
     ok = max(steps) <= TOL and jump <= 1.5
     return (f"8 full-screen layers at alpha 0.3 (16²) moved back 40 times by 0.01 in window depth: wboit's image changes "
             f"{min(steps):.5f} to {max(steps):.5f} a step (mean RGB distance), each at most {jump:.2f}× the one before "
@@ -298,7 +296,7 @@ def no_perfect_method() -> tuple[str, str]:
         good = {}
         for m in names:
             frame = render(built, m)
-            if image_errors(frame.image, exact.image, exact.depth_complexity > 0, flip=False)["mean_err"] <= TOL:
+            if error_against(frame.image, exact) <= TOL:
                 good[m] = frame.stats["memory_bytes"]
         least = min(good.values())
         best.append({m for m, b in good.items() if b == least})
