@@ -137,8 +137,7 @@ impl<'a> FrameCtx<'a> {
     /// Records a geometry pass of `pipeline` over the transparent geometry (timed as `label`),
     /// with the frame's targets at group 1 and `own` at group 2.
     pub fn capture(&mut self, enc: &mut wgpu::CommandEncoder, label: &'static str, pipeline: &wgpu::RenderPipeline, own: &wgpu::BindGroup) {
-        let (depth, targets, scene) = (self.raster_depth(), self.targets_group(), self.scene);
-        capture_pass(enc, label, depth, &[], targets, scene, self.tile, self.timer.render_pass(label), pipeline, own);
+        self.capture_into(enc, label, pipeline, own, &[]);
     }
 
     /// Records a geometry pass like `capture` that also blends into `colors` (timed as `label`).
