@@ -40,7 +40,7 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
         s.color[k] = colors[indices[3u * t + k]];
         s.normal[k] = vec4<f32>(0.0);
         s.uv[k] = vec2<f32>(0.0);
-        if frame.shading.x != 0u {
+        if SHADED != 0u {
             s.normal[k] = attributes[2u * indices[3u * t + k]];
             s.uv[k] = attributes[2u * indices[3u * t + k] + 1u].xy;
         }
@@ -67,9 +67,11 @@ fn node_frag(node: Node, link: u32, px: u32) -> Frag {
     f.clip = vec4<f32>(at, node.depth, 1.0);
     f.color = b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2];
     f.prim = node.prim;
+//!if SHADED
     f.normal = b.x * s.normal[0].xyz + b.y * s.normal[1].xyz + b.z * s.normal[2].xyz;
     f.uv = b.x * s.uv[0] + b.y * s.uv[1] + b.z * s.uv[2];
     f.material = bitcast<u32>(s.normal[0].w);
+//!endif
     let color = clamp(shade(f), vec4<f32>(0.0), vec4<f32>(1.0));
     return Frag(node.depth, color, link);
 }

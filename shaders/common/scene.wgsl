@@ -12,7 +12,9 @@ struct FrameUniform {
     tile_size: vec2<u32>,
     // Shading (common/shading.wgsl): the inverse view-projection for a pixel's eye direction,
     // ambient RGB (w = 0, the factor of the shading-cost loop's result), then x = whether any
-    // mesh is shaded, y = the light count, z = the shading-cost loop count.
+    // mesh is shaded, y = the light count, z = the shading-cost loop count: the same numbers as
+    // the constants SHADED, LIGHTS and SHADING_COST the pipelines are compiled with, which the
+    // shaders use instead (loop bounds the compiler knows).
     inv_view_proj: mat4x4<f32>,
     ambient: vec4<f32>,
     shading: vec4<u32>,
@@ -51,11 +53,14 @@ struct VsOut {
     @location(1) @interpolate(flat) prim: u32,
     // Clip w, interpolated: the view distance under a perspective camera (1 for orthographic).
     @location(2) view_w: f32,
-    // Shaded scenes only (zero otherwise): the shading normal (flat meshes are uploaded with
-    // a vertex per corner carrying the face normal), UVs and the mesh's material.
+//!if SHADED
+    // Shaded scenes only (an unlit scene compiles without them): the shading normal (flat
+    // meshes are uploaded with a vertex per corner carrying the face normal), UVs and the
+    // mesh's material.
     @location(3) normal: vec3<f32>,
     @location(4) uv: vec2<f32>,
     @location(5) @interpolate(flat) material: u32,
+//!endif
 }
 
 @vertex
@@ -67,15 +72,12 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     out.color = colors[v];
     out.prim = chunk.first_triangle + vi / 3u;
     out.view_w = out.clip.w;
-    out.normal = vec3<f32>(0.0);
-    out.uv = vec2<f32>(0.0);
-    out.material = 0u;
-    if frame.shading.x != 0u {
-        let a = attributes[2u * v];
-        out.material = bitcast<u32>(a.w);
-        out.normal = a.xyz;
-        out.uv = attributes[2u * v + 1u].xy;
-    }
+//!if SHADED
+    let a = attributes[2u * v];
+    out.material = bitcast<u32>(a.w);
+    out.normal = a.xyz;
+    out.uv = attributes[2u * v + 1u].xy;
+//!endif
     return out;
 }
 

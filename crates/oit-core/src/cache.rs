@@ -36,6 +36,13 @@ impl ShaderKey {
         Self { path, consts }
     }
 
+    /// The same shader with `extra` constants after its own (a scene variant's, for instance).
+    pub fn with(&self, extra: &[Const]) -> Self {
+        let mut key = self.clone();
+        key.consts.extend(Self::new(self.path, extra).consts);
+        key
+    }
+
     fn consts(&self) -> Vec<Const> {
         self.consts
             .iter()

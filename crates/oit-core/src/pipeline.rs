@@ -29,20 +29,8 @@ pub fn layout(device: &wgpu::Device, groups: &[&wgpu::BindGroupLayout]) -> wgpu:
     device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: &groups, immediate_size: 0 })
 }
 
-/// A pipeline drawing scene triangles with `vs_main` and the fragment entry `fs`.
-pub fn geometry(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::PipelineLayout,
-    fs: &str,
-    targets: &[Option<wgpu::ColorTargetState>],
-    depth: Option<wgpu::DepthStencilState>,
-) -> wgpu::RenderPipeline {
-    geometry_samples(device, label, module, layout, fs, targets, depth, 1)
-}
-
-/// [`geometry`] rasterized at `samples` samples a pixel (the shader reads the coverage mask).
+/// A pipeline drawing scene triangles with `vs_main` and the fragment entry `fs`, rasterized
+/// at `samples` samples a pixel (above 1 the shader reads the coverage mask).
 #[allow(clippy::too_many_arguments)]
 pub fn geometry_samples(
     device: &wgpu::Device,

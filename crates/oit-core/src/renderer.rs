@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use crate::antialias;
 use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
-use crate::cache::Layout;
+use crate::cache::{Draw, Layout, RenderDesc, ShaderKey};
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
 use crate::gpu_types::{FrameUniform, GpuLight};
@@ -15,7 +15,7 @@ use crate::method::{self, AntialiasMode, FrameCtx, Limits, Method, MethodInfo, M
 use crate::passes;
 use crate::pipeline;
 use crate::scene::{Camera, Scene};
-use crate::shader;
+use crate::shader::SceneVariant;
 use crate::shading::{Light, Lighting, MAX_LIGHTS};
 use crate::targets::{read_buffer, read_rows, SampleTargets, Targets};
 use crate::tiles::{self, Footprint, Tile};
@@ -73,13 +73,12 @@ pub struct Frame {
     pub stats: Stats,
 }
 
-/// Pipelines and layouts every frame uses, whatever the method.
+/// Layouts and the uniform every frame uses, whatever the method; the opaque and census
+/// pipelines come from the device's cache, specialized to the scene (`SceneVariant`).
 struct Shared {
     scene_layout: wgpu::BindGroupLayout,
     targets_layout: wgpu::BindGroupLayout,
     counts_layout: wgpu::BindGroupLayout,
-    opaque: wgpu::RenderPipeline,
-    census: wgpu::RenderPipeline,
     uniform: wgpu::Buffer,
 }
 
@@ -89,40 +88,56 @@ impl Shared {
         let scene_layout = gpu.cache.layout(d, Layout::Scene);
         let targets_layout = gpu.cache.layout(d, Layout::Targets);
         let counts_layout = gpu.cache.layout(d, Layout::Storage(1));
-        let opaque_module = shader::module(d, "opaque.wgsl", &[]);
-        let opaque = pipeline::geometry(
-            d,
-            "opaque",
-            &opaque_module,
-            &pipeline::layout(d, &[&scene_layout]),
-            "fs_opaque",
-            &[Some(COLOR_FORMAT.into())],
-            Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-        );
-        let census_module = shader::module(d, "census.wgsl", &[]);
-        let census = pipeline::geometry(
-            d,
-            "census",
-            &census_module,
-            &pipeline::layout(d, &[&scene_layout, &targets_layout, &counts_layout]),
-            "fs_census",
-            &[],
-            pipeline::depth_test_only(),
-        );
         let uniform = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniform"),
             size: std::mem::size_of::<FrameUniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self { scene_layout, targets_layout, counts_layout, opaque, census, uniform }
+        Self { scene_layout, targets_layout, counts_layout, uniform }
     }
+}
+
+/// The opaque pass's pipeline for `variant`: straight color, writes depth.
+fn opaque_pipeline(gpu: &GpuContext, variant: SceneVariant) -> wgpu::RenderPipeline {
+    let depth = wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: Default::default(),
+    };
+    let desc = RenderDesc {
+        shader: ShaderKey::new("opaque.wgsl", &variant.consts()),
+        entry: "fs_opaque",
+        groups: vec![Layout::Scene],
+        draw: Draw::Geometry { depth: Some(depth), samples: 1 },
+        targets: vec![Some(COLOR_FORMAT.into())],
+    };
+    gpu.cache.render(&gpu.device, &desc)
+}
+
+/// The census pipeline for `variant` (multisampled in a coverage-mask frame). The census reads
+/// only positions: its variant is always the unlit one, whatever the scene.
+fn census_pipeline(gpu: &GpuContext, coverage: bool) -> wgpu::RenderPipeline {
+    let variant = SceneVariant::default().consts();
+    let desc = match coverage {
+        false => RenderDesc {
+            shader: ShaderKey::new("census.wgsl", &variant),
+            entry: "fs_census",
+            groups: vec![Layout::Scene, Layout::Targets, Layout::Storage(1)],
+            draw: Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
+            targets: vec![],
+        },
+        true => RenderDesc {
+            shader: ShaderKey::new("census_samples.wgsl", &variant),
+            entry: "fs_census",
+            groups: vec![Layout::Scene, Layout::SampleTargets, Layout::Storage(1)],
+            draw: Draw::Geometry { depth: pipeline::raster_only(), samples: COVERAGE_SAMPLES },
+            targets: vec![],
+        },
+    };
+    gpu.cache.render(&gpu.device, &desc)
 }
 
 /// Renders scenes at one size with any registered method.
@@ -361,7 +376,7 @@ impl Renderer {
         let start = Instant::now();
         let gpu = self.gpu.clone();
         if coverage && self.coverage.is_none() {
-            self.coverage = Some(Coverage::new(&gpu, self.width, self.height, &self.shared));
+            self.coverage = Some(Coverage::new(&gpu, self.width, self.height));
             gpu.take_error()?;
         }
         let cov = if coverage { self.coverage.as_ref() } else { None };
@@ -373,6 +388,7 @@ impl Renderer {
         let fragments: u64 = depth_complexity.iter().map(|&c| c as u64).sum();
 
         let limits = self.limits;
+        let variant = self.variant(gpu_scene);
         // Out of the map while it renders, so that the loop can set each tile's uniform.
         let mut method = self.methods.remove(info.name).unwrap_or_else(|| info.instantiate(&gpu, &limits));
         // Tiles planned from the census; a method whose storage proves larger than planned (pall's
@@ -405,7 +421,7 @@ impl Renderer {
                     frame_uniform: &self.shared.uniform,
                     limits: self.limits,
                     coverage: cov.map(|c| &c.targets),
-                    shading_cost: self.shading_cost,
+                    variant,
                 };
                 let r = method.render(&mut cx)?;
                 if let Some(short) = r.pool_short {
@@ -557,6 +573,13 @@ impl Renderer {
         Ok(())
     }
 
+    /// What `scene`'s passes compile for: its surfaces, its light count (the headlight when it
+    /// has none) and the shading-cost knob.
+    fn variant(&self, scene: &GpuScene) -> SceneVariant {
+        let lights = if self.lights.0.is_empty() { 1 } else { self.lights.0.len() as u32 };
+        SceneVariant { shaded: scene.shaded, lights, textured: scene.textured, shading_cost: self.shading_cost }
+    }
+
     /// Writes the frame uniform for `camera`.
     fn set_camera(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3]) {
         self.set_uniform(camera, scene, bg, Tile::frame(self.width, self.height));
@@ -616,7 +639,7 @@ impl Renderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.shared.opaque);
+        pass.set_pipeline(&opaque_pipeline(&self.gpu, self.variant(scene)));
         scene.opaque.draw_all(&mut pass);
     }
 
@@ -640,12 +663,12 @@ impl Renderer {
         }
         enc.clear_buffer(&t.counts, 0, None);
         {
-            let (census, group, depth) = match coverage {
-                Some(c) => (&c.census, &c.targets.group, &c.targets.raster_depth),
-                None => (&self.shared.census, &t.group, &t.depth),
+            let (group, depth) = match coverage {
+                Some(c) => (&c.targets.group, &c.targets.raster_depth),
+                None => (&t.group, &t.depth),
             };
             let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
-            pass.set_pipeline(census);
+            pass.set_pipeline(&census_pipeline(&self.gpu, coverage.is_some()));
             pass.set_bind_group(1, group, &[]);
             pass.set_bind_group(2, &t.counts_group, &[]);
             scene.transparent.draw_all(&mut pass);
@@ -655,21 +678,15 @@ impl Renderer {
     }
 }
 
-/// What a coverage-mask frame needs besides the frame targets: the per-sample targets and the
-/// multisampled census.
+/// What a coverage-mask frame needs besides the frame targets: the per-sample targets (the
+/// census is multisampled: `census_pipeline`).
 struct Coverage {
     targets: SampleTargets,
-    census: wgpu::RenderPipeline,
 }
 
 impl Coverage {
-    fn new(gpu: &GpuContext, width: u32, height: u32, shared: &Shared) -> Self {
-        let d = &gpu.device;
-        let layout = gpu.cache.layout(d, Layout::SampleTargets);
-        let targets = SampleTargets::new(gpu, width, height, COVERAGE_SAMPLES, &layout);
-        let module = shader::module(d, "census_samples.wgsl", &[]);
-        let pl = pipeline::layout(d, &[&shared.scene_layout, &layout, &shared.counts_layout]);
-        let census = pipeline::geometry_samples(d, "census", &module, &pl, "fs_census", &[], pipeline::raster_only(), COVERAGE_SAMPLES);
-        Self { targets, census }
+    fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
+        let layout = gpu.cache.layout(&gpu.device, Layout::SampleTargets);
+        Self { targets: SampleTargets::new(gpu, width, height, COVERAGE_SAMPLES, &layout) }
     }
 }

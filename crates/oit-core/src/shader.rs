@@ -1,5 +1,7 @@
 //! WGSL sources: `//!include path` directives resolved from the embedded `shaders/` tree,
-//! and compile-time constants prepended from Rust so that each number lives in one place.
+//! compile-time constants prepended from Rust so that each number lives in one place, and
+//! `//!if NAME` / `//!else` / `//!endif` blocks kept or dropped by a constant's value, so that a
+//! pipeline compiles only the varyings and code its scene uses (docs/methods.md, "Specialization").
 
 include!(concat!(env!("OUT_DIR"), "/shader_sources.rs"));
 
@@ -24,26 +26,86 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("LAYERS", 4),
     Const::U32("LAYERS_PLUS_ONE", 5),
     Const::U32("BUCKETS", 32),
+    // The scene variant (`SceneVariant`): validated shaded, lit and textured, the longest text.
+    Const::U32("SHADED", 1),
+    Const::U32("LIGHTS", 2),
+    Const::U32("TEXTURES", 1),
+    Const::U32("SHADING_COST", 0),
 ];
+
+/// What a scene's geometry passes compile for (`//!if` blocks and loop bounds in
+/// common/scene.wgsl and common/shading.wgsl): whether any mesh has a surface (normals, UVs
+/// and the material as varyings), the light count, whether any mesh is textured, and the
+/// shading-cost knob's extra light evaluations. An unlit scene's pipelines carry the vertex
+/// color alone, as they did before shading existed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct SceneVariant {
+    pub shaded: bool,
+    pub lights: u32,
+    pub textured: bool,
+    pub shading_cost: u32,
+}
+
+impl SceneVariant {
+    pub fn consts(&self) -> [Const; 4] {
+        [
+            Const::U32("SHADED", self.shaded as u32),
+            Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
+            Const::U32("TEXTURES", (self.shaded && self.textured) as u32),
+            Const::U32("SHADING_COST", self.shading_cost),
+        ]
+    }
+}
 
 fn source(path: &str) -> &'static str {
     SOURCES.iter().find(|(p, _)| *p == path).map(|(_, s)| *s).unwrap_or_else(|| panic!("shader '{path}' is not in shader::SOURCES"))
 }
 
-fn expand(path: &str, out: &mut String, seen: &mut Vec<String>) {
+/// Lines of `path` and its includes, with `//!if` blocks resolved against `consts`.
+fn expand(path: &str, consts: &[Const], out: &mut String, seen: &mut Vec<String>) {
     if seen.iter().any(|s| s == path) {
         return;
     }
     seen.push(path.to_string());
-    for line in source(path).lines() {
-        match line.trim().strip_prefix("//!include ") {
-            Some(inc) => expand(inc.trim(), out, seen),
-            None => {
-                out.push_str(line);
-                out.push('\n');
+    // One entry per open `//!if`: whether its current branch is kept, and whether it is at `else`.
+    let mut open: Vec<(bool, bool)> = Vec::new();
+    let live = |open: &[(bool, bool)]| open.iter().all(|(keep, _)| *keep);
+    for (n, line) in source(path).lines().enumerate() {
+        let directive = line.trim();
+        if let Some(name) = directive.strip_prefix("//!if ") {
+            open.push((condition(name.trim(), consts, path, n), false));
+        } else if directive == "//!else" {
+            match open.last_mut() {
+                Some(top) if !top.1 => *top = (!top.0, true),
+                _ => panic!("{path}:{}: //!else without its //!if", n + 1),
             }
+        } else if directive == "//!endif" {
+            open.pop().unwrap_or_else(|| panic!("{path}:{}: //!endif without its //!if", n + 1));
+        } else if !live(&open) {
+            continue;
+        } else if let Some(inc) = directive.strip_prefix("//!include ") {
+            expand(inc.trim(), consts, out, seen);
+        } else {
+            out.push_str(line);
+            out.push('\n');
         }
     }
+    assert!(open.is_empty(), "{path}: an //!if is never closed by //!endif");
+}
+
+/// `NAME` (or `!NAME`): whether the u32 constant NAME is nonzero (or zero). A name no constant
+/// defines is a mistake in the caller, never taken as false.
+fn condition(expr: &str, consts: &[Const], path: &str, line: usize) -> bool {
+    let (negate, name) = match expr.strip_prefix('!') {
+        Some(rest) => (true, rest.trim()),
+        None => (false, expr),
+    };
+    let value = crate::consts::SHARED.iter().chain(consts).rev().find_map(|c| match c {
+        Const::U32(n, v) if *n == name => Some(*v != 0),
+        _ => None,
+    });
+    let value = value.unwrap_or_else(|| panic!("{path}:{}: //!if {name}: no u32 constant {name} is given", line + 1));
+    value != negate
 }
 
 /// The full WGSL text of `path` with its includes, the shared constants (`consts::SHARED`) and
@@ -56,7 +118,7 @@ pub fn compose(path: &str, consts: &[Const]) -> String {
             Const::F32(name, v) => out.push_str(&format!("const {name}: f32 = {v:?};\n")),
         }
     }
-    expand(path, &mut out, &mut Vec::new());
+    expand(path, consts, &mut out, &mut Vec::new());
     out
 }
 

@@ -66,6 +66,8 @@ pub struct GpuScene {
     pub opaque: Geometry,
     /// Whether any mesh is shaded (the frame uniform's flag).
     pub shaded: bool,
+    /// Whether any mesh is textured.
+    pub textured: bool,
 }
 
 /// Chunk contents on the host while they are gathered.
@@ -253,7 +255,8 @@ impl GpuScene {
         if shaded {
             transparent.bytes += table.len() as u64 * 16;
         }
-        Ok(Self { transparent, opaque, shaded })
+        let textured = shaded && scene.meshes().iter().any(|m| m.material.texture.is_some());
+        Ok(Self { transparent, opaque, shaded, textured })
     }
 }
 

@@ -9,6 +9,7 @@ use crate::error::Result;
 use crate::passes;
 use crate::pipeline;
 use crate::scene::Camera;
+use crate::shader::SceneVariant;
 use crate::targets::{SampleTargets, Targets};
 use crate::tiles::Tile;
 use crate::timer::PassTimer;
@@ -48,8 +49,10 @@ pub(crate) struct FrameCtx<'a> {
     /// A coverage-mask frame's per-sample targets (only methods that take coverage masks
     /// see one).
     pub coverage: Option<&'a SampleTargets>,
-    /// Extra light evaluations each shaded fragment does (`Renderer::set_shading_cost`).
-    pub shading_cost: u32,
+    /// What the scene's passes compile for (shading, light count, textures, and the extra
+    /// light evaluations of `Renderer::set_shading_cost`): every pipeline a helper below looks
+    /// up is specialized to it.
+    pub variant: SceneVariant,
 }
 
 impl<'a> FrameCtx<'a> {
@@ -79,6 +82,11 @@ impl<'a> FrameCtx<'a> {
         }
     }
 
+    /// `shader` compiled for this frame's scene variant.
+    fn specialized(&self, shader: &ShaderKey) -> ShaderKey {
+        shader.with(&self.variant.consts())
+    }
+
     /// A geometry pipeline of `shader`'s fragment entry `fs` that writes storage only (group 2:
     /// `own`), tested against the opaque depth; in a coverage-mask frame, multisampled.
     pub fn capture_pipeline(&self, shader: &ShaderKey, fs: &'static str, own: Layout) -> wgpu::RenderPipeline {
@@ -87,7 +95,7 @@ impl<'a> FrameCtx<'a> {
             None => Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
         };
         let groups = vec![Layout::Scene, self.targets_key(), own];
-        self.gpu.cache.render(&self.gpu.device, &RenderDesc { shader: shader.clone(), entry: fs, groups, draw, targets: vec![] })
+        self.gpu.cache.render(&self.gpu.device, &RenderDesc { shader: self.specialized(shader), entry: fs, groups, draw, targets: vec![] })
     }
 
     /// A geometry pipeline of `fs` with its own groups, color targets and depth state.
@@ -100,7 +108,7 @@ impl<'a> FrameCtx<'a> {
         depth: Option<wgpu::DepthStencilState>,
     ) -> wgpu::RenderPipeline {
         let draw = Draw::Geometry { depth, samples: 1 };
-        self.gpu.cache.render(&self.gpu.device, &RenderDesc { shader: shader.clone(), entry: fs, groups, draw, targets })
+        self.gpu.cache.render(&self.gpu.device, &RenderDesc { shader: self.specialized(shader), entry: fs, groups, draw, targets })
     }
 
     /// A full-screen resolve of `fs` into the output (and the error bound, with `bound`).
@@ -112,14 +120,14 @@ impl<'a> FrameCtx<'a> {
     pub fn resolve_pipeline_groups(&self, shader: &ShaderKey, fs: &'static str, own: &[Layout], bound: bool) -> wgpu::RenderPipeline {
         let mut groups = vec![Layout::Scene, self.targets_key()];
         groups.extend_from_slice(own);
-        let desc = RenderDesc { shader: shader.clone(), entry: fs, groups, draw: Draw::Fullscreen, targets: resolve_targets(bound) };
+        let desc = RenderDesc { shader: self.specialized(shader), entry: fs, groups, draw: Draw::Fullscreen, targets: resolve_targets(bound) };
         self.gpu.cache.render(&self.gpu.device, &desc)
     }
 
     /// A compute pipeline of `entry` over the shared groups and `own`.
     pub fn compute_pipeline(&self, shader: &ShaderKey, entry: &'static str, own: Layout) -> wgpu::ComputePipeline {
         let groups = vec![Layout::Scene, self.targets_key(), own];
-        self.gpu.cache.compute(&self.gpu.device, &ComputeDesc { shader: shader.clone(), entry, groups })
+        self.gpu.cache.compute(&self.gpu.device, &ComputeDesc { shader: self.specialized(shader), entry, groups })
     }
 
     /// A bind group of `layout` over `resources` at bindings 0, 1, ... (or the layout's own).
@@ -286,7 +294,7 @@ impl FrameCtx<'_> {
             frame_uniform: self.frame_uniform,
             limits: self.limits,
             coverage: self.coverage,
-            shading_cost: self.shading_cost,
+            variant: self.variant,
         }
     }
 

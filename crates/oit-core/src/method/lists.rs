@@ -265,7 +265,7 @@ impl ListMethod {
     fn step_costs(&self, cx: &FrameCtx<'_>) -> StepCosts {
         // shading.wgsl's `shade`: its light loop, the shading-cost loop, and a margin for its
         // other loops, each of which llvmpipe's limiter counts once even when skipped.
-        let frag = if self.shades_at_resolve { 4 + crate::shading::MAX_LIGHTS as u64 + cx.shading_cost as u64 } else { 0 };
+        let frag = if self.shades_at_resolve { 4 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64 } else { 0 };
         let run = (cx.max_depth_complexity as u64).min(RUN as u64);
         StepCosts { samples: self.sweeps.unwrap_or(1) as u64, frag, run }
     }
