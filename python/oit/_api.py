@@ -494,8 +494,9 @@ class Stats(TypedDict, total=False):
 
     method: str
     params: dict[str, Any]  # every parameter, defaults filled in
-    fragments: int  # transparent fragments in front of the opaque depth (summed over samples)
-    max_depth_complexity: int
+    census: bool  # whether the fragment census ran (render(census=True), or a method that plans from it)
+    fragments: int | None  # transparent fragments in front of the opaque depth (summed over samples); None without a census
+    max_depth_complexity: int | None  # None without a census
     memory_bytes: int  # what the method allocated (oit.memory_bytes gives its formula)
     target_bytes: int  # the shared frame targets: base color, depth, output, census, bound
     scene_bytes: int
@@ -519,14 +520,15 @@ class Stats(TypedDict, total=False):
 @dataclass
 class Frame:
     """One rendered frame. `image`: (h, w, 4) float32, linear; RGB is the final color and A
-    the coverage of the background. `depth_complexity`: transparent fragments per pixel.
+    the coverage of the background. `depth_complexity`: transparent fragments per pixel, where
+    the census ran (`stats["census"]`), else None.
     `error_bound`: (h, w, 3) float32, a bound of |image RGB - the exact composite| at every
     pixel and channel, for the methods that derive one (hybrid, hybrid64, ktab, auto);
     otherwise None, and `error_bound_reason` says why."""
 
     image: np.ndarray
     stats: Stats
-    depth_complexity: np.ndarray = field(repr=False)
+    depth_complexity: np.ndarray | None = field(repr=False)
     error_bound: np.ndarray | None = field(default=None, repr=False)
     error_bound_reason: str = ""
 
@@ -573,7 +575,7 @@ class Renderer:
 
     def render(self, scene: Scene, camera: Camera, method: str = "abuffer",
                background: Sequence[float] = (1.0, 1.0, 1.0), antialias: int = 1, antialias_mode: str = "frames",
-               shading_cost: int = 0, **params: Any) -> Frame:
+               shading_cost: int = 0, census: bool = False, **params: Any) -> Frame:
         """Renders `scene` with `method` (see `oit.methods()`); parameters go as keywords.
         `antialias` S in (1, 2, 4, 8, 16): S samples a pixel on the standard pattern. With
         antialias_mode "frames" each sample is a frame of its own with the method's buffers
@@ -581,7 +583,11 @@ class Renderer:
         "coverage" (abuffer, S = 4) the transparent geometry is rasterized once, multisampled,
         and each stored fragment keeps its sample mask (docs/methods.md, "Antialiasing").
         `shading_cost` N: every shaded fragment evaluates N extra lights whose result is
-        discarded, so the image is unchanged and shading costs more (docs/shading.md)."""
+        discarded, so the image is unchanged and shading costs more (docs/shading.md).
+        `census=True` counts every pixel's transparent fragments (`stats["fragments"]`,
+        `stats["max_depth_complexity"]`, `frame.depth_complexity`) with one more geometry pass;
+        methods that plan their storage from the counts (the A-buffers, peeling, adaptive, MLAB,
+        auto) always do, the others by default do not, and report None there."""
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be an oit.Scene, got {type(scene).__name__}")
         if not isinstance(camera, Camera):
@@ -594,8 +600,10 @@ class Renderer:
         cost = _int(shading_cost, "shading_cost", "an int (extra light evaluations per fragment)")
         if not 0 <= cost <= 65536:
             raise ValueError(f"shading_cost must be in [0, 65536], got {cost}")
+        if not isinstance(census, bool):
+            raise TypeError(f"census must be True or False, got {census!r}")
         image, dc, stats, bound = self._native.render(scene._native, camera.view_proj, method, bg, params,
-                                                      _antialias(antialias), antialias_mode, cost)
+                                                      _antialias(antialias), antialias_mode, cost, census)
         stats["adapter"] = self.adapter_info["name"]
         if bound is not None:
             stats["error_bound_max"] = float(bound.max()) if bound.size else 0.0

@@ -121,9 +121,10 @@ class Renderer:
         antialias: int = 1,
         antialias_mode: str = "frames",
         shading_cost: int = 0,
-    ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32], dict[str, Any], npt.NDArray[np.float32] | None]:
-        """Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict,
-        error bound (h, w) float32 or None)."""
+        census: bool = False,
+    ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32] | None, dict[str, Any], npt.NDArray[np.float32] | None]:
+        """Returns (image (h, w, 4) float32, depth complexity (h, w) uint32 or None without a
+        census, stats dict, error bound (h, w) float32 or None)."""
 
 def methods() -> list[_MethodInfo]:
     """Every method: name, summary, exact, bounded memory, passes, parameters."""

@@ -27,6 +27,10 @@ use crate::upload::GpuScene;
 pub struct Stats {
     pub method: String,
     pub params: Params,
+    /// Whether the fragment census ran: without it `fragments` and `max_depth_complexity` are 0
+    /// and the frame's `depth_complexity` is empty (methods that need no census run none unless
+    /// `Renderer::set_census` asks for it).
+    pub census: bool,
     /// Transparent fragments that passed the opaque depth test.
     pub fragments: u64,
     pub max_depth_complexity: u32,
@@ -65,7 +69,8 @@ pub struct Frame {
     pub height: u32,
     /// Row-major (height, width, 4) linear RGBA; row 0 is the top of the picture.
     pub image: Vec<f32>,
-    /// Transparent fragments per pixel (same layout, one value a pixel).
+    /// Transparent fragments per pixel (same layout, one value a pixel); empty where the
+    /// census did not run (`Stats::census`).
     pub depth_complexity: Vec<u32>,
     /// Per-pixel bound of the error against the exact composite (any RGB channel), for the
     /// methods that derive one.
@@ -160,6 +165,8 @@ pub struct Renderer {
     lights: (Vec<Light>, [f32; 3]),
     /// Extra light evaluations per shaded fragment that leave its color unchanged (docs/shading.md).
     shading_cost: u32,
+    /// Whether every frame runs the fragment census, not only those of methods that need it.
+    census: bool,
 }
 
 /// One device per adapter choice, shared by every renderer in the process.
@@ -209,6 +216,7 @@ impl Renderer {
             coverage: None,
             lights: (Vec::new(), [0.0; 3]),
             shading_cost: 0,
+            census: false,
         })
     }
 
@@ -221,6 +229,14 @@ impl Renderer {
         }
         self.shading_cost = count;
         Ok(())
+    }
+
+    /// Runs the fragment census (per-pixel transparent fragment counts: `Stats::fragments`,
+    /// `max_depth_complexity`, `Frame::depth_complexity`) in every frame when `always`; else only
+    /// for the methods that plan from it (`MethodInfo::census`), so that the others pay for no
+    /// extra geometry pass.
+    pub fn set_census(&mut self, always: bool) {
+        self.census = always;
     }
 
     /// Sizes method buffers as if the adapter bound at most `bytes` per storage binding
@@ -322,7 +338,7 @@ impl Renderer {
         let pixels = self.width as usize * self.height as usize;
         let mut image = vec![0.0f64; pixels * 4];
         let mut bound: Option<Vec<f64>> = None;
-        let mut depth_complexity = vec![0u32; pixels];
+        let mut depth_complexity = Vec::new();
         let mut stats = Stats::default();
         for (i, offset) in offsets.iter().enumerate() {
             let jittered = camera.jittered(*offset, self.width, self.height);
@@ -331,6 +347,9 @@ impl Renderer {
             if let Some(b) = &f.error_bound {
                 let sum = bound.get_or_insert_with(|| vec![0.0; pixels]);
                 sum.iter_mut().zip(b).for_each(|(a, &v)| *a += v as f64);
+            }
+            if depth_complexity.is_empty() {
+                depth_complexity = vec![0u32; f.depth_complexity.len()];
             }
             depth_complexity.iter_mut().zip(&f.depth_complexity).for_each(|(a, &v)| *a = (*a).max(v));
             let s = f.stats;
@@ -381,9 +400,12 @@ impl Renderer {
         }
         let cov = if coverage { self.coverage.as_ref() } else { None };
         let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
-        self.opaque_and_census(gpu_scene, camera, background, cov);
-        let counts_raw = read_buffer(&gpu, &self.targets.counts_readback, self.width as u64 * self.height as u64 * 4)?;
-        let depth_complexity: Vec<u32> = bytemuck::pod_collect_to_vec(&counts_raw);
+        let census = info.census || self.census;
+        self.opaque_and_census(gpu_scene, camera, background, cov, census);
+        let depth_complexity: Vec<u32> = match census {
+            true => bytemuck::pod_collect_to_vec(&read_buffer(&gpu, &self.targets.counts_readback, self.width as u64 * self.height as u64 * 4)?),
+            false => Vec::new(),
+        };
         let max_depth_complexity = depth_complexity.iter().copied().max().unwrap_or(0);
         let fragments: u64 = depth_complexity.iter().map(|&c| c as u64).sum();
 
@@ -401,6 +423,7 @@ impl Renderer {
             let mut pass_times: Option<Vec<(&'static str, f64)>> = None;
             for tile in &tiles {
                 let counts: std::borrow::Cow<[u32]> = match tiles.len() {
+                    _ if !census => (&[] as &[u32]).into(),
                     1 => depth_complexity.as_slice().into(),
                     _ => tile.crop(&depth_complexity, self.width).into(),
                 };
@@ -474,6 +497,7 @@ impl Renderer {
         let stats = Stats {
             method: info.name.to_string(),
             params: params.clone(),
+            census,
             fragments,
             max_depth_complexity,
             memory_bytes: report.memory_bytes,
@@ -644,8 +668,8 @@ impl Renderer {
     }
 
     /// The opaque pass under `camera` (for a coverage-mask frame, one per sample position into
-    /// the sample targets), then the untimed fragment census, copied to its readback.
-    fn opaque_and_census(&self, scene: &GpuScene, camera: &Camera, bg: [f32; 3], coverage: Option<&Coverage>) {
+    /// the sample targets), then with `census` the untimed fragment census, copied to its readback.
+    fn opaque_and_census(&self, scene: &GpuScene, camera: &Camera, bg: [f32; 3], coverage: Option<&Coverage>, census: bool) {
         let t = &self.targets;
         if let Some(c) = coverage {
             let offsets = antialias::sample_offsets(c.targets.samples).expect("a supported sample count");
@@ -661,19 +685,21 @@ impl Renderer {
         if coverage.is_none() {
             self.opaque_pass(&mut enc, scene, &t.base, &t.depth, bg);
         }
-        enc.clear_buffer(&t.counts, 0, None);
-        {
+        if census {
+            enc.clear_buffer(&t.counts, 0, None);
             let (group, depth) = match coverage {
                 Some(c) => (&c.targets.group, &c.targets.raster_depth),
                 None => (&t.group, &t.depth),
             };
-            let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
-            pass.set_pipeline(&census_pipeline(&self.gpu, coverage.is_some()));
-            pass.set_bind_group(1, group, &[]);
-            pass.set_bind_group(2, &t.counts_group, &[]);
-            scene.transparent.draw_all(&mut pass);
+            {
+                let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
+                pass.set_pipeline(&census_pipeline(&self.gpu, coverage.is_some()));
+                pass.set_bind_group(1, group, &[]);
+                pass.set_bind_group(2, &t.counts_group, &[]);
+                scene.transparent.draw_all(&mut pass);
+            }
+            enc.copy_buffer_to_buffer(&t.counts, 0, &t.counts_readback, 0, t.counts.size().min(t.counts_readback.size()));
         }
-        enc.copy_buffer_to_buffer(&t.counts, 0, &t.counts_readback, 0, t.counts.size().min(t.counts_readback.size()));
         self.gpu.queue.submit([enc.finish()]);
     }
 }

@@ -63,6 +63,15 @@ impl Footprint {
 /// each within `fp`: bands of whole rows, greedily as tall as fit; a row that does not fit alone
 /// is cut into runs of pixels. Fails only where one pixel alone does not fit.
 pub fn plan(width: u32, height: u32, counts: &[u32], fp: &Footprint) -> Result<Vec<Tile>> {
+    // No census (a method that keeps nothing per fragment): every pixel counts as empty.
+    let zeros;
+    let counts = match counts.is_empty() {
+        true if fp.per_fragment == 0 => {
+            zeros = vec![0u32; width as usize * height as usize];
+            &zeros[..]
+        }
+        _ => counts,
+    };
     let row_fragments: Vec<u64> = counts.chunks(width as usize).map(|r| r.iter().map(|&c| c as u64).sum()).collect();
     if fp.fits(width as u64 * height as u64, row_fragments.iter().sum()) {
         return Ok(vec![Tile::frame(width, height)]);

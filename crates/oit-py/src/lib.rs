@@ -219,8 +219,10 @@ fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, 
         params.set_item(*k, value_to_py(py, v)?)?;
     }
     d.set_item("params", params)?;
-    d.set_item("fragments", s.fragments)?;
-    d.set_item("max_depth_complexity", s.max_depth_complexity)?;
+    // Without a census (the method needs none and none was asked for) the counts are unknown.
+    d.set_item("census", s.census)?;
+    d.set_item("fragments", s.census.then_some(s.fragments))?;
+    d.set_item("max_depth_complexity", s.census.then_some(s.max_depth_complexity))?;
     d.set_item("memory_bytes", s.memory_bytes)?;
     d.set_item("target_bytes", s.target_bytes)?;
     d.set_item("scene_bytes", s.scene_bytes)?;
@@ -303,9 +305,9 @@ impl Renderer {
         Ok(d)
     }
 
-    /// Returns (image (h, w, 4) float32, depth complexity (h, w) uint32, stats dict,
-    /// error bound (h, w) float32 or None).
-    #[pyo3(signature = (scene, view_proj, method, background, params, antialias=1, antialias_mode="frames", shading_cost=0))]
+    /// Returns (image (h, w, 4) float32, depth complexity (h, w) uint32 or None without a
+    /// census, stats dict, error bound (h, w) float32 or None).
+    #[pyo3(signature = (scene, view_proj, method, background, params, antialias=1, antialias_mode="frames", shading_cost=0, census=false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -318,6 +320,7 @@ impl Renderer {
         antialias: u32,
         antialias_mode: &str,
         shading_cost: u32,
+        census: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let mode = match antialias_mode {
             "frames" => oit_core::AntialiasMode::Frames,
@@ -332,12 +335,16 @@ impl Renderer {
             .detach(|| {
                 let mut r = self.inner.lock().unwrap_or_else(|p| p.into_inner());
                 r.set_shading_cost(shading_cost)?;
+                r.set_census(census);
                 r.render_antialiased(inner_scene, &camera, method, &plist, bg, antialias, mode)
             })
             .map_err(Error::from)?;
         let (h, w) = (frame.height as usize, frame.width as usize);
         let image = frame.image.into_pyarray(py).reshape([h, w, 4])?;
-        let dc = frame.depth_complexity.into_pyarray(py).reshape([h, w])?;
+        let dc = match frame.stats.census {
+            true => Some(frame.depth_complexity.into_pyarray(py).reshape([h, w])?),
+            false => None,
+        };
         let stats = stats_dict(py, &frame.stats)?;
         let bound = match frame.error_bound {
             Some(b) => Some(b.into_pyarray(py).reshape([h, w])?),

@@ -201,7 +201,11 @@ impl ViewerApp {
         if self.renderer.as_ref().map(|r| r.size()) != Some((size[0], size[1])) {
             self.renderer = None; // free the old targets first
             match Renderer::new(gpu, size[0], size[1]) {
-                Ok(r) => self.renderer = Some(r),
+                Ok(mut r) => {
+                    // The panel shows fragments and depth complexity for every method.
+                    r.set_census(true);
+                    self.renderer = Some(r);
+                }
                 Err(e) => {
                     self.render_error = Some(e.to_string());
                     return false;

@@ -21,6 +21,7 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Scene { formula: "24 B/fragment + 68 B/pixel (the node pool grows with the scene)" },
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
+    census: true,
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 

@@ -22,6 +22,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
     tiling: Tiling::Whole,
+    census: false,
     create: |_, _| Box::new(Blend { kind: Kind::Unsorted }),
 };
 

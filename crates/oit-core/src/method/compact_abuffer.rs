@@ -23,6 +23,7 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Scene { formula: "12 B/fragment + 68 B/pixel + 176 B/triangle" },
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 12, per_triangle: 176 },
+    census: true,
     create: |gpu, limits| {
         Box::new(Compact(ListMethod::new(
             gpu,

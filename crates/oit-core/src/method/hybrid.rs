@@ -33,6 +33,7 @@ pub const HYBRID: MethodInfo = MethodInfo {
     memory: MEMORY,
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Formula { targets: 0 },
+    census: false,
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
 };
 

@@ -31,6 +31,10 @@ pub struct MethodInfo {
     pub error_bound: ErrorBound,
     /// How a frame too large for its bindings or the memory budget is split into screen tiles.
     pub tiling: Tiling,
+    /// Whether the method reads the fragment census before it renders (its storage, tiles or
+    /// pass count are planned from every pixel's fragment count). Methods that do not get no
+    /// census pass unless the caller asks for the counts (`Renderer::set_census`).
+    pub census: bool,
     pub(crate) create: fn(&GpuContext, &Limits) -> Box<dyn Method>,
 }
 

@@ -24,6 +24,7 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Scene { formula: "32 B/fragment + 4 B/pixel (grows with the scene)" },
     error_bound: ErrorBound::None,
     tiling: Tiling::Storage { per_pixel: 4, per_fragment: 32, per_triangle: 0 },
+    census: true,
     create: |gpu, limits| {
         Box::new(Mlab(ListMethod::new(
             gpu,

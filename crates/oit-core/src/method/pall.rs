@@ -23,6 +23,7 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Scene { formula: "24 B/node of the triangles' bounds + 68 B/pixel + 16 B/triangle" },
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 16 },
+    census: true,
     create: |gpu, limits| {
         Box::new(Pall(ListMethod::new(
             gpu,

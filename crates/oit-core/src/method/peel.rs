@@ -30,6 +30,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     memory: MEMORY,
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Formula { targets: 0 },
+    census: true,
     create: |_, _| Box::new(Peel { dual: false, buffers: None, peeled: None }),
 };
 

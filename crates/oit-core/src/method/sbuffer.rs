@@ -23,6 +23,7 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Scene { formula: "24 B/fragment + 72 B/pixel + scan sums" },
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES + 8, per_fragment: 24, per_triangle: 0 },
+    census: true,
     create: |gpu, limits| {
         Box::new(SBuffer(ListMethod::new(
             gpu,

@@ -23,6 +23,7 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Frame { formula: "W·H·4", bytes: |px, _| memory_bytes(px) },
     error_bound: ErrorBound::None,
     tiling: Tiling::Whole,
+    census: false,
     create: |_, _| Box::new(ScreenDoor { depth: None }),
 };
 

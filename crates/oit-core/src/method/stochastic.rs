@@ -37,6 +37,7 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Frame { formula: "W·H·(4·samples + 20)", bytes: |px, p| memory_bytes(px, p.int("samples") as u64) },
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula { targets: super::accum::TARGET_BYTES },
+    census: false,
     create: |_, _| Box::new(Stochastic { samples: None, targets: None }),
 };
 

@@ -30,6 +30,7 @@ pub const WSUM: MethodInfo = MethodInfo {
     memory: MEMORY,
     error_bound: ErrorBound::None,
     tiling: Tiling::Whole,
+    census: false,
     create: |_, _| Box::new(Weighted::new(Kind::Sum)),
 };
 
