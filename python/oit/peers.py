@@ -13,6 +13,10 @@ inputs are matched as follows (docs/results.md says how the match was checked):
   toward the camera, as it expects.
 - objects: one gfx.Mesh per mesh, placed at its vertex centroid, since pygfx sorts
   transparent objects by their position; opaque meshes use alpha mode `solid`.
+- lit meshes (those with normals in their surface, `oit.bench.floor`'s lit rows): a
+  MeshPhongMaterial with the same normals, specular and shininess, the scene's directional
+  lights and its ambient term. pygfx's Phong is not our shading model, so only the times of
+  these rows compare, not the images.
 - output: pygfx blends into an rgba8unorm-srgb target; `snapshot()` reads that target before
   the output pass (with `ppaa="none"` and `pixel_scale=1` nothing filters it) and we decode it
   to linear. Its 8-bit sRGB storage is part of what pygfx computes, so it stays in the error.
@@ -123,12 +127,28 @@ class PygfxRenderer:
             scene.add(gfx.Background.from_color(gfx.Color(*srgb)))
             for m in built.meshes:
                 center = m.positions.astype(np.float64).mean(0)
-                geometry = gfx.Geometry(positions=(m.positions - center).astype(np.float32),
-                                        indices=m.indices, colors=m.colors)
-                material = gfx.MeshBasicMaterial(color_mode="vertex", alpha_mode="solid" if m.opaque else mode)
+                alpha_mode = "solid" if m.opaque else mode
+                normals = m.surface.get("normals")
+                if normals is None:
+                    geometry = gfx.Geometry(positions=(m.positions - center).astype(np.float32),
+                                            indices=m.indices, colors=m.colors)
+                    material = gfx.MeshBasicMaterial(color_mode="vertex", alpha_mode=alpha_mode)
+                else:
+                    # A lit mesh: Phong with the same normals, specular and shininess.
+                    geometry = gfx.Geometry(positions=(m.positions - center).astype(np.float32), indices=m.indices,
+                                            colors=m.colors, normals=np.asarray(normals, dtype=np.float32))
+                    spec = float(m.surface.get("specular", 0.0))
+                    material = gfx.MeshPhongMaterial(color_mode="vertex", alpha_mode=alpha_mode, specular=(spec, spec, spec),
+                                                     shininess=float(m.surface.get("shininess", 32.0)))
                 mesh = gfx.Mesh(geometry, material)
                 mesh.local.position = center
                 scene.add(mesh)
+            if any(m.surface.get("normals") is not None for m in built.meshes):
+                for direction, color, intensity in built.lights:
+                    light = gfx.DirectionalLight(color=gfx.Color(*color), intensity=intensity)
+                    light.local.position = -np.asarray(direction, dtype=np.float64)  # shines towards the origin
+                    scene.add(light)
+                scene.add(gfx.AmbientLight(color=gfx.Color(*built.ambient), intensity=1.0))
             self._scenes[key] = scene
         return self._scenes[key]
 

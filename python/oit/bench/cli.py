@@ -15,6 +15,8 @@ from .antialias import AA_COLUMNS, AA_METHODS, AA_SAMPLES, antialias
 from .auto import AUTO_COLUMNS, AUTO_MAX_K, AUTO_TOLERANCES, auto_vs_fixed
 from .claims import CLAIM_COLUMNS, run_claims
 from .figure7 import figure7_table
+from .floor import BASELINE, FLOOR_COLUMNS, GROWTH, load_baseline, peers_floor, write_baseline
+from .floor import SCENES as FLOOR_SCENE_NAMES
 from .harness import QUICK_SIZE, write_tables
 from .results import COLUMNS, run
 from .scale import SCALE_METHODS, SWEEPS, parse_size, scale, write_scale
@@ -76,6 +78,13 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--full", action="store_true", help="--claims: also the claims that need full-size scenes (minutes)")
     ap.add_argument("--only", nargs="+", default=None, metavar="ID",
                     help="--claims: just these claims, quick or full (ids as in docs/claims.md)")
+    ap.add_argument("--peers-floor", action="store_true",
+                    help="instead of the method sweep: the floor and the methods over it against pygfx on the same fixed "
+                         "arrays, unlit and lit, as ratios to pygfx in this run, each against its target and against the "
+                         f"baseline in {BASELINE.name} (floor.csv, floor.md); exits 1 when a ratio grew by more than "
+                         f"{GROWTH:.0%}")
+    ap.add_argument("--update-baseline", action="store_true",
+                    help="--peers-floor: keep this run's ratios as the new baseline (after a change that is meant to cost time)")
     ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
                     help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
 
@@ -101,6 +110,23 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
+    if a.peers_floor:
+        # The floor's scenes among --scenes (by default all three of them).
+        scenes = tuple(s for s in FLOOR_SCENE_NAMES if s in a.scenes) or FLOOR_SCENE_NAMES
+        result = peers_floor(scenes, repeat, a.quick, baseline=load_baseline())
+        write_tables(a.out, "floor", result, FLOOR_COLUMNS)
+        missed = [r for r in result.rows if r["meets"] == "no"]
+        for r in missed:
+            print(f"note: {r['scene']} {r['shading']} {r['method']} is {r['ratio']:.2f}x pygfx, past its target {r['target']:.1f}x")
+        slower = [r for r in result.rows if r["flag"]]
+        for r in slower:
+            print(f"error: {r['scene']} {r['shading']} {r['method']}: {r['ratio']:.2f}x pygfx against {r['baseline']:.2f}x in "
+                  f"the baseline ({r['growth']:+.0%})", file=sys.stderr)
+        if a.update_baseline and not a.quick:
+            write_baseline(result)
+            print(f"wrote {BASELINE}")
+            return 0
+        return 1 if slower else 0
     if a.claims:
         write_tables(a.out, "claims", run_claims(full=a.full, only=a.only), CLAIM_COLUMNS)
         return 0
