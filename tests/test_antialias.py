@@ -60,8 +60,8 @@ def test_one_sample_is_the_plain_frame(renderer):
 def test_memory_is_that_of_one_sample(renderer, method):
     scene = build_scene(random_meshes(5, transparent=6))
     r = renderer(32, 24)
-    one = r.render(scene, PERSPECTIVE, method)
-    four = r.render(scene, PERSPECTIVE, method, antialias=4)
+    one = r.render(scene, PERSPECTIVE, method, census=True)
+    four = r.render(scene, PERSPECTIVE, method, antialias=4, census=True)
     assert four.stats["memory_bytes"] == one.stats["memory_bytes"]
     assert four.stats["target_bytes"] == one.stats["target_bytes"]
     # Every sample frame's fragments are counted.

@@ -19,7 +19,7 @@ def test_stats_count_known_fragments(renderer, method):
     w, h = 24, 16
     r = renderer(w, h)
     scene = build_scene([layer(z, (0.5, 0.5, 0.5, 0.5)) for z in (0.2, 0.4, 0.6)])
-    frame = r.render(scene, IDENTITY, method=method)
+    frame = r.render(scene, IDENTITY, method=method, census=True)
     s = frame.stats
     assert set(s) >= STAT_KEYS
     assert s["method"] == method
@@ -42,7 +42,7 @@ def test_stats_count_known_fragments(renderer, method):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_image_and_depth_complexity_types(renderer, method):
-    frame = renderer(24, 16).render(build_scene([layer(0.5, (1, 0, 0, 0.5))]), IDENTITY, method=method)
+    frame = renderer(24, 16).render(build_scene([layer(0.5, (1, 0, 0, 0.5))]), IDENTITY, method=method, census=True)
     assert frame.image.dtype == np.float32 and frame.image.shape == (16, 24, 4)
     assert frame.depth_complexity.dtype == np.uint32 and frame.depth_complexity.shape == (16, 24)
     assert frame.image.flags.c_contiguous
@@ -144,6 +144,33 @@ def test_empty_scene_is_the_background(renderer, method):
     empty_mesh = oit.Scene()
     empty_mesh.add_mesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.uint32), (1.0, 0.0, 0.0, 1.0))
     for scene in (oit.Scene(), empty_mesh):
-        frame = r.render(scene, IDENTITY, method=method, background=(0.1, 0.2, 0.3))
+        frame = r.render(scene, IDENTITY, method=method, background=(0.1, 0.2, 0.3), census=True)
         assert np.array_equal(frame.image, np.broadcast_to(np.float32([0.1, 0.2, 0.3, 0.0]), (16, 16, 4)))
         assert frame.stats["fragments"] == 0 and frame.stats["max_depth_complexity"] == 0
+
+
+@pytest.mark.parametrize("method", [m["name"] for m in oit.methods() if m["name"] in ("unsorted", "wboit", "hybrid", "hybrid64",
+                                                                                       "abuffer", "depth_peeling")])
+def test_the_census_runs_where_the_method_needs_it_or_the_caller_asks(renderer, method):
+    """A method that plans from the census (oit.methods()'s "census") always runs it; the others
+    run it only with census=True, and report no counts without it. The image is the same bits
+    either way."""
+    r = renderer(24, 16)
+    scene = build_scene([layer(z, (0.5, 0.5, 0.5, 0.5)) for z in (0.2, 0.4, 0.6)])
+    needs = next(m["census"] for m in oit.methods() if m["name"] == method)
+    plain = r.render(scene, IDENTITY, method=method)
+    counted = r.render(scene, IDENTITY, method=method, census=True)
+    assert np.array_equal(plain.image, counted.image)
+    assert counted.stats["census"] and counted.stats["fragments"] == 3 * 24 * 16 and (counted.depth_complexity == 3).all()
+    assert plain.stats["census"] == needs
+    if needs:
+        assert plain.stats["fragments"] == counted.stats["fragments"]
+        assert np.array_equal(plain.depth_complexity, counted.depth_complexity)
+    else:
+        assert plain.stats["fragments"] is None and plain.stats["max_depth_complexity"] is None
+        assert plain.depth_complexity is None
+
+
+def test_census_must_be_a_bool(renderer):
+    with pytest.raises(TypeError, match="census must be True or False"):
+        renderer(4, 4).render(oit.Scene(), IDENTITY, method="unsorted", census=1)

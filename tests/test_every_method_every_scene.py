@@ -28,6 +28,6 @@ def built():
 def test_method_renders_every_scene(renderer, built, method):
     r = renderer(32, 32)
     for name, b in built.items():
-        frame = r.render(b.scene, b.camera, method)
+        frame = r.render(b.scene, b.camera, method, census=True)
         assert np.isfinite(frame.image).all(), (method, name)
         assert frame.stats["fragments"] == int(frame.depth_complexity.sum()), (method, name)

@@ -74,7 +74,7 @@ def test_random_valid_scenes(renderer, ms, size, mp):
         scene.add_mesh(pos, idx, col, opaque=opaque)
     r = renderer(*size)
     name, params = mp
-    frame = r.render(scene, IDENTITY, name, background=tuple(BG), **params)
+    frame = r.render(scene, IDENTITY, name, background=tuple(BG), **params, census=True)
     w, h = size
     assert frame.image.shape == (h, w, 4) and np.isfinite(frame.image).all()
     assert frame.depth_complexity.shape == (h, w)

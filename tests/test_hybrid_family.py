@@ -246,7 +246,7 @@ def test_blended_tail_matches_the_model_within_float_sums(renderer, k, alphas):
 def test_blended_tail_depends_on_order_only_within_its_rounding(renderer):
     meshes = random_meshes(7, transparent=12, opaque=1, triangles=8, space="ndc", spread=0.9)
     r = renderer(40, 40)
-    first = r.render(build_scene(meshes), IDENTITY, "hybrid", background=(0.3, 0.3, 0.3), k=2, tail="blend")
+    first = r.render(build_scene(meshes), IDENTITY, "hybrid", background=(0.3, 0.3, 0.3), k=2, tail="blend", census=True)
     n = first.stats["max_depth_complexity"]
     assert first.stats["overflow_fragments"] > 0  # a tail to sum
     exact = r.render(build_scene(meshes), IDENTITY, "hybrid", background=(0.3, 0.3, 0.3), k=2)

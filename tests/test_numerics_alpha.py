@@ -144,6 +144,6 @@ def test_no_transparent_fragments_at_all(renderer, name):
     opaque_only = full_screen_layers([(0.5, (0.25, 0.5, 0.75, 1.0))], opaque=[0])
     cases = ((oit.Scene(), (*F32_BG, 0.0)), (empty_mesh, (*F32_BG, 0.0)), (opaque_only, (0.25, 0.5, 0.75, 1.0)))
     for scene, want in cases:
-        frame = r.render(scene, IDENTITY, name, background=tuple(BG), **params_for(name))
+        frame = r.render(scene, IDENTITY, name, background=tuple(BG), **params_for(name), census=True)
         assert np.array_equal(frame.image, np.broadcast_to(np.float32(want), (2, 3, 4)))
         assert frame.stats["fragments"] == 0 and frame.stats["overflow_fragments"] == 0

@@ -86,7 +86,7 @@ def shuffles(meshes, count, seed=0):
 
 def render(renderer, meshes, name, **params):
     return renderer(*SIZE).render(build_scene(meshes), IDENTITY, name, background=tuple(BG),
-                                  **params_for(name, **params))
+                                  **params_for(name, **params), census=True)
 
 
 # "layers-near" has distinct float32 depths everywhere: no exact tie for peeling to break.

@@ -55,7 +55,7 @@ RANGES = {
 def test_wide_depth_range_matches_reference(renderer, case, name):
     near, far, dists = RANGES[case]
     scene, camera = build_scene(spread_quads(dists)), look(near, far)
-    frame = renderer(SIZE, SIZE).render(scene, camera, name, background=tuple(BG))
+    frame = renderer(SIZE, SIZE).render(scene, camera, name, background=tuple(BG), census=True)
     ref, ambiguous = oit.reference(scene, camera, SIZE, SIZE, background=tuple(BG), return_mask=True)
     n = int(frame.stats["max_depth_complexity"])
     assert n >= len(dists) - 1 and ambiguous.mean() < 0.1
@@ -72,7 +72,7 @@ def test_hybrid_keys_separate_layers_at_wide_depth_ranges(renderer, case):
     near, far, dists = RANGES[case]
     scene, camera = build_scene(spread_quads(dists)), look(near, far)
     r = renderer(SIZE, SIZE)
-    exact = r.render(scene, camera, EXACT[0], background=tuple(BG))
+    exact = r.render(scene, camera, EXACT[0], background=tuple(BG), census=True)
     dc = exact.depth_complexity
     for name in sorted({"hybrid", "ktab"} & set(NAMES)):
         f = r.render(scene, camera, name, background=tuple(BG), k=int(dc.max()))
@@ -94,7 +94,7 @@ def planes_scene(z, opaque=False):
 def test_geometry_at_the_near_plane_is_drawn(renderer, name):
     # z = 0 is inside both the GPU's clip volume and the reference's segment.
     r = renderer(8, 8)
-    frame = r.render(planes_scene(0.0), IDENTITY, name, background=tuple(BG), **params_for(name))
+    frame = r.render(planes_scene(0.0), IDENTITY, name, background=tuple(BG), **params_for(name), census=True)
     assert (frame.depth_complexity == 2).all()
     if name in EXACT:
         ref, ambiguous = oit.reference(planes_scene(0.0), IDENTITY, 8, 8, background=tuple(BG), return_mask=True)
@@ -109,7 +109,7 @@ PAST_FAR = float(np.nextafter(np.float32(1), np.float32(2)))
 @pytest.mark.parametrize("name", NAMES)
 def test_geometry_just_outside_the_planes_is_clipped(renderer, name, z):
     scene = planes_scene(z)
-    frame = renderer(8, 8).render(scene, IDENTITY, name, background=tuple(BG), **params_for(name))
+    frame = renderer(8, 8).render(scene, IDENTITY, name, background=tuple(BG), **params_for(name), census=True)
     assert (frame.depth_complexity == 1).all()
     if name in EXACT:
         # Clipped by the reference too; no plane tie to excuse (only the quads' diagonal is
@@ -124,7 +124,7 @@ def test_geometry_at_the_far_plane_is_clipped_as_in_the_reference(renderer, name
     # Window depth exactly 1: the GPU's depth test rejects it against the cleared 1.0, and the
     # reference takes depths in [0, 1) to match (it once composited z = 1).
     scene = planes_scene(1.0, opaque)
-    frame = renderer(8, 8).render(scene, IDENTITY, name, background=tuple(BG), **params_for(name))
+    frame = renderer(8, 8).render(scene, IDENTITY, name, background=tuple(BG), **params_for(name), census=True)
     assert (frame.depth_complexity == 1).all()
     if name not in RANDOMIZED:  # (whose noise follows triangle indices)
         alone = renderer(8, 8).render(full_screen_layers([MID]), IDENTITY, name, background=tuple(BG),
@@ -155,7 +155,7 @@ def test_perspective_geometry_on_a_plane_is_in_or_out_never_garbage(renderer, ra
     with_it = models.exact(z, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], [0.5, 0.5], BG)
     without = models.exact([0.5], [[0.0, 1.0, 0.0]], [0.5], BG)
     for name in EXACT:
-        f = renderer(16, 16).render(scene, camera, name, background=tuple(BG))
+        f = renderer(16, 16).render(scene, camera, name, background=tuple(BG), census=True)
         assert set(np.unique(f.depth_complexity)) <= {1, 2}
         want = np.where((f.depth_complexity == 2)[..., None], with_it, without)
         assert np.abs(f.image - want).max() <= tolerance(name, 2), name

@@ -141,7 +141,7 @@ def test_per_pixel_buffers_past_the_binding_limit_go_in_tiles(past_binding, name
     r = past_binding
     scene = oit.Scene()
     scene.add_mesh(TINY_TRIANGLE, [[0, 1, 2]], (1, 0, 0, 0.5))
-    frame = r.render(scene, IDENTITY, name, background=(0.0, 0.0, 0.0))
+    frame = r.render(scene, IDENTITY, name, background=(0.0, 0.0, 0.0), census=True)
     assert frame.stats["tiles"] > 1 and frame.stats["fragments"] > 0
     # One layer: every method gives the over-blended triangle (hybrid up to its 8-bit alpha).
     want = r.render(scene, IDENTITY, "unsorted", background=(0.0, 0.0, 0.0)).image

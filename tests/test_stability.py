@@ -80,7 +80,7 @@ def test_bit_identical_under_reordering_and_across_frames(renderer, name, params
     r = renderer(*SIZE)
     build, deeper, shallower = SCENES[scene]
     meshes, camera = build()
-    render = lambda ms: r.render(build_scene(ms), camera, name, background=BACKGROUND, **params)  # noqa: E731
+    render = lambda ms: r.render(build_scene(ms), camera, name, background=BACKGROUND, **params, census=True)  # noqa: E731
     try:
         first = render(meshes)
     except RuntimeError as e:
@@ -94,10 +94,10 @@ def test_bit_identical_under_reordering_and_across_frames(renderer, name, params
     # Across frames: the same scene again, then after a deeper scene (more fragments, larger
     # pools) and a shallower one (pools may shrink), twice.
     same = build_scene(meshes)
-    assert differences(r.render(same, camera, name, background=BACKGROUND, **params), first) == "", "repeated"
+    assert differences(r.render(same, camera, name, background=BACKGROUND, **params, census=True), first) == "", "repeated"
     for other in (deeper, shallower):
         ms, cam = other()
         r.render(build_scene(ms), cam, name, background=BACKGROUND, **params)
     for i in range(2):
-        frame = r.render(same, camera, name, background=BACKGROUND, **params)
+        frame = r.render(same, camera, name, background=BACKGROUND, **params, census=True)
         assert differences(frame, first) == "", f"{name} {params}, frame {i + 1} after other scenes"

@@ -56,6 +56,7 @@ class _MethodInfo(TypedDict):
     memory: _MemoryInfo
     error_bound: Literal["exact", "per_pixel", "none"]
     tiling: _TilingInfo
+    census: bool  # whether it plans from the fragment census (and so always runs it)
 
 @final
 class Scene:

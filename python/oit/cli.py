@@ -119,7 +119,7 @@ def _render(args: argparse.Namespace) -> int:
     camera = Camera.fit(mesh.vertices, aspect=width / height)
     params: dict[str, Any] = dict(args.param)
     frame = Renderer(width, height, adapter=args.adapter).render(
-        scene, camera, method=args.method, background=tuple(args.background), **params
+        scene, camera, method=args.method, background=tuple(args.background), census=True, **params
     )
     stem = os.path.splitext(os.path.basename(args.file))[0]
     output = args.output or os.path.join("out", f"{stem}-{args.method}.png")

@@ -78,7 +78,7 @@ def run(size: int = 384, adapter: str | None = None) -> DemoResult:
     # About 8 pixels a triangle: finer meshes put a triangle edge near most pixel centers.
     scene, camera, subject = demo_scene(max_triangles=int(np.clip(size * size // 8, 1000, 20000)))
     renderer = Renderer(size, size, adapter=adapter)
-    frames = {m: renderer.render(scene, camera, method=m, background=BACKGROUND) for m in METHODS}
+    frames = {m: renderer.render(scene, camera, method=m, background=BACKGROUND, census=True) for m in METHODS}
     exact = frames["abuffer"].image[..., :3].astype(np.float64)
     ref, ambiguous = reference(scene, camera, size, size, background=BACKGROUND, return_mask=True)
     ref_diff = np.abs(exact - ref[..., :3]).max(axis=-1)

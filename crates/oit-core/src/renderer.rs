@@ -403,7 +403,9 @@ impl Renderer {
         let census = info.census || self.census;
         self.opaque_and_census(gpu_scene, camera, background, cov, census);
         let depth_complexity: Vec<u32> = match census {
-            true => bytemuck::pod_collect_to_vec(&read_buffer(&gpu, &self.targets.counts_readback, self.width as u64 * self.height as u64 * 4)?),
+            true => {
+                bytemuck::pod_collect_to_vec(&read_buffer(&gpu, &self.targets.counts_readback, self.width as u64 * self.height as u64 * 4)?)
+            }
             false => Vec::new(),
         };
         let max_depth_complexity = depth_complexity.iter().copied().max().unwrap_or(0);

@@ -67,10 +67,22 @@ fn expand(path: &str, consts: &[Const], out: &mut String, seen: &mut Vec<String>
         return;
     }
     seen.push(path.to_string());
+    expand_lines(path, source(path), consts, out, seen);
+}
+
+/// `text` (as if it were the file `path`) with its directives resolved: for tests of the
+/// directives themselves.
+pub fn expand_text(path: &str, text: &str, consts: &[Const]) -> String {
+    let mut out = String::new();
+    expand_lines(path, text, consts, &mut out, &mut vec![path.to_string()]);
+    out
+}
+
+fn expand_lines(path: &str, text: &str, consts: &[Const], out: &mut String, seen: &mut Vec<String>) {
     // One entry per open `//!if`: whether its current branch is kept, and whether it is at `else`.
     let mut open: Vec<(bool, bool)> = Vec::new();
     let live = |open: &[(bool, bool)]| open.iter().all(|(keep, _)| *keep);
-    for (n, line) in source(path).lines().enumerate() {
+    for (n, line) in text.lines().enumerate() {
         let directive = line.trim();
         if let Some(name) = directive.strip_prefix("//!if ") {
             open.push((condition(name.trim(), consts, path, n), false));

@@ -2,10 +2,14 @@
 //! with Rust have the sizes naga computes.
 
 use oit_core::gpu_types::{Alloc, CompactNode, CoverageNode, FrameUniform, GpuLight, PallBlock, PoolNode, PrimNode, PrimShading};
-use oit_core::shader::{compose, entry_files, DEFAULT_CONSTS};
+use oit_core::shader::{compose, entry_files, Const, SceneVariant, DEFAULT_CONSTS};
 
 fn validate(path: &str) -> naga::Module {
-    let src = compose(path, DEFAULT_CONSTS);
+    validate_with(path, DEFAULT_CONSTS)
+}
+
+fn validate_with(path: &str, consts: &[Const]) -> naga::Module {
+    let src = compose(path, consts);
     let module = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{path}: {}", e.emit_to_string(&src)));
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
         .validate(&module)
@@ -20,6 +24,50 @@ fn every_shader_validates() {
     for f in files {
         validate(f);
     }
+}
+
+/// Every scene variant a pipeline can be specialized to (unlit, lit without textures, the
+/// shading-cost knob on an unlit scene) validates too: the `//!if` blocks leave whole shaders.
+#[test]
+fn every_shader_validates_in_every_scene_variant() {
+    let variants = [
+        SceneVariant::default(),
+        SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0 },
+        SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3 },
+    ];
+    for v in variants {
+        // The variant's constants replace the defaults of the same names.
+        let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !v.consts().iter().any(|o| name(o) == name(c))).collect();
+        consts.extend(v.consts());
+        for f in entry_files() {
+            validate_with(f, &consts);
+        }
+    }
+}
+
+fn name(c: &Const) -> &'static str {
+    match c {
+        Const::U32(n, _) | Const::F32(n, _) => n,
+    }
+}
+
+#[test]
+fn an_unlit_variant_has_no_shading_varyings() {
+    let mut consts: Vec<Const> =
+        DEFAULT_CONSTS.iter().copied().filter(|c| !SceneVariant::default().consts().iter().any(|o| name(o) == name(c))).collect();
+    consts.extend(SceneVariant::default().consts());
+    let unlit = compose("blend.wgsl", &consts);
+    let lit = compose("blend.wgsl", DEFAULT_CONSTS);
+    for varying in ["normal: vec3<f32>", "uv: vec2<f32>", "material: u32", "fn texture_sample"] {
+        assert!(!unlit.contains(varying), "the unlit blend shader still has `{varying}`");
+        assert!(lit.contains(varying), "the lit blend shader lacks `{varying}`");
+    }
+}
+
+#[test]
+#[should_panic(expected = "no u32 constant NOT_A_CONSTANT")]
+fn an_if_on_an_unknown_constant_is_refused() {
+    oit_core::shader::expand_text("t.wgsl", "//!if NOT_A_CONSTANT\nx\n//!endif\n", &[]);
 }
 
 fn struct_size(module: &naga::Module, name: &str) -> u32 {

@@ -385,6 +385,7 @@ fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
             tiling.set_item("per_triangle", per_triangle)?;
         }
         d.set_item("tiling", tiling)?;
+        d.set_item("census", m.census)?;
         let params = PyList::empty(py);
         for p in m.params {
             let pd = PyDict::new(py);

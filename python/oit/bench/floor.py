@@ -129,15 +129,17 @@ def peers_floor(scenes: tuple[str, ...] = SCENES, repeat: int = 5, quick: bool =
                 baseline: dict[str, Any] | None = None) -> Result:
     """Every ROWS method on each scene, unlit and lit, against its pygfx mode: wall medians of
     `repeat` alternating renders after a warm-up of each, the ratio, its target and its growth
-    over `baseline` (a `load_baseline()` dict; quick runs, at QUICK_SIZE, compare with none)."""
+    over `baseline` (a `load_baseline()` dict, compared only when it was measured at this run's
+    frame size: 512 x 512, or QUICK_SIZE with `quick`)."""
     missing = peers.pygfx_missing()
     if missing:
         raise RuntimeError(f"--peers-floor measures against pygfx: {missing}")
     size = (QUICK_SIZE, QUICK_SIZE) if quick else (512, 512)
     result = Result(rows=[])
     version = _pygfx_version()
-    base = (baseline or {}).get("ratios", {}) if not quick else {}
-    if baseline and not quick and baseline.get("pygfx") != version:
+    same_size = baseline is not None and baseline.get("size") == f"{size[0]}x{size[1]}"
+    base = baseline.get("ratios", {}) if baseline is not None and same_size else {}
+    if baseline is not None and same_size and baseline.get("pygfx") != version:
         result.notes.append(f"the baseline was measured against pygfx {baseline.get('pygfx')}, this run against {version}: "
                             "its growth column compares different peers")
     renderer = Renderer(*size)
@@ -185,7 +187,7 @@ def _floor_row(renderer: Renderer, peer: peers.PygfxRenderer, built: scene_lib.B
         "meets": "" if target is None else ("yes" if ratio <= target else "no"), "baseline": old if old else math.nan,
         "growth": growth, "flag": "slower" if growth > GROWTH else "", "ns_per_fragment": ours_ms * 1e6 / max(fragments, 1),
         "gpu_ms": statistics.median(gpus) if gpus else math.nan, "fragments": fragments, "status": "ok", "message": "",
-        "adapter": renderer.adapter_info["name"],
+        "adapter": renderer.adapter_info["name"], "size": f"{renderer.width}x{renderer.height}",
     }
 
 
@@ -193,7 +195,8 @@ def write_baseline(result: Result, path: Path = BASELINE) -> None:
     """Keeps this run's ratios as the baseline later runs are held against."""
     ratios = {row_key(r["scene"], r["shading"], r["method"]): round(r["ratio"], 4) for r in result.rows}
     adapter = result.rows[0]["adapter"] if result.rows else ""
-    data = {"pygfx": _pygfx_version(), "adapter": adapter, "size": "512x512", "ratios": ratios}
+    size = result.rows[0]["size"] if result.rows else ""
+    data = {"pygfx": _pygfx_version(), "adapter": adapter, "size": size, "ratios": ratios}
     with open(path, "w") as f:
         json.dump(data, f, indent=1, sort_keys=True)
         f.write("\n")

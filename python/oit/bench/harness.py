@@ -151,6 +151,12 @@ def medians(gpu: list[float], wall: list[float]) -> dict[str, float]:
     return {"gpu_ms": statistics.median(gpu) if gpu else math.nan, "wall_ms": statistics.median(wall)}
 
 
+def census_count(value: int | None) -> float:
+    """A census count (stats "fragments", "max_depth_complexity") for a table: NaN where the
+    frame ran no census."""
+    return math.nan if value is None else value
+
+
 def mean_rgb_distance(a: np.ndarray, b: np.ndarray) -> float:
     """Mean over pixels of the RGB distance between two images."""
     return float(np.sqrt(((a[..., :3].astype(np.float64) - b[..., :3]) ** 2).sum(-1)).mean())

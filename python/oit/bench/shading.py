@@ -11,7 +11,7 @@ from functools import partial
 
 import numpy as np
 
-from .harness import Progress, Result, medians, scene_jobs, timed
+from .harness import Progress, Result, census_count, medians, scene_jobs, timed
 
 SHADING_METHODS = ("abuffer", "compact_abuffer", "hybrid", "ktab", "hybrid64", "wboit", "stochastic", "depth_peeling")
 SHADING_COSTS = (0, 64, 256, 1024)
@@ -50,7 +50,7 @@ def shading_cost(scenes: list[str], methods: list[str] | None = None, sizes: lis
                     result.rows.append(row)
                     progress.step(method)
                     continue
-                row.update(**medians(gpu, wall), fragments=frame.stats["fragments"])
+                row.update(**medians(gpu, wall), fragments=census_count(frame.stats["fragments"]))
                 if cost == 0:
                     base = {k: row[k] for k in ("gpu_ms", "wall_ms")}
                     image0 = frame.image

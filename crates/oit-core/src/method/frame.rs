@@ -120,7 +120,8 @@ impl<'a> FrameCtx<'a> {
     pub fn resolve_pipeline_groups(&self, shader: &ShaderKey, fs: &'static str, own: &[Layout], bound: bool) -> wgpu::RenderPipeline {
         let mut groups = vec![Layout::Scene, self.targets_key()];
         groups.extend_from_slice(own);
-        let desc = RenderDesc { shader: self.specialized(shader), entry: fs, groups, draw: Draw::Fullscreen, targets: resolve_targets(bound) };
+        let desc =
+            RenderDesc { shader: self.specialized(shader), entry: fs, groups, draw: Draw::Fullscreen, targets: resolve_targets(bound) };
         self.gpu.cache.render(&self.gpu.device, &desc)
     }
 

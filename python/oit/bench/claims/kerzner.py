@@ -133,7 +133,7 @@ def pall_atomics() -> tuple[str, str]:
     out, ok = [], True
     for name in scene_lib.SHOWCASE:
         built = scene_lib.SCENES[name](**QUICK_SCENE_ARGS.get(name, {}))
-        t, f = built.scene.triangle_count, render(built, "unsorted").stats["fragments"]
+        t, f = built.scene.triangle_count, render(built, "unsorted", census=True).stats["fragments"]
         ok &= t < f
         out.append(f"{name} {t} against {f} ({f / t:.1f}× fewer)")
     return ("global atomicAdds a frame, by construction (pall: one a triangle in its allocate pass, none in capture; abuffer: "
