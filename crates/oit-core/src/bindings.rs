@@ -6,6 +6,9 @@ pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// The census's count target: fragments add 1.0 by blending (exact below 2^24).
+pub const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
 /// Per-pixel error bound written by methods that derive one.
 pub const BOUND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 

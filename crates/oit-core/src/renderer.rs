@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use crate::antialias;
-use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
+use crate::bindings::{COLOR_FORMAT, COUNT_FORMAT, DEPTH_FORMAT};
 use crate::cache::{Draw, Layout, RenderDesc, ShaderKey};
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
@@ -122,19 +122,45 @@ fn opaque_pipeline(gpu: &GpuContext, variant: SceneVariant) -> wgpu::RenderPipel
     gpu.cache.render(&gpu.device, &desc)
 }
 
-/// The census pipeline for `variant` (multisampled in a coverage-mask frame). The census reads
-/// only positions: its variant is always the unlit one, whatever the scene.
-fn census_pipeline(gpu: &GpuContext, coverage: bool) -> wgpu::RenderPipeline {
+/// How the census counts: by blending into the count target where the adapter blends float32
+/// (one pass, no atomics), else with an atomic a fragment into the counts buffer; a
+/// coverage-mask frame counts with atomics at each sample's coverage.
+#[derive(Clone, Copy, PartialEq)]
+enum CensusKind {
+    Blend,
+    Atomic,
+    Samples,
+}
+
+/// The census pipeline of `kind`. The census reads only positions: its variant is always the
+/// unlit one, whatever the scene.
+fn census_pipeline(gpu: &GpuContext, kind: CensusKind) -> wgpu::RenderPipeline {
     let variant = SceneVariant::default().consts();
-    let desc = match coverage {
-        false => RenderDesc {
+    let add = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    let desc = match kind {
+        CensusKind::Blend => RenderDesc {
+            shader: ShaderKey::new("census.wgsl", &variant),
+            entry: "fs_count",
+            groups: vec![Layout::Scene],
+            draw: Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
+            targets: vec![Some(wgpu::ColorTargetState {
+                format: COUNT_FORMAT,
+                blend: Some(wgpu::BlendState { color: add, alpha: add }),
+                write_mask: wgpu::ColorWrites::RED,
+            })],
+        },
+        CensusKind::Atomic => RenderDesc {
             shader: ShaderKey::new("census.wgsl", &variant),
             entry: "fs_census",
             groups: vec![Layout::Scene, Layout::Targets, Layout::Storage(1)],
             draw: Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
             targets: vec![],
         },
-        true => RenderDesc {
+        CensusKind::Samples => RenderDesc {
             shader: ShaderKey::new("census_samples.wgsl", &variant),
             entry: "fs_census",
             groups: vec![Layout::Scene, Layout::SampleTargets, Layout::Storage(1)],
@@ -402,10 +428,8 @@ impl Renderer {
         let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
         let census = info.census || self.census;
         self.opaque_and_census(gpu_scene, camera, background, cov, census);
-        let depth_complexity: Vec<u32> = match census {
-            true => {
-                bytemuck::pod_collect_to_vec(&read_buffer(&gpu, &self.targets.counts_readback, self.width as u64 * self.height as u64 * 4)?)
-            }
+        let depth_complexity = match census {
+            true => self.read_census(coverage)?,
             false => Vec::new(),
         };
         let max_depth_complexity = depth_complexity.iter().copied().max().unwrap_or(0);
@@ -599,6 +623,25 @@ impl Renderer {
         Ok(())
     }
 
+    /// How this frame's census counts (`CensusKind`).
+    fn census_kind(&self, coverage: bool) -> CensusKind {
+        match coverage {
+            true => CensusKind::Samples,
+            false if self.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) => CensusKind::Blend,
+            false => CensusKind::Atomic,
+        }
+    }
+
+    /// The census's per-pixel counts, row-major.
+    fn read_census(&self, coverage: bool) -> Result<Vec<u32>> {
+        let t = &self.targets;
+        Ok(match self.census_kind(coverage) {
+            // Whole numbers below 2^24, exact in float32.
+            CensusKind::Blend => read_rows(&self.gpu, &t.count_texture, &t.counts_readback, 4)?.iter().map(|&c| c as u32).collect(),
+            _ => bytemuck::pod_collect_to_vec(&read_buffer(&self.gpu, &t.counts_readback, self.width as u64 * self.height as u64 * 4)?),
+        })
+    }
+
     /// What `scene`'s passes compile for: its surfaces, its light count (the headlight when it
     /// has none) and the shading-cost knob.
     fn variant(&self, scene: &GpuScene) -> SceneVariant {
@@ -688,19 +731,35 @@ impl Renderer {
             self.opaque_pass(&mut enc, scene, &t.base, &t.depth, bg);
         }
         if census {
-            enc.clear_buffer(&t.counts, 0, None);
-            let (group, depth) = match coverage {
-                Some(c) => (&c.targets.group, &c.targets.raster_depth),
-                None => (&t.group, &t.depth),
-            };
-            {
-                let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
-                pass.set_pipeline(&census_pipeline(&self.gpu, coverage.is_some()));
-                pass.set_bind_group(1, group, &[]);
-                pass.set_bind_group(2, &t.counts_group, &[]);
-                scene.transparent.draw_all(&mut pass);
+            match self.census_kind(coverage.is_some()) {
+                CensusKind::Blend => {
+                    let count = wgpu::RenderPassColorAttachment {
+                        view: &t.count,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                    };
+                    let mut pass = passes::capture_into(&mut enc, "census", &t.depth, &[Some(count)], None);
+                    pass.set_pipeline(&census_pipeline(&self.gpu, CensusKind::Blend));
+                    scene.transparent.draw_all(&mut pass);
+                }
+                kind => {
+                    enc.clear_buffer(&t.counts, 0, None);
+                    let (group, depth) = match coverage {
+                        Some(c) => (&c.targets.group, &c.targets.raster_depth),
+                        None => (&t.group, &t.depth),
+                    };
+                    {
+                        let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
+                        pass.set_pipeline(&census_pipeline(&self.gpu, kind));
+                        pass.set_bind_group(1, group, &[]);
+                        pass.set_bind_group(2, &t.counts_group, &[]);
+                        scene.transparent.draw_all(&mut pass);
+                    }
+                    let bytes = t.counts.size().min(t.counts_readback.size());
+                    enc.copy_buffer_to_buffer(&t.counts, 0, &t.counts_readback, 0, bytes);
+                }
             }
-            enc.copy_buffer_to_buffer(&t.counts, 0, &t.counts_readback, 0, t.counts.size().min(t.counts_readback.size()));
         }
         self.gpu.queue.submit([enc.finish()]);
     }

@@ -15,6 +15,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("RUN", 32),
     Const::U32("STEP_BUDGET", 32_768),
     Const::U32("FRAG_STEPS", 0),
+    Const::U32("KEYED", 1),
     Const::U32("K", 8),
     Const::U32("PER_PIXEL", 0),
     Const::U32("TAIL", 1),

@@ -1,7 +1,7 @@
 //! Per-size frame resources shared by every method: the opaque color with coverage
 //! (`base`), the opaque depth, the output image, census counts, and their readbacks.
 
-use crate::bindings::{BOUND_FORMAT, COLOR_FORMAT, DEPTH_FORMAT};
+use crate::bindings::{BOUND_FORMAT, COLOR_FORMAT, COUNT_FORMAT, DEPTH_FORMAT};
 use crate::context::GpuContext;
 use crate::tiles::Tile;
 
@@ -27,6 +27,9 @@ pub struct Targets {
     pub group: wgpu::BindGroup,
     pub counts: wgpu::Buffer,
     pub counts_group: wgpu::BindGroup,
+    /// The census as an R32Float target that fragments add 1 to (`census.wgsl`'s fs_count).
+    pub count_texture: wgpu::Texture,
+    pub count: wgpu::TextureView,
     pub image_readback: wgpu::Buffer,
     pub counts_readback: wgpu::Buffer,
 }
@@ -84,6 +87,8 @@ impl Targets {
         let group = opaque_group(d, "targets", layout, &depth, &base);
         let pixels = width as u64 * height as u64;
         let counts = storage_buffer(d, "census counts", pixels * 4, wgpu::BufferUsages::COPY_SRC);
+        let count_texture = texture(d, "census count", width, height, COUNT_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
+        let count = count_texture.create_view(&Default::default());
         let counts_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("census"),
             layout: counts_layout,
@@ -98,7 +103,7 @@ impl Targets {
             })
         };
         let image_readback = readback("image readback", padded_row(width, 16) as u64 * height as u64);
-        let counts_readback = readback("counts readback", pixels * 4);
+        let counts_readback = readback("counts readback", padded_row(width, 4) as u64 * height as u64);
         let bound_readback = readback("bound readback", padded_row(width, 4) as u64 * height as u64);
         Self {
             width,
@@ -115,15 +120,17 @@ impl Targets {
             group,
             counts,
             counts_group,
+            count_texture,
+            count,
             image_readback,
             counts_readback,
         }
     }
 
-    /// Bytes of the shared targets (base, depth, out, census counts, error bound), not
-    /// counted per method.
+    /// Bytes of the shared targets (base, depth, out, census counts as a buffer and as a
+    /// target, error bound), not counted per method.
     pub fn bytes(&self) -> u64 {
-        self.width as u64 * self.height as u64 * (16 + 4 + 16 + 4 + 4)
+        self.width as u64 * self.height as u64 * (16 + 4 + 16 + 4 + 4 + 4)
     }
 }
 

@@ -23,7 +23,7 @@ pub const RUN: u32 = 32;
 /// The local array of a frame whose deepest pixel has n fragments: the smallest of 8, 16
 /// and RUN that holds it (a smaller array is cheaper to sort and to keep).
 pub fn run_length(n: u64) -> u32 {
-    (n.next_power_of_two() as u32).clamp(8, RUN)
+    (n.next_power_of_two() as u32).clamp(8, std::env::var("OIT_RUN").ok().and_then(|v| v.parse().ok()).unwrap_or(RUN))
 }
 
 /// The pool's group: heads, allocator, the pool bindings, sweep state and binding 7.
@@ -276,6 +276,7 @@ impl ListMethod {
         consts.push(Const::U32("RUN", run));
         consts.push(Const::U32("STEP_BUDGET", budget as u32));
         consts.push(Const::U32("FRAG_STEPS", costs.frag as u32));
+        consts.push(Const::U32("KEYED", costs.keyed() as u32));
         consts.extend(self.consts.iter().copied());
         let shader = ShaderKey::new(self.shader, &consts);
         let compute = |entry| cx.compute_pipeline(&shader, entry, POOL_LAYOUT);
@@ -445,11 +446,20 @@ impl StepCosts {
         4 + self.samples + self.frag
     }
 
+    /// Whether runs hold sort keys, not whole fragments (sweep.wgsl's KEYED): where turning a
+    /// node into a fragment costs nothing beyond its load.
+    fn keyed(self) -> bool {
+        self.frag == 0
+    }
+
     /// A run loaded, insertion-sorted and relinked or composited: the largest unit of work
-    /// between two checks of the budget.
+    /// between two checks of the budget. Keyed runs load two nodes again at each comparison of
+    /// equal depths, and each node again to composite it.
     fn run(self) -> u64 {
         let run = self.run;
-        self.load() * (run + 1) + run.saturating_sub(1) * (run + 2) / 2 + run * Self::LINK.max(2 + self.samples)
+        let compares = run.saturating_sub(1) * (run + 2) / 2;
+        let (tie, again) = if self.keyed() { (2 * self.load(), self.load()) } else { (0, 0) };
+        self.load() * (run + 1) + compares * (1 + tie) + run * (Self::LINK.max(2 + self.samples) + again)
     }
 
     fn largest_unit(self) -> u64 {
