@@ -5,9 +5,14 @@
 
 // Storage-writing passes test the opaque depth themselves: a fragment shader with side
 // effects may run its depth test late, after its atomics already happened. They also ask
-// for the test before the shader (`@early_depth_test(force)`), so that an adapter that
-// honours it never runs the shader for a fragment behind the opaque scene.
+// for the test before the shader (`@early_depth_test(force)`), which an adapter with
+// SHADER_EARLY_DEPTH_TEST must honour: there (EARLY_DEPTH = 1, set per device by
+// oit_core::shader::module) a fragment behind the opaque scene never reaches the shader, and
+// the test here compiles to nothing.
 fn behind_opaque(pos: vec4<f32>) -> bool {
+    if EARLY_DEPTH != 0u {
+        return false;
+    }
     return pos.z >= textureLoad(opaque_depth, vec2<i32>(pos.xy), 0);
 }
 

@@ -16,6 +16,9 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("STEP_BUDGET", 32_768),
     Const::U32("FRAG_STEPS", 0),
     Const::U32("KEYED", 1),
+    // Whether the device honours @early_depth_test(force) (set by `module`): validated with
+    // the shaders' own opaque-depth test.
+    Const::U32("EARLY_DEPTH", 0),
     Const::U32("K", 8),
     Const::U32("PER_PIXEL", 0),
     Const::U32("TAIL", 1),
@@ -146,8 +149,11 @@ pub fn entry_files() -> impl Iterator<Item = &'static str> {
 const EARLY_DEPTH_TEST: &str = " @early_depth_test(force)";
 
 pub(crate) fn module(device: &wgpu::Device, path: &str, consts: &[Const]) -> wgpu::ShaderModule {
-    let mut text = compose(path, consts);
-    if !device.features().contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST) {
+    let early = device.features().contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
+    let mut all = consts.to_vec();
+    all.push(Const::U32("EARLY_DEPTH", early as u32));
+    let mut text = compose(path, &all);
+    if !early {
         text = text.replace(EARLY_DEPTH_TEST, "");
     }
     device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(path), source: wgpu::ShaderSource::Wgsl(text.into()) })
