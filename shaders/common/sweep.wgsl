@@ -123,30 +123,22 @@ fn save_acc(px: u32, c: Acc) {
     }
 }
 
+// A run of up to RUN fragments in a local array. Where KEYED (the node's fragment costs nothing
+// beyond its load) an entry is a sort key, the fragment's depth bits and node link: 8 bytes,
+// not the fragment's 24, and the array is zeroed at every invocation and its entries move in
+// the sort. Equal depths, which are rare, are ordered by the whole fragment (frag_less) from
+// their nodes, loaded again; the composite loads each node once more. Methods that shade at
+// resolve (FRAG_STEPS > 0: compact_abuffer) keep whole fragments (KEYED = 0), since loading
+// one again would shade it again.
 //!if KEYED
-// A run of up to RUN fragments in a local array, as sort keys: each fragment's depth bits and
-// node link (8 bytes, not the fragment's 24: the array is zeroed at every invocation and its
-// entries move in the sort). Equal depths, which are rare, are ordered by the whole fragment
-// (frag_less) from their nodes, loaded again; the composite loads each node once more.
-// Methods that shade at resolve (FRAG_STEPS > 0: compact_abuffer) keep whole fragments (KEYED
-// is 0), since loading one again would shade it again.
-struct Run {
-    keys: array<vec2<u32>, RUN>,
-    n: u32,
-    // The node after the run (0: the list ended).
-    next: u32,
+alias Entry = vec2<u32>;
+
+fn entry(w: Walked, link: u32) -> Entry {
+    return vec2<u32>(bitcast<u32>(w.frag.depth), link);
 }
 
-fn run_link(run: ptr<function, Run>, i: u32) -> u32 {
-    return (*run).keys[i].y;
-}
-
-fn run_frag(run: ptr<function, Run>, i: u32, px: u32) -> Frag {
-    return walk((*run).keys[i].y, px).frag;
-}
-
-// Whether key a sorts before key b (frag_less's order); `steps` grows by a tie's node loads.
-fn key_less(a: vec2<u32>, b: vec2<u32>, px: u32, steps: ptr<function, u32>) -> bool {
+// Whether entry a sorts before entry b (frag_less's order); `steps` grows by a tie's loads.
+fn entry_less(a: Entry, b: Entry, px: u32, steps: ptr<function, u32>) -> bool {
     let da = bitcast<f32>(a.x);
     let db = bitcast<f32>(b.x);
     if da != db {
@@ -156,74 +148,65 @@ fn key_less(a: vec2<u32>, b: vec2<u32>, px: u32, steps: ptr<function, u32>) -> b
     return frag_less(walk(a.y, px).frag, walk(b.y, px).frag);
 }
 
-// Loads the run starting at `link` and sorts it by insertion; `steps` grows by the work done.
-fn load_run(link: u32, px: u32, run: ptr<function, Run>, steps: ptr<function, u32>) {
-    var n = 0u;
-    var at = link;
-    while at != 0u && n < RUN {
-        let w = walk(at, px);
-        (*run).keys[n] = vec2<u32>(bitcast<u32>(w.frag.depth), at);
-        at = w.next;
-        n++;
-    }
-    var shifts = 0u;
-    for (var i = 1u; i < n; i++) {
-        let k = (*run).keys[i];
-        var j = i;
-        while j > 0u && key_less(k, (*run).keys[j - 1u], px, steps) {
-            (*run).keys[j] = (*run).keys[j - 1u];
-            j--;
-        }
-        (*run).keys[j] = k;
-        shifts += i - j + 1u;
-    }
-    (*run).n = n;
-    (*run).next = at;
-    *steps += LOAD_STEPS * (n + 1u) + shifts;
+fn entry_link(e: Entry) -> u32 {
+    return e.y;
+}
+
+fn entry_frag(e: Entry, px: u32) -> Frag {
+    return walk(e.y, px).frag;
 }
 //!else
-// A run of up to RUN fragments in a local array.
+alias Entry = Frag;
+
+fn entry(w: Walked, link: u32) -> Entry {
+    return w.frag;
+}
+
+fn entry_less(a: Entry, b: Entry, px: u32, steps: ptr<function, u32>) -> bool {
+    return frag_less(a, b);
+}
+
+fn entry_link(e: Entry) -> u32 {
+    return e.id;
+}
+
+fn entry_frag(e: Entry, px: u32) -> Frag {
+    return e;
+}
+//!endif
+
 struct Run {
-    frags: array<Frag, RUN>,
+    entries: array<Entry, RUN>,
     n: u32,
     // The node after the run (0: the list ended).
     next: u32,
 }
 
-fn run_link(run: ptr<function, Run>, i: u32) -> u32 {
-    return (*run).frags[i].id;
-}
-
-fn run_frag(run: ptr<function, Run>, i: u32, px: u32) -> Frag {
-    return (*run).frags[i];
-}
-
 // Loads the run starting at `link` and sorts it by insertion; `steps` grows by the work done.
 fn load_run(link: u32, px: u32, run: ptr<function, Run>, steps: ptr<function, u32>) {
     var n = 0u;
     var at = link;
     while at != 0u && n < RUN {
         let w = walk(at, px);
-        (*run).frags[n] = w.frag;
+        (*run).entries[n] = entry(w, at);
         at = w.next;
         n++;
     }
     var shifts = 0u;
     for (var i = 1u; i < n; i++) {
-        let f = (*run).frags[i];
+        let e = (*run).entries[i];
         var j = i;
-        while j > 0u && frag_less(f, (*run).frags[j - 1u]) {
-            (*run).frags[j] = (*run).frags[j - 1u];
+        while j > 0u && entry_less(e, (*run).entries[j - 1u], px, steps) {
+            (*run).entries[j] = (*run).entries[j - 1u];
             j--;
         }
-        (*run).frags[j] = f;
+        (*run).entries[j] = e;
         shifts += i - j + 1u;
     }
     (*run).n = n;
     (*run).next = at;
     *steps += LOAD_STEPS * (n + 1u) + shifts;
 }
-//!endif
 
 // A deep pixel's progress between dispatches, in registers.
 struct Sweep {
@@ -279,7 +262,7 @@ fn end_pass(s: ptr<function, Sweep>) {
 // Relinks a sorted run onto the pass's output; after the list's last run, the merges start.
 fn link_run(s: ptr<function, Sweep>, run: ptr<function, Run>, steps: ptr<function, u32>) {
     for (var i = 0u; i < (*run).n; i++) {
-        append(s, run_link(run, i));
+        append(s, entry_link((*run).entries[i]));
     }
     *steps += LINK_STEPS * (*run).n;
     (*s).src = (*run).next;
@@ -399,7 +382,7 @@ fn cs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     var c = acc_empty();
     if run.next == 0u {
         for (var i = 0u; i < run.n; i++) {
-            if composite(&c, run_frag(&run, i, px)) {
+            if composite(&c, entry_frag(run.entries[i], px)) {
                 break;
             }
         }

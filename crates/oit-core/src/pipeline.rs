@@ -3,6 +3,18 @@
 
 use crate::bindings::DEPTH_FORMAT;
 
+/// Depth state of passes that draw the nearest surface: test and write (the opaque pass,
+/// screen_door's).
+pub fn depth_write() -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: Default::default(),
+    })
+}
+
 /// Depth state of transparent geometry passes: test against the opaque depth, never write.
 pub fn depth_test_only() -> Option<wgpu::DepthStencilState> {
     read_only_depth(wgpu::CompareFunction::Less)

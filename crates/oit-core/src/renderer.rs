@@ -105,18 +105,11 @@ impl Shared {
 
 /// The opaque pass's pipeline for `variant`: straight color, writes depth.
 fn opaque_pipeline(gpu: &GpuContext, variant: SceneVariant) -> wgpu::RenderPipeline {
-    let depth = wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
-        depth_write_enabled: Some(true),
-        depth_compare: Some(wgpu::CompareFunction::Less),
-        stencil: Default::default(),
-        bias: Default::default(),
-    };
     let desc = RenderDesc {
         shader: ShaderKey::new("opaque.wgsl", &variant.consts()),
         entry: "fs_opaque",
         groups: vec![Layout::Scene],
-        draw: Draw::Geometry { depth: Some(depth), samples: 1 },
+        draw: Draw::Geometry { depth: pipeline::depth_write(), samples: 1 },
         targets: vec![Some(COLOR_FORMAT.into())],
     };
     gpu.cache.render(&gpu.device, &desc)

@@ -23,7 +23,7 @@ pub const RUN: u32 = 32;
 /// The local array of a frame whose deepest pixel has n fragments: the smallest of 8, 16
 /// and RUN that holds it (a smaller array is cheaper to sort and to keep).
 pub fn run_length(n: u64) -> u32 {
-    (n.next_power_of_two() as u32).clamp(8, std::env::var("OIT_RUN").ok().and_then(|v| v.parse().ok()).unwrap_or(RUN))
+    (n.next_power_of_two() as u32).clamp(8, RUN)
 }
 
 /// The pool's group: heads, allocator, the pool bindings, sweep state and binding 7.

@@ -8,6 +8,7 @@ use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::cache::{Layout, ShaderKey};
 use crate::error::Result;
 use crate::passes;
+use crate::pipeline;
 use crate::targets::texture;
 
 pub const INFO: MethodInfo = MethodInfo {
@@ -40,15 +41,8 @@ impl Method for ScreenDoor {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let d = &cx.gpu.device;
         let t = cx.targets;
-        let depth = wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        };
         let shader = ShaderKey::new("screen_door.wgsl", &[]);
-        let pipeline = cx.draw_pipeline(&shader, "fs_door", vec![Layout::Scene], vec![Some(COLOR_FORMAT.into())], Some(depth));
+        let pipeline = cx.draw_pipeline(&shader, "fs_door", vec![Layout::Scene], vec![Some(COLOR_FORMAT.into())], pipeline::depth_write());
         let size = (t.width, t.height);
         if self.depth.as_ref().is_none_or(|(s, _, _)| *s != size) {
             let tex = texture(
