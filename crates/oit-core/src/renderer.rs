@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use crate::antialias;
-use crate::bindings::{COLOR_FORMAT, COUNT_FORMAT, DEPTH_FORMAT};
+use crate::bindings::{COLOR_FORMAT, COUNT_FORMAT};
 use crate::cache::{Draw, Layout, RenderDesc, ShaderKey};
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
