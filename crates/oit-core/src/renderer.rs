@@ -186,6 +186,8 @@ pub struct Renderer {
     shading_cost: u32,
     /// Whether every frame runs the fragment census, not only those of methods that need it.
     census: bool,
+    /// Whether the census counts with atomics even where the adapter blends float32.
+    atomic_census: bool,
 }
 
 /// One device per adapter choice, shared by every renderer in the process.
@@ -236,6 +238,7 @@ impl Renderer {
             lights: (Vec::new(), [0.0; 3]),
             shading_cost: 0,
             census: false,
+            atomic_census: false,
         })
     }
 
@@ -256,6 +259,12 @@ impl Renderer {
     /// extra geometry pass.
     pub fn set_census(&mut self, always: bool) {
         self.census = always;
+    }
+
+    /// Makes the census count with an atomic a fragment, as it does on adapters that cannot
+    /// blend float32, instead of by blending (the counts are the same: tests compare them).
+    pub fn set_atomic_census(&mut self, on: bool) {
+        self.atomic_census = on;
     }
 
     /// Sizes method buffers as if the adapter bound at most `bytes` per storage binding
@@ -620,7 +629,7 @@ impl Renderer {
     fn census_kind(&self, coverage: bool) -> CensusKind {
         match coverage {
             true => CensusKind::Samples,
-            false if self.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) => CensusKind::Blend,
+            false if !self.atomic_census && self.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) => CensusKind::Blend,
             false => CensusKind::Atomic,
         }
     }
