@@ -44,14 +44,14 @@ const SPLIT_A: u32 = 0u;
 const SPLIT_B: u32 = 1u;
 const MERGING: u32 = 2u;
 const MULTI: u32 = 0x100u;
-// Steps per node loaded into a run (the loop, the pool switch), per node relinked (the loop,
-// append's switch), per merge step (its own switch, two fragments, the link, the append), and
-// per fragment composited from the list; FRAG_STEPS (injected) is what turning a node into a
-// fragment adds (compact_abuffer shades it). oit_core::method::lists::StepCosts mirrors them.
-const LOAD_STEPS: u32 = 2u + FRAG_STEPS;
-const LINK_STEPS: u32 = 2u;
-const MERGE_STEPS: u32 = 6u + 2u * FRAG_STEPS;
-const COMPOSITE_STEPS: u32 = 4u + PIXEL_SAMPLES + FRAG_STEPS;
+// Steps per node loaded into a run, per node relinked, per merge step and per fragment
+// composited from the list: the SWEEP_* constants (oit_core::consts, where they are explained;
+// oit_core::method::lists::StepCosts plans the dispatches from the same ones), plus FRAG_STEPS
+// (injected), what turning a node into a fragment adds (compact_abuffer shades it).
+const LOAD_STEPS: u32 = SWEEP_LOAD_STEPS + FRAG_STEPS;
+const LINK_STEPS: u32 = SWEEP_LINK_STEPS;
+const MERGE_STEPS: u32 = SWEEP_MERGE_STEPS + 2u * FRAG_STEPS;
+const COMPOSITE_STEPS: u32 = SWEEP_COMPOSITE_STEPS + PIXEL_SAMPLES + FRAG_STEPS;
 
 struct Frag {
     depth: f32,

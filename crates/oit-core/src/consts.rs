@@ -39,6 +39,18 @@ pub const TAU_SCALE: f32 = 4096.0;
 pub const TAU2_SCALE: f32 = 1024.0;
 pub const QUANT_SCALE: f32 = 16_777_216.0;
 
+/// What one unit of the sorted resolve costs on llvmpipe's loop limiter, which ends an
+/// invocation's loops after 65,535 iterations and counts every `switch` as one
+/// (shaders/common/sweep.wgsl adds what turning a node into a fragment costs, FRAG_STEPS;
+/// oit_core::method::lists::StepCosts plans dispatches from the same numbers): a node loaded
+/// into a run (its loop, the pool's switch), a node relinked (the loop, append's switch), a
+/// merge step (its switch, two fragments, the link, the append), a fragment composited from
+/// the list (before its samples).
+pub const SWEEP_LOAD_STEPS: u32 = 2;
+pub const SWEEP_LINK_STEPS: u32 = 2;
+pub const SWEEP_MERGE_STEPS: u32 = 6;
+pub const SWEEP_COMPOSITE_STEPS: u32 = 4;
+
 /// Every shared constant, in the order they are prepended (float64 ones as the float32 the
 /// shaders compute with).
 pub const SHARED: &[Const] = &[
@@ -63,4 +75,8 @@ pub const SHARED: &[Const] = &[
     Const::U32("SHADING_SMOOTH", crate::shading::Shading::Smooth as u32),
     Const::U32("TWO_SIDED", crate::shading::TWO_SIDED),
     Const::U32("TEXTURED", crate::shading::TEXTURED),
+    Const::U32("SWEEP_LOAD_STEPS", SWEEP_LOAD_STEPS),
+    Const::U32("SWEEP_LINK_STEPS", SWEEP_LINK_STEPS),
+    Const::U32("SWEEP_MERGE_STEPS", SWEEP_MERGE_STEPS),
+    Const::U32("SWEEP_COMPOSITE_STEPS", SWEEP_COMPOSITE_STEPS),
 ];

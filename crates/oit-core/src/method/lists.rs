@@ -5,6 +5,7 @@
 
 use super::frame::{FrameCtx, Limits, MethodReport};
 use crate::cache::{Layout, ShaderKey};
+use crate::consts::{SWEEP_COMPOSITE_STEPS, SWEEP_LINK_STEPS, SWEEP_LOAD_STEPS, SWEEP_MERGE_STEPS};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::Alloc;
@@ -436,14 +437,14 @@ pub struct StepCosts {
 
 impl StepCosts {
     fn load(self) -> u64 {
-        2 + self.frag
+        SWEEP_LOAD_STEPS as u64 + self.frag
     }
-    const LINK: u64 = 2;
+    const LINK: u64 = SWEEP_LINK_STEPS as u64;
     fn merge(self) -> u64 {
-        6 + 2 * self.frag
+        SWEEP_MERGE_STEPS as u64 + 2 * self.frag
     }
     fn composite(self) -> u64 {
-        4 + self.samples + self.frag
+        SWEEP_COMPOSITE_STEPS as u64 + self.samples + self.frag
     }
 
     /// Whether runs hold sort keys, not whole fragments (sweep.wgsl's KEYED): where turning a
@@ -522,4 +523,42 @@ pub(crate) fn check_replay_budget(cx: &FrameCtx<'_>, method: &str, param: &str, 
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PLAIN: StepCosts = StepCosts { samples: 1, frag: 0, run: RUN as u64 };
+
+    #[test]
+    fn a_list_of_one_run_needs_no_dispatch_after_the_first() {
+        assert_eq!(resolve_steps(RUN as u64, PLAIN), [0; 3]);
+        assert_eq!(resolve_dispatches(1, PLAIN, 1000), [0; 3]);
+    }
+
+    #[test]
+    fn deeper_lists_take_the_runs_merges_and_composite_the_shader_counts() {
+        // 100 fragments: 4 runs of 32 (3 after the first), 2 merge passes, 101 composite steps.
+        let n = 100;
+        let [runs, merge, composite] = resolve_steps(n, PLAIN);
+        assert_eq!(runs, 3 * PLAIN.run());
+        assert_eq!(merge, 2 * (SWEEP_MERGE_STEPS as u64) * (2 * n + 2 * 4));
+        assert_eq!(composite, (n + 1) * (SWEEP_COMPOSITE_STEPS as u64 + 1));
+        let budget = 1000;
+        assert_eq!(resolve_dispatches(n, PLAIN, budget), [runs, merge, composite].map(|s| s.div_ceil(budget) as u32));
+        // A keyed run's worst case: every comparison a tie that loads two nodes again, and every
+        // node loaded again to composite it.
+        let compares = 31 * 34 / 2;
+        let load = SWEEP_LOAD_STEPS as u64;
+        assert_eq!(PLAIN.run(), load * 33 + compares * (1 + 2 * load) + 32 * (SWEEP_LINK_STEPS as u64).max(3) + 32 * load);
+    }
+
+    #[test]
+    fn runs_that_shade_at_resolve_keep_whole_fragments_and_cost_no_reloads() {
+        let shaded = StepCosts { samples: 1, frag: 12, run: RUN as u64 };
+        assert!(PLAIN.keyed() && !shaded.keyed());
+        let compares = 31 * 34 / 2;
+        assert_eq!(shaded.run(), (SWEEP_LOAD_STEPS as u64 + 12) * 33 + compares + 32 * 3);
+    }
 }
