@@ -658,7 +658,7 @@ impl Renderer {
 
     /// Writes the frame uniform for `camera` and the screen tile `tile`.
     fn set_uniform(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3], tile: Tile) {
-        let lighting = Lighting::new(&self.lights.0, self.lights.1, camera);
+        let lighting = Lighting::new(&self.lights.0, self.lights.1, camera.view_direction());
         let mut lights = [GpuLight::default(); MAX_LIGHTS as usize];
         for (g, (l, radiance)) in lights.iter_mut().zip(&lighting.lights) {
             g.to_light = l.as_vec3().extend(0.0).to_array();

@@ -155,7 +155,7 @@ impl Scene {
     /// Lights (L, radiance) and ambient under `camera`: the scene's lights, or one white
     /// headlight travelling along the view direction when it has none.
     pub fn lighting(&self, camera: &Camera) -> Lighting {
-        Lighting::new(&self.lights, self.ambient, camera)
+        Lighting::new(&self.lights, self.ambient, camera.view_direction())
     }
 
     pub fn add_mesh(&mut self, mesh: Mesh) -> usize {
@@ -212,6 +212,12 @@ impl Camera {
             return Err(invalid!("camera matrix is singular (determinant {det:e}): build it with Camera.look_at or Camera.orthographic"));
         }
         Ok(Self { view_proj })
+    }
+
+    /// The unit direction the view looks along: its middle ray, from near to far.
+    pub fn view_direction(&self) -> glam::DVec3 {
+        let (near, far) = self.unproject_segment(&self.view_proj.inverse(), 0.0, 0.0);
+        (far - near).normalize()
     }
 
     pub fn matrix_f32(&self) -> Mat4 {

@@ -6,7 +6,6 @@
 use glam::{DVec2, DVec3, DVec4};
 
 use crate::error::{invalid, Result};
-use crate::scene::Camera;
 
 /// The most directional lights a scene holds (the frame uniform's light array).
 pub const MAX_LIGHTS: u32 = 8;
@@ -215,15 +214,11 @@ pub struct Lighting {
 }
 
 impl Lighting {
-    /// `lights` (or, when there are none, one white headlight travelling along the view
-    /// direction: the ray through the middle of the view) and `ambient` under `camera`.
-    pub fn new(lights: &[Light], ambient: [f32; 3], camera: &Camera) -> Self {
-        let lights = if lights.is_empty() {
-            let (near, far) = camera.unproject_segment(&camera.view_proj.inverse(), 0.0, 0.0);
-            vec![(-(far - near).normalize(), DVec3::ONE)]
-        } else {
-            lights.iter().map(|l| l.to_light_radiance()).collect()
-        };
+    /// `lights` (or, when there are none, one white headlight travelling along `view`, the
+    /// unit direction of the ray through the middle of the view: `Camera::view_direction`) and
+    /// `ambient`.
+    pub fn new(lights: &[Light], ambient: [f32; 3], view: DVec3) -> Self {
+        let lights = if lights.is_empty() { vec![(-view, DVec3::ONE)] } else { lights.iter().map(|l| l.to_light_radiance()).collect() };
         Self { lights, ambient: DVec3::from(ambient.map(|x| x as f64)) }
     }
 }
