@@ -84,7 +84,9 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                          f"baseline in {BASELINE.name} (floor.csv, floor.md); exits 1 when a ratio grew by more than "
                          f"{GROWTH:.0%}")
     ap.add_argument("--update-baseline", action="store_true",
-                    help="--peers-floor: keep this run's ratios as the new baseline (after a change that is meant to cost time)")
+                    help="--peers-floor: keep this run's ratios as the new baseline (after a change that is meant to cost "
+                         "time); it is the package's file, so run from an editable install (scripts/dev-install.sh) "
+                         "to change the repository's")
     ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
                     help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
 

@@ -8,7 +8,8 @@ cameras of `oit.scenes.hair()`, `foliage()` and `glass()` as they were when the 
 builders change. Unlit rows draw the vertex colors (pygfx `MeshBasicMaterial`); lit rows add the
 normals, one directional light and an ambient term (pygfx `MeshPhongMaterial`). Times are wall
 times of a render and its readback (ours: `Renderer.render`, whose frame holds the image;
-pygfx: `render` + `snapshot`), medians of renders that alternate between the two libraries.
+pygfx: `render` + `snapshot`), medians of renders that alternate between the two libraries;
+the ratio is the median of each render's ratio to the peer render taken right after it.
 Milliseconds move by a third from run to run on a shared machine; ratios taken in one run move
 far less, so the baseline keeps ratios, and a row whose ratio grew by more than GROWTH is
 flagged."""
@@ -176,7 +177,9 @@ def _floor_row(renderer: Renderer, peer: peers.PygfxRenderer, built: scene_lib.B
             gpus.append(gpu)
         peer_walls.append(peer.render(built, mode)[1])
     ours_ms, peer_ms = statistics.median(walls), statistics.median(peer_walls)
-    ratio = ours_ms / peer_ms
+    # The median of each render's ratio to the peer's render right after it: the machine's
+    # speed drifts over seconds, and a pair taken together shares the drift.
+    ratio = statistics.median(w / p for w, p in zip(walls, peer_walls))
     key = row_key(name, shading, method)
     target = TARGETS.get((name, method))
     old = base.get(key)
