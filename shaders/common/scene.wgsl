@@ -11,13 +11,11 @@ struct FrameUniform {
     tile_origin: vec2<u32>,
     tile_size: vec2<u32>,
     // Shading (common/shading.wgsl): the inverse view-projection for a pixel's eye direction,
-    // ambient RGB (w = 0, the factor of the shading-cost loop's result), then x = whether any
-    // mesh is shaded, y = the light count, z = the shading-cost loop count: the same numbers as
-    // the constants SHADED, LIGHTS and SHADING_COST the pipelines are compiled with, which the
-    // shaders use instead (loop bounds the compiler knows).
+    // ambient RGB (w = 0, the factor of the shading-cost loop's result), the lights. Whether a
+    // mesh is shaded, the light count and the shading-cost loop count are the constants SHADED,
+    // LIGHTS and SHADING_COST the pipelines are compiled with (loop bounds the compiler knows).
     inv_view_proj: mat4x4<f32>,
     ambient: vec4<f32>,
-    shading: vec4<u32>,
     lights: array<Light, MAX_LIGHTS>,
 }
 

@@ -19,9 +19,6 @@ pub struct FrameUniform {
     pub inv_view_proj: [[f32; 4]; 4],
     /// Ambient RGB; w is 0, a factor the shading-cost loop's result is multiplied by.
     pub ambient: [f32; 4],
-    /// Whether any mesh is shaded (0: every fragment keeps its vertex color), the light
-    /// count, the shading-cost loop count, unused.
-    pub shading: [u32; 4],
     pub lights: [GpuLight; crate::shading::MAX_LIGHTS as usize],
 }
 

@@ -647,8 +647,12 @@ impl Renderer {
     /// What `scene`'s passes compile for: its surfaces, its light count (the headlight when it
     /// has none) and the shading-cost knob.
     fn variant(&self, scene: &GpuScene) -> SceneVariant {
-        let lights = if self.lights.0.is_empty() { 1 } else { self.lights.0.len() as u32 };
-        SceneVariant { shaded: scene.shaded, lights, textured: scene.textured, shading_cost: self.shading_cost }
+        SceneVariant {
+            shaded: scene.shaded,
+            lights: Lighting::count(&self.lights.0),
+            textured: scene.textured,
+            shading_cost: self.shading_cost,
+        }
     }
 
     /// Writes the frame uniform for `camera`.
@@ -675,7 +679,6 @@ impl Renderer {
             tile_size: [tile.width, tile.height],
             inv_view_proj: camera.view_proj.inverse().as_mat4().to_cols_array_2d(),
             ambient: [a.x, a.y, a.z, 0.0],
-            shading: [scene.shaded as u32, lighting.lights.len() as u32, self.shading_cost, 0],
             lights,
         };
         self.gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));

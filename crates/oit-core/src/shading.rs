@@ -214,6 +214,11 @@ pub struct Lighting {
 }
 
 impl Lighting {
+    /// How many lights `new` gives for `lights`: them, or the headlight alone.
+    pub fn count(lights: &[Light]) -> u32 {
+        lights.len().max(1) as u32
+    }
+
     /// `lights` (or, when there are none, one white headlight travelling along `view`, the
     /// unit direction of the ray through the middle of the view: `Camera::view_direction`) and
     /// `ambient`.

@@ -64,15 +64,12 @@ impl Footprint {
 /// is cut into runs of pixels. Fails only where one pixel alone does not fit.
 pub fn plan(width: u32, height: u32, counts: &[u32], fp: &Footprint) -> Result<Vec<Tile>> {
     // No census (a method that keeps nothing per fragment): every pixel counts as empty.
-    let zeros;
-    let counts = match counts.is_empty() {
-        true if fp.per_fragment == 0 => {
-            zeros = vec![0u32; width as usize * height as usize];
-            &zeros[..]
-        }
-        _ => counts,
+    assert!(!counts.is_empty() || fp.per_fragment == 0, "a footprint with per-fragment storage is planned from the census");
+    let count = |i: u32| counts.get(i as usize).map_or(0, |&c| c as u64);
+    let row_fragments: Vec<u64> = match counts.is_empty() {
+        true => vec![0; height as usize],
+        false => counts.chunks(width as usize).map(|r| r.iter().map(|&c| c as u64).sum()).collect(),
     };
-    let row_fragments: Vec<u64> = counts.chunks(width as usize).map(|r| r.iter().map(|&c| c as u64).sum()).collect();
     if fp.fits(width as u64 * height as u64, row_fragments.iter().sum()) {
         return Ok(vec![Tile::frame(width, height)]);
     }
@@ -90,16 +87,16 @@ pub fn plan(width: u32, height: u32, counts: &[u32], fp: &Footprint) -> Result<V
             continue;
         }
         // One row does not fit: runs of pixels along it.
-        let row = &counts[(y * width) as usize..((y + 1) * width) as usize];
+        let at = |x: u32| count(y * width + x);
         let mut x = 0;
         while x < width {
             let (mut n, mut fragments) = (0u32, 0u64);
-            while x + n < width && fp.fits(n as u64 + 1, fragments + row[(x + n) as usize] as u64) {
-                fragments += row[(x + n) as usize] as u64;
+            while x + n < width && fp.fits(n as u64 + 1, fragments + at(x + n)) {
+                fragments += at(x + n);
                 n += 1;
             }
             if n == 0 {
-                let c = row[x as usize] as u64;
+                let c = at(x);
                 return Err(OitError::OutOfMemory(format!(
                     "pixel ({x}, {y}) has {c} transparent fragments, more than one tile can hold ({} bytes of storage, at most \
                      {} fragments a tile on this adapter and budget): raise memory_budget or use a bounded method (e.g. hybrid)",

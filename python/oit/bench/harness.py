@@ -157,6 +157,13 @@ def census_count(value: int | None) -> float:
     return math.nan if value is None else value
 
 
+def scene_counts(stats: dict, exact_stats: dict | None) -> dict[str, float]:
+    """A row's `fragments` and `max_depth`: the frame's census, or for a method that ran none
+    (and was timed without one) the scene's, from its exact frame's; NaN without either."""
+    counted = stats if stats["census"] or exact_stats is None else exact_stats
+    return {"fragments": census_count(counted["fragments"]), "max_depth": census_count(counted["max_depth_complexity"])}
+
+
 def mean_rgb_distance(a: np.ndarray, b: np.ndarray) -> float:
     """Mean over pixels of the RGB distance between two images."""
     return float(np.sqrt(((a[..., :3].astype(np.float64) - b[..., :3]) ** 2).sum(-1)).mean())

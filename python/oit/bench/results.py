@@ -26,12 +26,12 @@ from .harness import (
     Params,
     Progress,
     Result,
-    census_count,
     flip_missing,
     format_params,
     image_errors,
     medians,
     method_plan,
+    scene_counts,
     scene_jobs,
     timed,
 )
@@ -110,11 +110,9 @@ def _run_scene(result: Result, scene_name: str, built: scene_lib.BuiltScene, ren
             continue
         s = frame.stats
         formula = memory_bytes(method, w, h, **params)
-        # Methods that run no census are timed without one; their fragments are the scene's.
-        counted = s if s["census"] or exact is None else exact_frame.stats
         row = _row(scene_name, size, method, params, **medians(gpu, wall), memory_mib=s["memory_bytes"] / 2 ** 20,
-                   formula_mib=math.nan if formula is None else formula / 2 ** 20, fragments=census_count(counted["fragments"]),
-                   max_depth=census_count(counted["max_depth_complexity"]), overflow=s["overflow_fragments"], adapter=adapter)
+                   formula_mib=math.nan if formula is None else formula / 2 ** 20,
+                   **scene_counts(s, None if exact is None else exact_frame.stats), overflow=s["overflow_fragments"], adapter=adapter)
         if exact is not None:
             row.update(image_errors(frame.image, exact, covered))
             if is_default:

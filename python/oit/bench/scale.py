@@ -21,7 +21,7 @@ import numpy as np
 from .. import scenes as scene_lib
 from .._api import Renderer
 from .._api import methods as list_methods
-from .harness import QUICK_SCENE_ARGS, Progress, Result, census_count, image_errors, markdown, medians, timed, write_csv, write_tables
+from .harness import QUICK_SCENE_ARGS, Progress, Result, image_errors, markdown, medians, scene_counts, timed, write_csv, write_tables
 
 SCALE_METHODS = ("unsorted", "abuffer", "hybrid", "hybrid64", "auto", "wboit", "stochastic")
 SWEEPS = ("resolution", "triangles", "depth")
@@ -149,12 +149,9 @@ def scale(sweeps: Sequence[str] = SWEEPS, methods: Sequence[str] | None = None,
             s = frame.stats
             if m == "abuffer":
                 exact = frame
-            # Methods that run no census are timed without one; their fragments are the scene's.
-            counted = s if s["census"] or exact is None else exact.stats
             row = _row(p, m, triangles=triangles, **medians(gpu, wall), memory_mib=s["memory_bytes"] / 2 ** 20,
                        peak_mib=s["peak_memory_bytes"] / 2 ** 20, tiles=s["tiles"], chunks=s["geometry_chunks"],
-                       fragments=census_count(counted["fragments"]), max_depth=census_count(counted["max_depth_complexity"]),
-                       adapter=s["adapter"])
+                       **scene_counts(s, None if exact is None else exact.stats), adapter=s["adapter"])
             if exact is not None:
                 row["mean_err"] = image_errors(frame.image, exact.image, exact.depth_complexity > 0, flip=False)["mean_err"]
             result.rows.append(row)
