@@ -8,6 +8,10 @@ struct Alloc {
     // Fragments a method could not place where its allocation said (pall: outside the
     // triangle's bound); any is an error the host reports.
     escaped: atomic<u32>,
+    // The sorted resolve's deep pixels (common/sweep.wgsl): how many, and the workgroups of
+    // the dispatches over them (copied to the indirect dispatches' arguments).
+    deep: atomic<u32>,
+    deep_groups: array<u32, 3>,
     pad: u32,
 }
 

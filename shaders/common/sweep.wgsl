@@ -125,11 +125,10 @@ fn save_acc(px: u32, c: Acc) {
 
 // A run of up to RUN fragments in a local array. Where KEYED (the node's fragment costs nothing
 // beyond its load) an entry is a sort key, the fragment's depth bits and node link: 8 bytes,
-// not the fragment's 24, and the array is zeroed at every invocation and its entries move in
-// the sort. Equal depths, which are rare, are ordered by the whole fragment (frag_less) from
-// their nodes, loaded again; the composite loads each node once more. Methods that shade at
-// resolve (FRAG_STEPS > 0: compact_abuffer) keep whole fragments (KEYED = 0), since loading
-// one again would shade it again.
+// not the fragment's 24. Keys are sorted by (depth, link), then equal depths, which are rare,
+// are put in frag_less's order from their nodes, loaded again; the composite loads each node
+// once more. Methods that shade at resolve (FRAG_STEPS > 0: compact_abuffer) keep whole
+// fragments (KEYED = 0), since loading one again would shade it again.
 //!if KEYED
 alias Entry = vec2<u32>;
 
@@ -137,14 +136,23 @@ fn entry(w: Walked, link: u32) -> Entry {
     return vec2<u32>(bitcast<u32>(w.frag.depth), link);
 }
 
-// Whether entry a sorts before entry b (frag_less's order); `steps` grows by a tie's loads.
+// The keys' own order: depth, then node link.
+fn key_less(a: Entry, b: Entry) -> bool {
+    let da = bitcast<f32>(a.x);
+    let db = bitcast<f32>(b.x);
+    return da < db || (da == db && a.y < b.y);
+}
+
+// frag_less's order: the keys', loading both nodes for equal depths. Counts each comparison in
+// `steps` as one with the loads (a lane without the tie loads nothing, but llvmpipe's loop
+// limiter cannot tell).
 fn entry_less(a: Entry, b: Entry, px: u32, steps: ptr<function, u32>) -> bool {
+    *steps += 2u * LOAD_STEPS;
     let da = bitcast<f32>(a.x);
     let db = bitcast<f32>(b.x);
     if da != db {
         return da < db;
     }
-    *steps += 2u * LOAD_STEPS;
     return frag_less(walk(a.y, px).frag, walk(b.y, px).frag);
 }
 
@@ -162,6 +170,10 @@ fn entry(w: Walked, link: u32) -> Entry {
     return w.frag;
 }
 
+fn key_less(a: Entry, b: Entry) -> bool {
+    return frag_less(a, b);
+}
+
 fn entry_less(a: Entry, b: Entry, px: u32, steps: ptr<function, u32>) -> bool {
     return frag_less(a, b);
 }
@@ -175,14 +187,118 @@ fn entry_frag(e: Entry, px: u32) -> Frag {
 }
 //!endif
 
+// The run's array has two halves, which the merges alternate between (one, where a run is one
+// block); RUN is a power of two, at least BLOCK.
+const RUN_SLOTS: u32 = select(2u * RUN, RUN, RUN == BLOCK);
+// Entries sorted by insertion before the merges.
+const BLOCK: u32 = 8u;
+
 struct Run {
-    entries: array<Entry, RUN>,
+    entries: array<Entry, RUN_SLOTS>,
     n: u32,
     // The node after the run (0: the list ended).
     next: u32,
 }
 
-// Loads the run starting at `link` and sorts it by insertion; `steps` grows by the work done.
+// Sorts entries lo..hi by insertion, in the keys' order or (`whole`) frag_less's; returns the
+// steps taken.
+fn insertion_sort(run: ptr<function, Run>, lo: u32, hi: u32, px: u32, whole: bool) -> u32 {
+    var steps = 0u;
+    for (var i = lo + 1u; i < hi; i++) {
+        let e = (*run).entries[i];
+        var j = i;
+        while j > lo && before(e, (*run).entries[j - 1u], px, &steps, whole) {
+            (*run).entries[j] = (*run).entries[j - 1u];
+            j--;
+        }
+        (*run).entries[j] = e;
+        steps += i - j + 1u;
+    }
+    return steps;
+}
+
+fn before(a: Entry, b: Entry, px: u32, steps: ptr<function, u32>, whole: bool) -> bool {
+    if whole {
+        return entry_less(a, b, px, steps);
+    }
+    return key_less(a, b);
+}
+
+// Sorts the first n entries in frag_less's order where a run is one block, by insertion;
+// otherwise in the keys' order: blocks of BLOCK by insertion, then merged bottom-up from one
+// half of the array into the other (O(n log n), where insertion alone takes O(n^2) on the deep
+// pixels that set a SIMD group's pace), and order_ties finishes. Returns the steps taken.
+fn sort_keys(run: ptr<function, Run>, n: u32, px: u32) -> u32 {
+    if RUN == BLOCK {
+        return insertion_sort(run, 0u, n, px, true);
+    }
+    var steps = 0u;
+    for (var lo = 0u; lo < n; lo += BLOCK) {
+        steps += 1u + insertion_sort(run, lo, min(lo + BLOCK, n), px, false);
+    }
+    var src = 0u;
+    for (var width = BLOCK; width < n; width *= 2u) {
+        let dst = RUN - src;
+        for (var lo = 0u; lo < n; lo += 2u * width) {
+            let mid = min(lo + width, n);
+            let hi = min(lo + 2u * width, n);
+            var a = lo;
+            var b = mid;
+            for (var k = lo; k < hi; k++) {
+                let take_b = b < hi && (a >= mid || key_less((*run).entries[src + b], (*run).entries[src + a]));
+                (*run).entries[dst + k] = (*run).entries[select(src + a, src + b, take_b)];
+                a += select(1u, 0u, take_b);
+                b += select(0u, 1u, take_b);
+            }
+            steps += 1u + hi - lo;
+        }
+        src = dst;
+        steps += 1u;
+    }
+    if src != 0u {
+        for (var k = 0u; k < n; k++) {
+            (*run).entries[k] = (*run).entries[src + k];
+        }
+        steps += n;
+    }
+    return steps;
+}
+
+//!if KEYED
+// Puts entries of equal depth, which sort_keys left in link order, in frag_less's order, by
+// insertion: on entries sorted by depth, one comparison of keys an entry outside runs of equal
+// depth. Nodes are loaded only for equal depths (the entry being placed once), so that lanes
+// without ties load nothing. Returns the steps taken.
+fn order_ties(run: ptr<function, Run>, n: u32, px: u32) -> u32 {
+    var steps = 0u;
+    for (var i = 1u; i < n; i++) {
+        let e = (*run).entries[i];
+        var fe: Frag;
+        var loaded = false;
+        var j = i;
+        while j > 0u {
+            let p = (*run).entries[j - 1u];
+            if bitcast<f32>(p.x) != bitcast<f32>(e.x) {
+                break;
+            }
+            if !loaded {
+                fe = walk(e.y, px).frag;
+                loaded = true;
+            }
+            if !frag_less(fe, walk(p.y, px).frag) {
+                break;
+            }
+            (*run).entries[j] = p;
+            j--;
+        }
+        (*run).entries[j] = e;
+        steps += LOAD_STEPS + (i - j + 1u) * (1u + LOAD_STEPS);
+    }
+    return steps;
+}
+//!endif
+
+// Loads the run starting at `link` and sorts it; `steps` grows by the work done.
 fn load_run(link: u32, px: u32, run: ptr<function, Run>, steps: ptr<function, u32>) {
     var n = 0u;
     var at = link;
@@ -192,20 +308,15 @@ fn load_run(link: u32, px: u32, run: ptr<function, Run>, steps: ptr<function, u3
         at = w.next;
         n++;
     }
-    var shifts = 0u;
-    for (var i = 1u; i < n; i++) {
-        let e = (*run).entries[i];
-        var j = i;
-        while j > 0u && entry_less(e, (*run).entries[j - 1u], px, steps) {
-            (*run).entries[j] = (*run).entries[j - 1u];
-            j--;
-        }
-        (*run).entries[j] = e;
-        shifts += i - j + 1u;
+    var sorting = sort_keys(run, n, px);
+//!if KEYED
+    if RUN > BLOCK {
+        sorting += order_ties(run, n, px);
     }
+//!endif
     (*run).n = n;
     (*run).next = at;
-    *steps += LOAD_STEPS * (n + 1u) + shifts;
+    *steps += LOAD_STEPS * (n + 1u) + sorting;
 }
 
 // A deep pixel's progress between dispatches, in registers.
@@ -368,8 +479,19 @@ fn save_sweep(s: Sweep) {
     }
 }
 
+// The deep pixels' list, after the per-pixel state: one pixel index an entry, appended by
+// cs_sort, so that the later phases run over the pixels that have work left, not the frame
+// (llvmpipe runs a shader's code for every SIMD group, lanes that have returned included).
+fn deep_list_at() -> u32 {
+    return frame.tile_size.x * frame.tile_size.y * STATE_WORDS;
+}
+
+// Workgroups of DEEP_GROUP invocations for the deep phases: at most 65,535 in x, then rows.
+const DEEP_GROUP: u32 = 64u;
+
 // The first dispatch: every pixel sorts its first run. A list of one run (most pixels) is
-// composited and done; a longer one keeps the run, relinked, and goes on to cs_runs.
+// composited and done; a longer one keeps the run, relinked, goes on to cs_runs and joins the
+// deep list.
 @compute @workgroup_size(8, 8)
 fn cs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = compute_pixel(gid);
@@ -392,23 +514,39 @@ fn cs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
         s.px = px;
         link_run(&s, &run, &steps);
         save_sweep(s);
+        state[deep_list_at() + atomicAdd(&alloc.deep, 1u)] = px;
     }
     save_acc(px, c);
+}
+
+// The workgroups of the deep phases' indirect dispatches, from the deep list's length.
+@compute @workgroup_size(1)
+fn cs_deep_groups() {
+    let groups = (atomicLoad(&alloc.deep) + DEEP_GROUP - 1u) / DEEP_GROUP;
+    let x = min(groups, 65535u);
+    alloc.deep_groups[0] = x;
+    alloc.deep_groups[1] = select(0u, (groups + x - 1u) / max(x, 1u), groups > 0u);
+    alloc.deep_groups[2] = 1u;
 }
 
 // The deeper pixels, one phase an entry point so that each dispatch runs one tight loop:
 // their further runs, then their merge passes, then their composite, STEP_BUDGET steps a
 // dispatch. The host dispatches each enough times for the deepest pixel
-// (oit_core::method::lists::resolve_dispatches); a pixel in another phase returns at once.
+// (oit_core::method::lists::resolve_dispatches), over the deep list; a pixel in another phase
+// returns at once.
 fn resume(gid: vec3<u32>, phase: u32) -> u32 {
-    let px = compute_pixel(gid);
-    if px == OUTSIDE || (state[px * STATE_WORDS + S_PHASE] & 0xfu) != phase {
+    let i = gid.y * alloc.deep_groups[0] * DEEP_GROUP + gid.x;
+    if i >= atomicLoad(&alloc.deep) {
+        return OUTSIDE;
+    }
+    let px = state[deep_list_at() + i];
+    if (state[px * STATE_WORDS + S_PHASE] & 0xfu) != phase {
         return OUTSIDE;
     }
     return px;
 }
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(DEEP_GROUP)
 fn cs_runs(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = resume(gid, RUNS);
     if px == OUTSIDE {
@@ -424,7 +562,7 @@ fn cs_runs(@builtin(global_invocation_id) gid: vec3<u32>) {
     save_sweep(s);
 }
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(DEEP_GROUP)
 fn cs_merge(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = resume(gid, MERGE);
     if px == OUTSIDE {
@@ -439,7 +577,7 @@ fn cs_merge(@builtin(global_invocation_id) gid: vec3<u32>) {
     save_sweep(s);
 }
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(DEEP_GROUP)
 fn cs_composite(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = resume(gid, COMPOSITE);
     if px == OUTSIDE {

@@ -77,12 +77,20 @@ pub struct PrimNode {
 
 /// Mirrors `Alloc` in `shaders/common/pool.wgsl`.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct Alloc {
     pub count: u32,
     pub capacity: u32,
     pub escaped: u32,
+    /// The sorted resolve's deep pixels and the workgroups of the dispatches over them.
+    pub deep: u32,
+    pub deep_groups: [u32; 3],
     pub pad: u32,
+}
+
+impl Alloc {
+    /// Bytes before `deep_groups`: where the indirect dispatches' arguments are copied from.
+    pub const DEEP_GROUPS_OFFSET: u64 = 16;
 }
 
 /// Mirrors `Node` in `shaders/compact_abuffer.wgsl`: depth, next link, triangle index.

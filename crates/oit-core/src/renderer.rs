@@ -590,7 +590,7 @@ impl Renderer {
             Tiling::Storage { per_pixel, per_fragment, per_triangle } => {
                 // A coverage-mask frame keeps sweep state per sample and a mask per node.
                 let (per_pixel, per_fragment) = if coverage {
-                    (4 + 4 * crate::method::lists::state_words(COVERAGE_SAMPLES), per_fragment + 8)
+                    (crate::method::lists::pixel_bytes(COVERAGE_SAMPLES), per_fragment + 8)
                 } else {
                     (per_pixel, per_fragment)
                 };

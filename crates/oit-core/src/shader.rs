@@ -12,7 +12,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("NODES_PER_BINDING", 1 << 20),
     Const::U32("POOL_SPLIT", 4),
     Const::U32("BATCH", 32),
-    Const::U32("RUN", 32),
+    Const::U32("RUN", 128),
     Const::U32("STEP_BUDGET", 32_768),
     Const::U32("FRAG_STEPS", 0),
     Const::U32("KEYED", 1),

@@ -176,7 +176,13 @@ impl<'a> FrameCtx<'a> {
     /// Binds the shared groups, `own` and `pipeline` to `pass` and dispatches one invocation
     /// per pixel (8 x 8 workgroups).
     pub fn bind_dispatch(&self, pass: &mut wgpu::ComputePass<'_>, pipeline: &wgpu::ComputePipeline, own: &wgpu::BindGroup) {
-        per_pixel_dispatch(pass, self.scene, self.targets_group(), self.tile, pipeline, own);
+        self.bind_dispatch_with(pass, pipeline, own, Dispatch::Pixels);
+    }
+
+    /// Records a dispatch of `pipeline` with the shared groups and `own` bound, of the
+    /// workgroups `dispatch` says.
+    pub fn bind_dispatch_with(&self, pass: &mut wgpu::ComputePass<'_>, pipeline: &wgpu::ComputePipeline, own: &wgpu::BindGroup, dispatch: Dispatch<'_>) {
+        record_dispatch(pass, self.scene, self.targets_group(), self.tile, pipeline, own, dispatch);
     }
 
     /// Records a full-screen pass of `pipeline` into the output (and the error bound, with
@@ -229,7 +235,7 @@ impl<'a> FrameCtx<'a> {
         let (tile, targets, scene) = (self.tile, self.targets_group(), self.scene);
         let timestamp_writes = self.timer.compute_pass(label);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
-        per_pixel_dispatch(&mut pass, scene, targets, tile, pipeline, own);
+        record_dispatch(&mut pass, scene, targets, tile, pipeline, own, Dispatch::Pixels);
     }
 
     pub fn encoder(&self) -> wgpu::CommandEncoder {
@@ -262,19 +268,35 @@ fn capture_pass(
     scene.transparent.draw_all(&mut pass);
 }
 
-fn per_pixel_dispatch(
+/// The workgroups of a compute dispatch.
+pub enum Dispatch<'a> {
+    /// An invocation a pixel of the tile, in workgroups of 8 × 8.
+    Pixels,
+    /// One workgroup.
+    One,
+    /// The three workgroup counts a buffer holds, written by an earlier pass.
+    Indirect(&'a wgpu::Buffer),
+}
+
+#[allow(clippy::too_many_arguments)]
+fn record_dispatch(
     pass: &mut wgpu::ComputePass<'_>,
     scene: &GpuScene,
     targets: &wgpu::BindGroup,
     tile: Tile,
     pipeline: &wgpu::ComputePipeline,
     own: &wgpu::BindGroup,
+    dispatch: Dispatch<'_>,
 ) {
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, scene.transparent.group(), &[]);
     pass.set_bind_group(1, targets, &[]);
     pass.set_bind_group(2, own, &[]);
-    pass.dispatch_workgroups(tile.width.div_ceil(8), tile.height.div_ceil(8), 1);
+    match dispatch {
+        Dispatch::Pixels => pass.dispatch_workgroups(tile.width.div_ceil(8), tile.height.div_ceil(8), 1),
+        Dispatch::One => pass.dispatch_workgroups(1, 1, 1),
+        Dispatch::Indirect(args) => pass.dispatch_workgroups_indirect(args, 0),
+    }
 }
 
 impl FrameCtx<'_> {

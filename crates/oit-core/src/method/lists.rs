@@ -3,7 +3,7 @@
 //! resolve. The pool follows the scene: it grows to the counted fragments and the frame is
 //! rendered again when the atomic counter says the pool overflowed (docs/methods.md).
 
-use super::frame::{FrameCtx, Limits, MethodReport};
+use super::frame::{Dispatch, FrameCtx, Limits, MethodReport};
 use crate::cache::{Layout, ShaderKey};
 use crate::consts::{SWEEP_COMPOSITE_STEPS, SWEEP_LINK_STEPS, SWEEP_LOAD_STEPS, SWEEP_MERGE_STEPS};
 use crate::context::GpuContext;
@@ -18,19 +18,27 @@ pub const POOL_BINDINGS: u64 = 4;
 /// Fragments the submission-order replays select per sweep (shaders/common/select.wgsl).
 pub const BATCH: u32 = 32;
 /// Fragments the exact resolve sorts in a local array at most (shaders/common/sweep.wgsl):
-/// a list no longer takes one walk; a longer one is sorted in runs of RUN, then merged.
-pub const RUN: u32 = 32;
+/// a list no longer takes one walk; a longer one is sorted in runs of RUN, then merged by
+/// relinking its nodes. 128 keeps all but the deepest pixels of hair in one walk (the relinking
+/// merges cost far more a node than the local ones); the array holds twice RUN entries of 8
+/// bytes (24 where the runs hold whole fragments).
+pub const RUN: u32 = 128;
+/// The shortest run, sorted by insertion before the local merges (BLOCK in sweep.wgsl).
+pub const BLOCK: u64 = 8;
 
-/// The local array of a frame whose deepest pixel has n fragments: the smallest of 8, 16
-/// and RUN that holds it (a smaller array is cheaper to sort and to keep).
+/// The local array of a frame whose deepest pixel has n fragments: the smallest power of two
+/// from BLOCK to RUN that holds it (a smaller array is cheaper to keep: it is zeroed at every
+/// invocation).
 pub fn run_length(n: u64) -> u32 {
-    (n.next_power_of_two() as u32).clamp(8, RUN)
+    (n.next_power_of_two() as u32).clamp(BLOCK as u32, RUN)
 }
 
 /// The pool's group: heads, allocator, the pool bindings, sweep state and binding 7.
 const POOL_LAYOUT: Layout = Layout::Storage(4 + POOL_BINDINGS as u32);
 
 const ALLOC_BYTES: u64 = std::mem::size_of::<Alloc>() as u64;
+/// The deep phases' indirect dispatch arguments (x, y, z workgroups).
+const DEEP_ARGS_BYTES: u64 = 12;
 
 /// What a list method keeps at binding 7 besides its pool.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,6 +63,8 @@ pub(crate) struct NodePool {
     /// Per-pixel state carried between resolve sweeps (binding 6).
     state: wgpu::Buffer,
     pub state_words: u64,
+    /// The deep phases' indirect dispatch arguments, copied from the allocator.
+    deep_args: wgpu::Buffer,
     /// Binding 7: per-triangle data of the allocation pass, or per-pixel offsets.
     pub aux: wgpu::Buffer,
     aux_kind: Aux,
@@ -85,6 +95,12 @@ impl NodePool {
             pools: Vec::new(),
             state: storage_buffer(d, "sweep state", 4, wgpu::BufferUsages::empty()),
             state_words,
+            deep_args: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("deep dispatch args"),
+                size: DEEP_ARGS_BYTES,
+                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
             aux: storage_buffer(d, "list aux", 4, wgpu::BufferUsages::empty()),
             aux_kind,
             aux_len: 0,
@@ -104,8 +120,14 @@ impl NodePool {
         self.nodes_per_binding * POOL_BINDINGS
     }
 
+    /// Words of the state buffer a pixel: its sweep state and, with one, its deep-list entry.
+    pub fn state_len(&self) -> u64 {
+        self.state_words + (self.state_words > 0) as u64
+    }
+
     pub fn bytes(&self) -> u64 {
-        self.capacity * self.node_bytes + self.pixels * (4 + 4 * self.state_words) + self.aux_len + ALLOC_BYTES
+        let args = if self.state_words > 0 { DEEP_ARGS_BYTES } else { 0 };
+        self.capacity * self.node_bytes + self.pixels * 4 * (1 + self.state_len()) + self.aux_len + ALLOC_BYTES + args
     }
 
     /// Makes room for `nodes` nodes, `pixels` heads and `triangles` per-triangle records,
@@ -125,7 +147,7 @@ impl NodePool {
         let mut changed = self.group.is_none();
         if pixels != self.pixels {
             self.heads = storage_buffer(d, "heads", pixels * 4, wgpu::BufferUsages::empty());
-            self.state = storage_buffer(d, "sweep state", pixels * 4 * self.state_words, wgpu::BufferUsages::empty());
+            self.state = storage_buffer(d, "sweep state", pixels * 4 * self.state_len(), wgpu::BufferUsages::empty());
             self.pixels = pixels;
             changed = true;
         }
@@ -178,7 +200,7 @@ impl NodePool {
     pub fn clear(&self, gpu: &GpuContext, enc: &mut wgpu::CommandEncoder) {
         enc.clear_buffer(&self.heads, 0, None);
         enc.clear_buffer(&self.state, 0, None);
-        let alloc = Alloc { count: 0, capacity: self.capacity.min(u32::MAX as u64) as u32, escaped: 0, pad: 0 };
+        let alloc = Alloc { capacity: self.capacity.min(u32::MAX as u64) as u32, ..Default::default() };
         gpu.queue.write_buffer(&self.alloc, 0, bytemuck::bytes_of(&alloc));
     }
 
@@ -212,8 +234,9 @@ struct Pipelines {
     allocate: Option<wgpu::ComputePipeline>,
     count: Option<wgpu::RenderPipeline>,
     capture: wgpu::RenderPipeline,
-    /// The sorted resolve's first dispatch, then the deeper pixels' runs, merges and composite.
-    sweep: Option<[wgpu::ComputePipeline; 4]>,
+    /// The sorted resolve's first dispatch, the deep list's workgroups, then the deeper
+    /// pixels' runs, merges and composite.
+    sweep: Option<[wgpu::ComputePipeline; 5]>,
     resolve: wgpu::RenderPipeline,
 }
 
@@ -285,7 +308,7 @@ impl ListMethod {
             allocate: matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate")),
             count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(&shader, "fs_count", POOL_LAYOUT)),
             capture: cx.capture_pipeline(&shader, "fs_capture", POOL_LAYOUT),
-            sweep: self.sweeps.map(|_| ["cs_sort", "cs_runs", "cs_merge", "cs_composite"].map(compute)),
+            sweep: self.sweeps.map(|_| ["cs_sort", "cs_deep_groups", "cs_runs", "cs_merge", "cs_composite"].map(compute)),
             resolve: cx.resolve_pipeline(&shader, "fs_resolve", POOL_LAYOUT, false),
         }
     }
@@ -320,7 +343,7 @@ impl ListMethod {
         let pixels = cx.pixels();
         cx.check_per_pixel(
             &format!("{} (its per-pixel heads and sweep state)", self.shader.trim_end_matches(".wgsl")),
-            4 * self.pool.state_words.max(1),
+            4 * self.pool.state_len().max(1),
         )?;
         // A tile of a larger frame gets a pool of its counted fragments, so that tiles planned
         // within a memory budget stay in it; a whole frame keeps the pool it has while it fits.
@@ -366,14 +389,22 @@ impl ListMethod {
             }
             cx.capture(&mut enc, "capture", &p.capture, group);
             self.pool.copy_count(&mut enc);
-            if let Some([sort, phases @ ..]) = &p.sweep {
+            if let Some([sort, deep_groups, phases @ ..]) = &p.sweep {
                 cx.dispatch(&mut enc, "sort", sort, group);
+                if sweeps.iter().any(|&n| n > 0) {
+                    // The later phases run over the deep list cs_sort wrote, not the frame.
+                    {
+                        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("deep list"), timestamp_writes: None });
+                        cx.bind_dispatch_with(&mut pass, deep_groups, group, Dispatch::One);
+                    }
+                    enc.copy_buffer_to_buffer(&self.pool.alloc, Alloc::DEEP_GROUPS_OFFSET, &self.pool.deep_args, 0, DEEP_ARGS_BYTES);
+                }
                 for ((label, pipeline), n) in ["runs", "merge", "composite"].into_iter().zip(phases).zip(sweeps) {
                     if n > 0 {
                         let timestamp_writes = cx.timer.compute_pass(label);
                         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
                         for _ in 0..n {
-                            cx.bind_dispatch(&mut pass, pipeline, group);
+                            cx.bind_dispatch_with(&mut pass, pipeline, group, Dispatch::Indirect(&self.pool.deep_args));
                         }
                     }
                 }
@@ -421,13 +452,19 @@ pub(crate) const fn state_words(samples: u32) -> u64 {
     12 + 4 * samples as u64
 }
 
-/// Bytes a pixel of a sorted-resolve method keeps besides its pool: its head and sweep state.
-pub(crate) const PIXEL_BYTES: u64 = 4 + 4 * STATE_WORDS;
+/// Bytes a pixel of a sorted-resolve method keeps besides its pool: its head, its sweep state
+/// and its entry of the deep list.
+pub(crate) const fn pixel_bytes(samples: u32) -> u64 {
+    4 + 4 * (state_words(samples) + 1)
+}
+
+pub(crate) const PIXEL_BYTES: u64 = pixel_bytes(1);
 
 /// What one step of the sorted resolve costs on llvmpipe's loop limiter (the constants of
 /// shaders/common/sweep.wgsl, which this mirrors): `frag` is what turning a node into a
 /// fragment adds (compact_abuffer shades it there: its lights and the shading-cost loop);
 /// `run` the fragments a run holds in this frame (RUN, or the deepest list when shorter).
+/// The array a run is sorted in is [`run_length`] of the deepest list.
 #[derive(Clone, Copy, Debug)]
 pub struct StepCosts {
     pub samples: u64,
@@ -453,14 +490,37 @@ impl StepCosts {
         self.frag == 0
     }
 
-    /// A run loaded, insertion-sorted and relinked or composited: the largest unit of work
-    /// between two checks of the budget. Keyed runs load two nodes again at each comparison of
-    /// equal depths, and each node again to composite it.
+    /// Steps of sweep.wgsl's `sort_keys` on n entries: the blocks' insertion sorts (at most
+    /// (BLOCK - 1)(BLOCK + 2) / 2 a block), then each merge level (a step a pair, an entry
+    /// and the level) and the copy back when the levels end in the upper half.
+    fn sort_keys(n: u64) -> u64 {
+        let blocks = n.div_ceil(BLOCK);
+        let full = (BLOCK - 1) * (BLOCK + 2) / 2;
+        let mut steps = blocks * (1 + full);
+        let (mut width, mut levels) = (BLOCK, 0);
+        while width < n {
+            steps += n + n.div_ceil(2 * width) + 1;
+            width *= 2;
+            levels += 1;
+        }
+        steps + if levels % 2 == 1 { n } else { 0 }
+    }
+
+    /// A run loaded, sorted and relinked or composited: the largest unit of work between two
+    /// checks of the budget. A run of one block is sorted by insertion in frag_less's order
+    /// (keyed: two nodes loaded at each comparison of equal depths); a longer one by its keys,
+    /// then keyed runs order equal depths by insertion, at worst every entry of the run at one
+    /// depth, a node loaded each comparison. Keyed runs load each node again to composite it.
     fn run(self) -> u64 {
         let run = self.run;
         let compares = run.saturating_sub(1) * (run + 2) / 2;
-        let (tie, again) = if self.keyed() { (2 * self.load(), self.load()) } else { (0, 0) };
-        self.load() * (run + 1) + compares * (1 + tie) + run * (Self::LINK.max(2 + self.samples) + again)
+        let keyed = self.keyed() as u64;
+        let sort = if run <= BLOCK {
+            compares * (1 + keyed * 2 * self.load())
+        } else {
+            Self::sort_keys(run) + keyed * (run.saturating_sub(1) * self.load() + compares * (1 + self.load()))
+        };
+        self.load() * (run + 1) + sort + run * (Self::LINK.max(2 + self.samples) + keyed * self.load())
     }
 
     fn largest_unit(self) -> u64 {
@@ -494,7 +554,7 @@ pub fn step_budget(gpu: &GpuContext, costs: StepCosts) -> Result<u64> {
 /// node and two a pair; the composite walk. Zero for a list of one run, which the first
 /// dispatch composites.
 pub fn resolve_steps(n: u64, costs: StepCosts) -> [u64; 3] {
-    let run = RUN as u64;
+    let run = run_length(n) as u64;
     if n <= run {
         return [0; 3];
     }
@@ -539,26 +599,60 @@ mod tests {
 
     #[test]
     fn deeper_lists_take_the_runs_merges_and_composite_the_shader_counts() {
-        // 100 fragments: 4 runs of 32 (3 after the first), 2 merge passes, 101 composite steps.
-        let n = 100;
+        // 300 fragments: 3 runs of 128 (2 after the first), 2 merge passes, 301 composite steps.
+        let n = 300;
         let [runs, merge, composite] = resolve_steps(n, PLAIN);
-        assert_eq!(runs, 3 * PLAIN.run());
-        assert_eq!(merge, 2 * (SWEEP_MERGE_STEPS as u64) * (2 * n + 2 * 4));
+        assert_eq!(runs, 2 * PLAIN.run());
+        assert_eq!(merge, 2 * (SWEEP_MERGE_STEPS as u64) * (2 * n + 2 * 3));
         assert_eq!(composite, (n + 1) * (SWEEP_COMPOSITE_STEPS as u64 + 1));
         let budget = 1000;
         assert_eq!(resolve_dispatches(n, PLAIN, budget), [runs, merge, composite].map(|s| s.div_ceil(budget) as u32));
-        // A keyed run's worst case: every comparison a tie that loads two nodes again, and every
-        // node loaded again to composite it.
-        let compares = 31 * 34 / 2;
+    }
+
+    #[test]
+    fn the_local_sort_counts_its_blocks_levels_and_copy() {
+        // 8 entries: one block of at most 35 shifts, no merge.
+        assert_eq!(StepCosts::sort_keys(8), 36);
+        // 20 entries: 3 blocks, then levels of width 8 (2 pairs) and 16 (1 pair), ending in
+        // the lower half (no copy).
+        assert_eq!(StepCosts::sort_keys(20), 3 * 36 + (20 + 2 + 1) + (20 + 1 + 1));
+        // 128 entries: 16 blocks, 4 levels (8, 16, 32, 64), no copy.
+        assert_eq!(StepCosts::sort_keys(128), 16 * 36 + (128 + 8 + 1) + (128 + 4 + 1) + (128 + 2 + 1) + (128 + 1 + 1));
+        // 64: 3 levels, so the result is copied back.
+        assert_eq!(StepCosts::sort_keys(64), 8 * 36 + (64 + 4 + 1) + (64 + 2 + 1) + (64 + 1 + 1) + 64);
+    }
+
+    #[test]
+    fn a_keyed_run_counts_its_worst_ties() {
+        // Every entry at one depth: the tie pass is a whole insertion sort, a node loaded each
+        // comparison, besides the entry's own load; and each node loaded again to composite it.
         let load = SWEEP_LOAD_STEPS as u64;
-        assert_eq!(PLAIN.run(), load * 33 + compares * (1 + 2 * load) + 32 * (SWEEP_LINK_STEPS as u64).max(3) + 32 * load);
+        let n = RUN as u64;
+        let compares = (n - 1) * (n + 2) / 2;
+        let ties = (n - 1) * load + compares * (1 + load);
+        assert_eq!(PLAIN.run(), load * (n + 1) + StepCosts::sort_keys(n) + ties + n * ((SWEEP_LINK_STEPS as u64).max(2 + 1) + load));
+        // A run of one block: one insertion sort, each comparison with the tie's two loads.
+        let short = StepCosts { run: BLOCK, ..PLAIN };
+        let compares = (BLOCK - 1) * (BLOCK + 2) / 2;
+        assert_eq!(short.run(), load * (BLOCK + 1) + compares * (1 + 2 * load) + BLOCK * (3 + load));
+        // The worst unit still leaves llvmpipe's limit room for more than one a dispatch.
+        assert!(PLAIN.largest_unit() < LLVMPIPE_LOOP_LIMIT / 2);
     }
 
     #[test]
     fn runs_that_shade_at_resolve_keep_whole_fragments_and_cost_no_reloads() {
         let shaded = StepCosts { samples: 1, frag: 12, run: RUN as u64 };
         assert!(PLAIN.keyed() && !shaded.keyed());
-        let compares = 31 * 34 / 2;
-        assert_eq!(shaded.run(), (SWEEP_LOAD_STEPS as u64 + 12) * 33 + compares + 32 * 3);
+        let n = RUN as u64;
+        assert_eq!(shaded.run(), (SWEEP_LOAD_STEPS as u64 + 12) * (n + 1) + StepCosts::sort_keys(n) + n * 3);
+    }
+
+    #[test]
+    fn the_array_is_the_smallest_power_of_two_that_holds_the_deepest_list() {
+        assert_eq!(run_length(1), BLOCK as u32);
+        assert_eq!(run_length(9), 16);
+        assert_eq!(run_length(46), 64);
+        assert_eq!(run_length(128), 128);
+        assert_eq!(run_length(388), RUN);
     }
 }
