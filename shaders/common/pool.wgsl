@@ -8,10 +8,12 @@ struct Alloc {
     // Fragments a method could not place where its allocation said (pall: outside the
     // triangle's bound); any is an error the host reports.
     escaped: atomic<u32>,
-    // The sorted resolve's deep pixels (common/sweep.wgsl): how many, and the workgroups of
-    // the dispatches over them (copied to the indirect dispatches' arguments).
+    // The sorted resolve's pixel lists (common/sweep.wgsl): pixels with fragments, and deep
+    // pixels, how many of each, and the workgroups of the dispatches over them (x, y, z for
+    // the first, then for the second; copied to the indirect dispatches' arguments).
+    listed: atomic<u32>,
     deep: atomic<u32>,
-    deep_groups: array<u32, 3>,
+    groups: array<u32, 6>,
     pad: u32,
 }
 

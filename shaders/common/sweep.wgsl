@@ -479,22 +479,63 @@ fn save_sweep(s: Sweep) {
     }
 }
 
-// The deep pixels' list, after the per-pixel state: one pixel index an entry, appended by
-// cs_sort, so that the later phases run over the pixels that have work left, not the frame
-// (llvmpipe runs a shader's code for every SIMD group, lanes that have returned included).
-fn deep_list_at() -> u32 {
+// Two lists of pixel indices after the per-pixel state, so that each phase runs over the pixels
+// that have work in it, not the frame (llvmpipe runs a shader's code for every SIMD group, lanes
+// that have returned included): the pixels with fragments, which cs_active lists for cs_sort,
+// and the deep pixels, which cs_sort lists for the later phases.
+fn active_list_at() -> u32 {
     return frame.tile_size.x * frame.tile_size.y * STATE_WORDS;
 }
 
-// Workgroups of DEEP_GROUP invocations for the deep phases: at most 65,535 in x, then rows.
-const DEEP_GROUP: u32 = 64u;
+fn deep_list_at() -> u32 {
+    return frame.tile_size.x * frame.tile_size.y * (STATE_WORDS + 1u);
+}
 
-// The first dispatch: every pixel sorts its first run. A list of one run (most pixels) is
-// composited and done; a longer one keeps the run, relinked, goes on to cs_runs and joins the
-// deep list.
+// Workgroups of LIST_GROUP invocations for the phases over a list: at most 65,535 in x, then
+// rows of them.
+const LIST_GROUP: u32 = 64u;
+
+// The i-th pixel of the list at `at` of `count` pixels, dispatched with the workgroups from
+// `groups` (OUTSIDE past its end).
+fn listed_pixel(gid: vec3<u32>, groups: u32, count: u32, at: u32) -> u32 {
+    let i = gid.y * alloc.groups[groups] * LIST_GROUP + gid.x;
+    if i >= count {
+        return OUTSIDE;
+    }
+    return state[at + i];
+}
+
 @compute @workgroup_size(8, 8)
-fn cs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn cs_active(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = compute_pixel(gid);
+    if px == OUTSIDE || list_head(px) == 0u {
+        return;
+    }
+    state[active_list_at() + atomicAdd(&alloc.listed, 1u)] = px;
+}
+
+fn set_groups(at: u32, count: u32) {
+    let groups = (count + LIST_GROUP - 1u) / LIST_GROUP;
+    let x = min(groups, 65535u);
+    alloc.groups[at] = x;
+    alloc.groups[at + 1u] = (groups + x - 1u) / max(x, 1u);
+    alloc.groups[at + 2u] = 1u;
+}
+
+// The workgroups of the dispatches over the two lists, from their lengths.
+@compute @workgroup_size(1)
+fn cs_groups() {
+    set_groups(0u, atomicLoad(&alloc.listed));
+    set_groups(3u, atomicLoad(&alloc.deep));
+}
+
+// The first dispatch: every pixel with fragments sorts its first run. A list of one run (most
+// pixels) is composited and done; a longer one keeps the run, relinked, goes on to cs_runs and
+// joins the deep list. A pixel without fragments keeps its cleared state: fs_resolve gives it
+// the opaque scene or background.
+@compute @workgroup_size(LIST_GROUP)
+fn cs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let px = listed_pixel(gid, 0u, atomicLoad(&alloc.listed), active_list_at());
     if px == OUTSIDE {
         return;
     }
@@ -519,34 +560,20 @@ fn cs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     save_acc(px, c);
 }
 
-// The workgroups of the deep phases' indirect dispatches, from the deep list's length.
-@compute @workgroup_size(1)
-fn cs_deep_groups() {
-    let groups = (atomicLoad(&alloc.deep) + DEEP_GROUP - 1u) / DEEP_GROUP;
-    let x = min(groups, 65535u);
-    alloc.deep_groups[0] = x;
-    alloc.deep_groups[1] = select(0u, (groups + x - 1u) / max(x, 1u), groups > 0u);
-    alloc.deep_groups[2] = 1u;
-}
-
 // The deeper pixels, one phase an entry point so that each dispatch runs one tight loop:
 // their further runs, then their merge passes, then their composite, STEP_BUDGET steps a
 // dispatch. The host dispatches each enough times for the deepest pixel
 // (oit_core::method::lists::resolve_dispatches), over the deep list; a pixel in another phase
 // returns at once.
 fn resume(gid: vec3<u32>, phase: u32) -> u32 {
-    let i = gid.y * alloc.deep_groups[0] * DEEP_GROUP + gid.x;
-    if i >= atomicLoad(&alloc.deep) {
-        return OUTSIDE;
-    }
-    let px = state[deep_list_at() + i];
-    if (state[px * STATE_WORDS + S_PHASE] & 0xfu) != phase {
+    let px = listed_pixel(gid, 3u, atomicLoad(&alloc.deep), deep_list_at());
+    if px == OUTSIDE || (state[px * STATE_WORDS + S_PHASE] & 0xfu) != phase {
         return OUTSIDE;
     }
     return px;
 }
 
-@compute @workgroup_size(DEEP_GROUP)
+@compute @workgroup_size(LIST_GROUP)
 fn cs_runs(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = resume(gid, RUNS);
     if px == OUTSIDE {
@@ -562,7 +589,7 @@ fn cs_runs(@builtin(global_invocation_id) gid: vec3<u32>) {
     save_sweep(s);
 }
 
-@compute @workgroup_size(DEEP_GROUP)
+@compute @workgroup_size(LIST_GROUP)
 fn cs_merge(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = resume(gid, MERGE);
     if px == OUTSIDE {
@@ -577,7 +604,7 @@ fn cs_merge(@builtin(global_invocation_id) gid: vec3<u32>) {
     save_sweep(s);
 }
 
-@compute @workgroup_size(DEEP_GROUP)
+@compute @workgroup_size(LIST_GROUP)
 fn cs_composite(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = resume(gid, COMPOSITE);
     if px == OUTSIDE {

@@ -82,15 +82,17 @@ pub struct Alloc {
     pub count: u32,
     pub capacity: u32,
     pub escaped: u32,
-    /// The sorted resolve's deep pixels and the workgroups of the dispatches over them.
+    /// The sorted resolve's pixel lists (pixels with fragments, deep pixels) and the
+    /// workgroups of the dispatches over them.
+    pub listed: u32,
     pub deep: u32,
-    pub deep_groups: [u32; 3],
+    pub groups: [u32; 6],
     pub pad: u32,
 }
 
 impl Alloc {
-    /// Bytes before `deep_groups`: where the indirect dispatches' arguments are copied from.
-    pub const DEEP_GROUPS_OFFSET: u64 = 16;
+    /// Bytes before `groups`: where the indirect dispatches' arguments are copied from.
+    pub const GROUPS_OFFSET: u64 = 20;
 }
 
 /// Mirrors `Node` in `shaders/compact_abuffer.wgsl`: depth, next link, triangle index.

@@ -274,8 +274,8 @@ pub enum Dispatch<'a> {
     Pixels,
     /// One workgroup.
     One,
-    /// The three workgroup counts a buffer holds, written by an earlier pass.
-    Indirect(&'a wgpu::Buffer),
+    /// The three workgroup counts a buffer holds at an offset, written by an earlier pass.
+    Indirect(&'a wgpu::Buffer, u64),
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -295,7 +295,7 @@ fn record_dispatch(
     match dispatch {
         Dispatch::Pixels => pass.dispatch_workgroups(tile.width.div_ceil(8), tile.height.div_ceil(8), 1),
         Dispatch::One => pass.dispatch_workgroups(1, 1, 1),
-        Dispatch::Indirect(args) => pass.dispatch_workgroups_indirect(args, 0),
+        Dispatch::Indirect(args, offset) => pass.dispatch_workgroups_indirect(args, offset),
     }
 }
 

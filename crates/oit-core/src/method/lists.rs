@@ -37,8 +37,9 @@ pub fn run_length(n: u64) -> u32 {
 const POOL_LAYOUT: Layout = Layout::Storage(4 + POOL_BINDINGS as u32);
 
 const ALLOC_BYTES: u64 = std::mem::size_of::<Alloc>() as u64;
-/// The deep phases' indirect dispatch arguments (x, y, z workgroups).
-const DEEP_ARGS_BYTES: u64 = 12;
+/// The indirect dispatch arguments (x, y, z workgroups) of the sorted resolve's first pass,
+/// then of its deep phases.
+const LIST_ARGS_BYTES: u64 = 24;
 
 /// What a list method keeps at binding 7 besides its pool.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,8 +64,8 @@ pub(crate) struct NodePool {
     /// Per-pixel state carried between resolve sweeps (binding 6).
     state: wgpu::Buffer,
     pub state_words: u64,
-    /// The deep phases' indirect dispatch arguments, copied from the allocator.
-    deep_args: wgpu::Buffer,
+    /// The sorted resolve's indirect dispatch arguments, copied from the allocator.
+    list_args: wgpu::Buffer,
     /// Binding 7: per-triangle data of the allocation pass, or per-pixel offsets.
     pub aux: wgpu::Buffer,
     aux_kind: Aux,
@@ -95,9 +96,9 @@ impl NodePool {
             pools: Vec::new(),
             state: storage_buffer(d, "sweep state", 4, wgpu::BufferUsages::empty()),
             state_words,
-            deep_args: d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("deep dispatch args"),
-                size: DEEP_ARGS_BYTES,
+            list_args: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pixel list dispatch args"),
+                size: LIST_ARGS_BYTES,
                 usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
@@ -120,13 +121,14 @@ impl NodePool {
         self.nodes_per_binding * POOL_BINDINGS
     }
 
-    /// Words of the state buffer a pixel: its sweep state and, with one, its deep-list entry.
+    /// Words of the state buffer a pixel: its sweep state and, with one, its entries of the
+    /// pixel lists (shaders/common/sweep.wgsl).
     pub fn state_len(&self) -> u64 {
-        self.state_words + (self.state_words > 0) as u64
+        self.state_words + 2 * (self.state_words > 0) as u64
     }
 
     pub fn bytes(&self) -> u64 {
-        let args = if self.state_words > 0 { DEEP_ARGS_BYTES } else { 0 };
+        let args = if self.state_words > 0 { LIST_ARGS_BYTES } else { 0 };
         self.capacity * self.node_bytes + self.pixels * 4 * (1 + self.state_len()) + self.aux_len + ALLOC_BYTES + args
     }
 
@@ -234,9 +236,9 @@ struct Pipelines {
     allocate: Option<wgpu::ComputePipeline>,
     count: Option<wgpu::RenderPipeline>,
     capture: wgpu::RenderPipeline,
-    /// The sorted resolve's first dispatch, the deep list's workgroups, then the deeper
-    /// pixels' runs, merges and composite.
-    sweep: Option<[wgpu::ComputePipeline; 5]>,
+    /// The sorted resolve: the pixel lists and their workgroups, the first dispatch, then the
+    /// deeper pixels' runs, merges and composite.
+    sweep: Option<[wgpu::ComputePipeline; 6]>,
     resolve: wgpu::RenderPipeline,
 }
 
@@ -308,7 +310,7 @@ impl ListMethod {
             allocate: matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate")),
             count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(&shader, "fs_count", POOL_LAYOUT)),
             capture: cx.capture_pipeline(&shader, "fs_capture", POOL_LAYOUT),
-            sweep: self.sweeps.map(|_| ["cs_sort", "cs_deep_groups", "cs_runs", "cs_merge", "cs_composite"].map(compute)),
+            sweep: self.sweeps.map(|_| ["cs_active", "cs_groups", "cs_sort", "cs_runs", "cs_merge", "cs_composite"].map(compute)),
             resolve: cx.resolve_pipeline(&shader, "fs_resolve", POOL_LAYOUT, false),
         }
     }
@@ -389,22 +391,35 @@ impl ListMethod {
             }
             cx.capture(&mut enc, "capture", &p.capture, group);
             self.pool.copy_count(&mut enc);
-            if let Some([sort, deep_groups, phases @ ..]) = &p.sweep {
-                cx.dispatch(&mut enc, "sort", sort, group);
+            if let Some([active, groups, sort, phases @ ..]) = &p.sweep {
+                // Each phase runs over a list of the pixels with work in it: cs_active lists
+                // those with fragments, cs_sort the deep ones; cs_groups sizes the dispatches.
+                let (alloc, args) = (&self.pool.alloc, &self.pool.list_args);
+                {
+                    let timestamp_writes = cx.timer.compute_pass("pixel lists");
+                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pixel lists"), timestamp_writes });
+                    cx.bind_dispatch(&mut pass, active, group);
+                    cx.bind_dispatch_with(&mut pass, groups, group, Dispatch::One);
+                }
+                enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);
+                {
+                    let timestamp_writes = cx.timer.compute_pass("sort");
+                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("sort"), timestamp_writes });
+                    cx.bind_dispatch_with(&mut pass, sort, group, Dispatch::Indirect(args, 0));
+                }
                 if sweeps.iter().any(|&n| n > 0) {
-                    // The later phases run over the deep list cs_sort wrote, not the frame.
                     {
                         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("deep list"), timestamp_writes: None });
-                        cx.bind_dispatch_with(&mut pass, deep_groups, group, Dispatch::One);
+                        cx.bind_dispatch_with(&mut pass, groups, group, Dispatch::One);
                     }
-                    enc.copy_buffer_to_buffer(&self.pool.alloc, Alloc::DEEP_GROUPS_OFFSET, &self.pool.deep_args, 0, DEEP_ARGS_BYTES);
+                    enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);
                 }
                 for ((label, pipeline), n) in ["runs", "merge", "composite"].into_iter().zip(phases).zip(sweeps) {
                     if n > 0 {
                         let timestamp_writes = cx.timer.compute_pass(label);
                         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
                         for _ in 0..n {
-                            cx.bind_dispatch_with(&mut pass, pipeline, group, Dispatch::Indirect(&self.pool.deep_args));
+                            cx.bind_dispatch_with(&mut pass, pipeline, group, Dispatch::Indirect(args, 12));
                         }
                     }
                 }
@@ -453,9 +468,9 @@ pub(crate) const fn state_words(samples: u32) -> u64 {
 }
 
 /// Bytes a pixel of a sorted-resolve method keeps besides its pool: its head, its sweep state
-/// and its entry of the deep list.
+/// and its entries of the two pixel lists.
 pub(crate) const fn pixel_bytes(samples: u32) -> u64 {
-    4 + 4 * (state_words(samples) + 1)
+    4 + 4 * (state_words(samples) + 2)
 }
 
 pub(crate) const PIXEL_BYTES: u64 = pixel_bytes(1);
