@@ -3,6 +3,9 @@ method table, adapter info, the node pool split across bindings, and empty scene
 
 from __future__ import annotations
 
+import ast
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -174,3 +177,36 @@ def test_the_census_runs_where_the_method_needs_it_or_the_caller_asks(renderer, 
 def test_census_must_be_a_bool(renderer):
     with pytest.raises(TypeError, match="census must be True or False"):
         renderer(4, 4).render(oit.Scene(), IDENTITY, method="unsorted", census=1)
+
+
+def _stub_class_annotations(name: str) -> dict[str, str]:
+    """A TypedDict's annotations in the native module's stub, as written."""
+    tree = ast.parse((Path(oit.__file__).parent / "_oit.pyi").read_text())
+    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == name)
+    return {n.target.id: ast.unparse(n.annotation) for n in cls.body if isinstance(n, ast.AnnAssign)}
+
+
+def test_the_stats_types_are_the_cores():
+    """`oit.Stats` and the stub's `_Stats` name the core's keys (crates/oit-core/src/stats.rs)
+    with its types, in its order."""
+    schema = [(name, ty) for name, ty, _ in oit._oit.stats_schema()]
+    # Annotations are kept as written (this module's `from __future__ import annotations`):
+    # TypedDict wraps each in a ForwardRef.
+    written = [(k, getattr(v, "__forward_arg__", v)) for k, v in oit.Stats.__annotations__.items()]
+    assert written == schema
+    assert list(_stub_class_annotations("_Stats").items()) == schema
+    assert all(doc for _, _, doc in oit._oit.stats_schema())
+
+
+@pytest.mark.parametrize("method", ["hybrid", "abuffer"])
+def test_a_frame_has_the_schemas_keys(renderer, method):
+    """Every key of the schema is in a frame's stats, error_bound_max only with a bound."""
+    r = renderer(16, 16)
+    frame = r.render(build_scene([layer(0.5, (1.0, 0.0, 0.0, 0.5))]), IDENTITY, method=method)
+    names = [name for name, _, _ in oit._oit.stats_schema()]
+    assert (frame.error_bound is not None) == (method == "hybrid")
+    expected = names if frame.error_bound is not None else [n for n in names if n != "error_bound_max"]
+    assert list(frame.stats) == expected
+    assert frame.stats["adapter"] == r.adapter_info["name"]
+    if frame.error_bound is not None:
+        assert frame.stats["error_bound_max"] == pytest.approx(float(frame.error_bound.max()))

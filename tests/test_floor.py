@@ -66,6 +66,7 @@ def test_a_ratio_past_the_baseline_is_flagged(tmp_path):
     baseline = {"pygfx": "0", "size": size, "ratios": dict.fromkeys(keys, 1e-3)}
     result = floor.peers_floor(("glass",), repeat=1, quick=True, show_progress=False, baseline=baseline)
     assert all(r["flag"] == "slower" and r["growth"] > floor.GROWTH for r in result.rows)
+    assert all(r["pairs"] == 1 for r in result.rows), "a quick run takes the pairs it is asked for, no more"
     assert any("pygfx 0" in n for n in result.notes)
     path = tmp_path / "baseline.json"
     floor.write_baseline(result, path)

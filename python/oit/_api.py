@@ -3,7 +3,6 @@ messages that name the argument and say what to do."""
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypedDict
@@ -11,6 +10,8 @@ from typing import Any, TypedDict
 import numpy as np
 
 from . import _oit
+from ._memory import available_memory
+from ._trimesh import srgb_to_linear, trimesh_arrays
 
 
 def _float_array(value: Any, name: str) -> np.ndarray:
@@ -71,7 +72,7 @@ def _texture(texture: Any) -> np.ndarray:
                          "of 1 (or 255) to an RGB image")
     if t.dtype == np.uint8:
         out = t.astype(np.float64) / 255.0
-        out[..., :3] = _srgb_to_linear(out[..., :3])
+        out[..., :3] = srgb_to_linear(out[..., :3])
         return np.ascontiguousarray(out, dtype=np.float32)
     out = _float_array(t, "texture")
     if out.min() < 0.0 or out.max() > 1.0:
@@ -259,7 +260,7 @@ class Scene:
         for m in meshes:
             if not isinstance(m, trimesh.Trimesh):
                 continue
-            t = _trimesh_arrays(m)
+            t = trimesh_arrays(m)
             colors = t.colors
             if color is not None:
                 c = np.asarray(color, dtype=np.float64)
@@ -273,126 +274,6 @@ class Scene:
             self.add_mesh(t.positions, t.faces, colors, opaque=opaque or t.opaque,
                           normals=t.normals if shading == "smooth" else None, uvs=t.uvs, texture=t.texture,
                           shading=shading, specular=specular, shininess=shininess, two_sided=two_sided)
-
-
-def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-
-
-@dataclass
-class _TrimeshArrays:
-    positions: np.ndarray
-    faces: np.ndarray
-    colors: np.ndarray  # linear straight RGBA per vertex
-    normals: np.ndarray | None = None
-    uvs: np.ndarray | None = None  # row 0 of the texture at v = 0 (trimesh's v flipped)
-    texture: np.ndarray | None = None  # uint8 sRGB or float linear (h, w, 4)
-    opaque: bool = False
-
-
-def _unit_normals(n: Any, count: int) -> np.ndarray | None:
-    """Vertex normals with zero or non-finite rows replaced by +z (unreferenced vertices)."""
-    try:
-        n = np.array(n, dtype=np.float64)
-    except Exception:
-        return None
-    if n.shape != (count, 3):
-        return None
-    length = np.linalg.norm(n, axis=1)
-    bad = ~np.isfinite(length) | (length < 1e-12)
-    n[bad] = (0.0, 0.0, 1.0)
-    return n / np.linalg.norm(n, axis=1, keepdims=True)
-
-
-def _rgba_image(image: Any) -> np.ndarray | None:
-    if image is None:
-        return None
-    try:
-        a = np.asarray(image.convert("RGBA") if hasattr(image, "convert") else image)
-    except Exception:
-        return None
-    if a.ndim == 2:
-        a = np.stack([a, a, a, np.full_like(a, 255 if a.dtype == np.uint8 else 1)], -1)
-    if a.ndim != 3 or a.shape[2] not in (3, 4) or a.size == 0:
-        return None
-    if a.shape[2] == 3:
-        a = np.concatenate([a, np.full((*a.shape[:2], 1), 255 if a.dtype == np.uint8 else 1, a.dtype)], -1)
-    return np.array(a, order="C")  # a writable copy: alphaMode edits it
-
-
-def _trimesh_arrays(m: Any) -> _TrimeshArrays:
-    positions = np.asarray(m.vertices, dtype=np.float32)
-    faces = np.asarray(m.faces, dtype=np.int64)
-    rgba = np.tile([0.8, 0.8, 0.8, 1.0], (len(positions), 1))
-    # Normals the file brought (trimesh computes missing ones slowly without scipy: the core
-    # computes them instead, angle-weighted, when none are passed).
-    cache = getattr(m, "_cache", None)
-    has_normals = cache is not None and "vertex_normals" in cache and len(faces)
-    normals = _unit_normals(m.vertex_normals, len(positions)) if has_normals else None
-    uvs = texture = None
-    opaque = False
-    visual = getattr(m, "visual", None)
-    kind = getattr(visual, "kind", None)
-    linear_rgb = False
-    if kind == "vertex":
-        rgba = np.asarray(visual.vertex_colors, dtype=np.float64) / 255.0
-    elif kind == "face":
-        # One color per face: split vertices so that each face keeps its own color.
-        fc = np.asarray(visual.face_colors, dtype=np.float64) / 255.0
-        corner = faces.reshape(-1)
-        if normals is None and len(faces):
-            from .geometry import vertex_normals
-
-            normals = _unit_normals(vertex_normals(positions, faces), len(positions))
-        positions = positions[corner]
-        normals = normals[corner] if normals is not None else None
-        faces = np.arange(len(positions)).reshape(-1, 3)
-        rgba = np.repeat(fc, 3, axis=0)
-    elif kind == "texture" and hasattr(visual, "material"):
-        mat = visual.material
-        base = getattr(mat, "baseColorFactor", None)
-        if base is not None:
-            linear_rgb = True  # glTF: the factor is linear
-        else:
-            base = getattr(mat, "main_color", None)
-        if base is not None:
-            base = np.asarray(base, dtype=np.float64)
-            base = base / (255.0 if base.max() > 1 else 1.0)
-            rgba = np.tile(np.append(base, 1.0)[:4] if base.shape == (3,) else base, (len(positions), 1))
-        image = getattr(mat, "baseColorTexture", None)
-        if image is None:
-            image = getattr(mat, "image", None)
-        uv = getattr(visual, "uv", None)
-        if image is not None and uv is not None and np.shape(uv) == (len(positions), 2):
-            texture = _rgba_image(image)
-            if texture is not None:
-                if not linear_rgb:
-                    # A plain material's diffuse color (trimesh's default grey when the file has
-                    # none) is not applied over its image, as trimesh's viewer shows it.
-                    rgba[:, :3] = 1.0
-                uvs = np.asarray(uv, dtype=np.float64).copy()
-                uvs[:, 1] = 1.0 - uvs[:, 1]  # trimesh's v points up the image; row 0 is v = 0 here
-                uvs = uvs.astype(np.float32)
-        mode = str(getattr(mat, "alphaMode", None) or "").upper()
-        if mode == "OPAQUE":
-            opaque = True
-            rgba[:, 3] = 1.0
-            if texture is not None:
-                texture[..., 3] = 255 if texture.dtype == np.uint8 else 1.0
-        elif mode == "MASK":
-            cutoff = getattr(mat, "alphaCutoff", None)
-            cutoff = 0.5 if cutoff is None else float(cutoff)
-            if texture is not None:
-                # Per texel (bilinear filtering then softens the cut's edges over a texel).
-                a = texture[..., 3].astype(np.float64) / (255.0 if texture.dtype == np.uint8 else 1.0)
-                texture[..., 3] = np.where(a * rgba[0, 3] >= cutoff, 255 if texture.dtype == np.uint8 else 1.0, 0)
-                rgba[:, 3] = 1.0
-            else:
-                rgba[:, 3] = np.where(rgba[:, 3] >= cutoff, 1.0, 0.0)
-    rgba = rgba.copy()
-    if not linear_rgb:
-        rgba[:, :3] = _srgb_to_linear(rgba[:, :3])
-    return _TrimeshArrays(positions, faces, np.clip(rgba, 0.0, 1.0), normals, uvs, texture, opaque)
 
 
 class Camera:
@@ -490,31 +371,30 @@ class Camera:
 
 
 class Stats(TypedDict, total=False):
-    """`frame.stats`: what every frame reports. Method-specific figures are under `extra`."""
+    """`frame.stats`: what every frame reports; method-specific figures are under `extra`. The
+    keys, their types and meanings are the core's (`oit._oit.stats_schema()`,
+    crates/oit-core/src/stats.rs); tests/test_contract.py holds this class to them."""
 
-    method: str
+    method: str  # the method's name
     params: dict[str, Any]  # every parameter, defaults filled in
     census: bool  # whether the fragment census ran (render(census=True), or a method that plans from it)
     fragments: int | None  # transparent fragments in front of the opaque depth (summed over samples); None without a census
-    max_depth_complexity: int | None  # None without a census
+    max_depth_complexity: int | None  # the most transparent fragments of a pixel; None without a census
     memory_bytes: int  # what the method allocated (oit.memory_bytes gives its formula)
     target_bytes: int  # the shared frame targets: base color, depth, output, census, bound
-    scene_bytes: int
-    gpu_time_ms: float | None  # None where the adapter has no timestamp queries
-    pass_times_ms: dict[str, float]  # per pass; a pass run more than once adds up
+    scene_bytes: int  # the scene's GPU buffers
+    gpu_time_ms: float | None  # the passes' GPU time; None where the adapter has no timestamp queries
+    pass_times_ms: dict[str, float]  # GPU time per pass; a pass run more than once adds up
     overflow_fragments: int  # fragments a bounded structure could not hold
-    wall_time_ms: float
-    antialias: int
-    antialias_mode: str
-    geometry_chunks: int  # chunks the transparent geometry was uploaded in (1 unless it passes a binding)
+    wall_time_ms: float  # the render's wall time, readback included
+    antialias: int  # samples a pixel (1: no antialiasing)
+    antialias_mode: str  # 'frames' or 'coverage'
     tiles: int  # screen tiles the frame was rendered in (1: untiled), summed over antialiasing samples
+    geometry_chunks: int  # chunks the transparent geometry was uploaded in (1 unless it passes a binding)
     peak_memory_bytes: int  # the most held at once: the method's largest tile, the shared targets, the scene
-    adapter: str
+    adapter: str  # the adapter's name
+    extra: dict[str, float]  # method-specific (the schema lists them)
     error_bound_max: float  # the largest of frame.error_bound, where the method derives one
-    # Method-specific: the node pool's `pool_nodes`, `pool_regrown`, `resolve_sweeps` (list
-    # methods); `tail_fragments` (k-TAB methods); `geometry_passes`, `peeled_fragments` (peeling);
-    # `auto_k`, `auto_mean_k`, `auto_slots`, `auto_predicted_k`, `auto_exact`, `auto_attempts` (auto).
-    extra: dict[str, float]
 
 
 @dataclass
@@ -604,9 +484,7 @@ class Renderer:
             raise TypeError(f"census must be True or False, got {census!r}")
         image, dc, stats, bound = self._native.render(scene._native, camera.view_proj, method, bg, params,
                                                       _antialias(antialias), antialias_mode, cost, census)
-        stats["adapter"] = self.adapter_info["name"]
         if bound is not None:
-            stats["error_bound_max"] = float(bound.max()) if bound.size else 0.0
             return Frame(image=image, stats=stats, depth_complexity=dc, error_bound=np.repeat(bound[..., None], 3, axis=2))
         exact = any(m["name"] == method and m["error_bound"] == "exact" for m in methods())
         reason = ("exact method: the error is float32 compositing, at most about (n + 2) * 2**-23 for n layers"
@@ -681,7 +559,7 @@ def reference(scene: Scene, camera: Camera, width: int, height: int, background:
     # float64 RGBA, the ambiguity mask and the depth complexity: a failed allocation in the
     # core would abort the process, so refuse what this machine cannot hold.
     need = w * h * (4 * 8 + 1 + 4)
-    avail = _available_memory()
+    avail = available_memory()
     if w * h > _U32_MAX or (avail is not None and need > avail):
         raise MemoryError(f"reference at {w} x {h} needs {need / 2**30:.1f} GiB"
                           + (f" but {avail / 2**30:.1f} GiB are available" if avail is not None else "")
@@ -689,19 +567,3 @@ def reference(scene: Scene, camera: Camera, width: int, height: int, background:
     samples = _antialias(antialias)
     image, ambiguous, _ = _oit.reference(scene._native, camera.view_proj, w, h, _background(background), samples)
     return (image, ambiguous) if return_mask else image
-
-
-def _available_memory() -> int | None:
-    """Bytes of memory available to allocate (Linux MemAvailable, else physical memory), or
-    None where neither is known."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    try:
-        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None

@@ -42,6 +42,29 @@ class _TilingInfo(TypedDict, total=False):
     per_triangle: int
     target_bytes_per_pixel: int  # formula only: frame-sized render targets the tiles share
 
+class _Stats(TypedDict, total=False):
+    # crates/oit-core/src/stats.rs, SCHEMA; tests/test_contract.py checks these against it.
+    method: str
+    params: dict[str, Any]
+    census: bool
+    fragments: int | None
+    max_depth_complexity: int | None
+    memory_bytes: int
+    target_bytes: int
+    scene_bytes: int
+    gpu_time_ms: float | None
+    pass_times_ms: dict[str, float]
+    overflow_fragments: int
+    wall_time_ms: float
+    antialias: int
+    antialias_mode: str
+    tiles: int
+    geometry_chunks: int
+    peak_memory_bytes: int
+    adapter: str
+    extra: dict[str, float]
+    error_bound_max: float
+
 class _MethodInfo(TypedDict):
     name: str
     summary: str
@@ -123,7 +146,7 @@ class Renderer:
         antialias_mode: str = "frames",
         shading_cost: int = 0,
         census: bool = False,
-    ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32] | None, dict[str, Any], npt.NDArray[np.float32] | None]:
+    ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32] | None, _Stats, npt.NDArray[np.float32] | None]:
         """Returns (image (h, w, 4) float32, depth complexity (h, w) uint32 or None without a
         census, stats dict, error bound (h, w) float32 or None)."""
 
@@ -133,6 +156,9 @@ def methods() -> list[_MethodInfo]:
 def memory_bytes(method: str, width: int, height: int, params: dict[str, _ParamValue], slots: int | None = None) -> int | None:
     """GPU bytes `method` allocates at `width` x `height` with `params` (its memory formula), or
     None when that grows with the scene; `slots` is auto's k-TAB slots in all."""
+
+def stats_schema() -> list[tuple[str, str, str]]:
+    """The keys of a frame's stats: (name, Python type, meaning), in order (crates/oit-core/src/stats.rs)."""
 
 def constants() -> dict[str, Any]:
     """The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs)."""

@@ -17,44 +17,11 @@ use crate::pipeline;
 use crate::scene::{Camera, Scene};
 use crate::shader::SceneVariant;
 use crate::shading::{Light, Lighting, MAX_LIGHTS};
+pub use crate::stats::Stats;
 use crate::targets::{read_buffer, read_rows, SampleTargets, Targets};
 use crate::tiles::{self, Footprint, Tile};
 use crate::timer::PassTimer;
 use crate::upload::GpuScene;
-
-/// Numbers about one frame (see the contract in README and docs/methods.md).
-#[derive(Clone, Debug, Default)]
-pub struct Stats {
-    pub method: String,
-    pub params: Params,
-    /// Whether the fragment census ran: without it `fragments` and `max_depth_complexity` are 0
-    /// and the frame's `depth_complexity` is empty (methods that need no census run none unless
-    /// `Renderer::set_census` asks for it).
-    pub census: bool,
-    /// Transparent fragments that passed the opaque depth test.
-    pub fragments: u64,
-    pub max_depth_complexity: u32,
-    /// GPU memory the method allocated for this frame (excludes the shared targets).
-    pub memory_bytes: u64,
-    /// Shared frame targets: base color, depth, output, census counts.
-    pub target_bytes: u64,
-    pub scene_bytes: u64,
-    pub gpu_time_ms: Option<f64>,
-    pub pass_times_ms: Vec<(&'static str, f64)>,
-    pub overflow_fragments: u64,
-    pub wall_time_ms: f64,
-    pub extra: Vec<(&'static str, f64)>,
-    /// Samples a pixel (1: no antialiasing).
-    pub antialias: u32,
-    pub antialias_mode: AntialiasMode,
-    /// Screen tiles the frame was rendered in (1: untiled); summed over antialiasing samples.
-    pub tiles: u32,
-    /// Chunks the transparent geometry was uploaded in (1 unless it passes a binding).
-    pub geometry_chunks: u32,
-    /// The most GPU memory the frame held at once: the method's largest tile, the shared
-    /// targets and the scene.
-    pub peak_memory_bytes: u64,
-}
 
 /// Methods that take coverage masks (`AntialiasMode::Coverage` in their `antialias_modes`).
 pub fn coverage_methods() -> Vec<&'static str> {
@@ -330,6 +297,22 @@ impl Renderer {
         antialias: u32,
         mode: AntialiasMode,
     ) -> Result<Frame> {
+        let mut frame = self.render_samples(scene, camera, method_name, params, background, antialias, mode)?;
+        frame.stats.finish(&self.gpu.info.name, frame.error_bound.as_deref());
+        Ok(frame)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn render_samples(
+        &mut self,
+        scene: &Scene,
+        camera: &Camera,
+        method_name: &str,
+        params: &[(String, ParamValue)],
+        background: [f32; 3],
+        antialias: u32,
+        mode: AntialiasMode,
+    ) -> Result<Frame> {
         let start = Instant::now();
         let offsets = antialias::sample_offsets(antialias)?;
         let info = method::lookup(method_name)?;
@@ -541,6 +524,7 @@ impl Renderer {
             tiles: tiles.len() as u32,
             geometry_chunks: gpu_scene.transparent.chunks.len() as u32,
             peak_memory_bytes: report.memory_bytes + target_bytes + scene_bytes,
+            ..Default::default()
         };
         Ok(Frame { width: self.width, height: self.height, image, depth_complexity, error_bound, stats })
     }

@@ -212,46 +212,31 @@ fn value_to_py<'py>(py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAn
 }
 
 fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, PyDict>> {
+    use oit_core::stats::StatValue;
+    let numbers = |pairs: &[(&str, f64)]| -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in pairs {
+            d.set_item(*k, v)?;
+        }
+        Ok(d)
+    };
     let d = PyDict::new(py);
-    d.set_item("method", &s.method)?;
-    let params = PyDict::new(py);
-    for (k, v) in &s.params.0 {
-        params.set_item(*k, value_to_py(py, v)?)?;
-    }
-    d.set_item("params", params)?;
-    // Without a census (the method needs none and none was asked for) the counts are unknown.
-    d.set_item("census", s.census)?;
-    d.set_item("fragments", s.census.then_some(s.fragments))?;
-    d.set_item("max_depth_complexity", s.census.then_some(s.max_depth_complexity))?;
-    d.set_item("memory_bytes", s.memory_bytes)?;
-    d.set_item("target_bytes", s.target_bytes)?;
-    d.set_item("scene_bytes", s.scene_bytes)?;
-    d.set_item("gpu_time_ms", s.gpu_time_ms)?;
-    // A pass that ran more than once (antialiasing samples, auto's attempts) adds up.
-    let mut summed: Vec<(&str, f64)> = Vec::new();
-    for &(k, v) in &s.pass_times_ms {
-        match summed.iter_mut().find(|(name, _)| *name == k) {
-            Some((_, total)) => *total += v,
-            None => summed.push((k, v)),
+    for (key, value) in s.entries() {
+        match value {
+            StatValue::Bool(b) => d.set_item(key, b)?,
+            StatValue::Int(i) => d.set_item(key, i)?,
+            StatValue::Float(f) => d.set_item(key, f)?,
+            StatValue::Str(text) => d.set_item(key, text)?,
+            StatValue::Params(params) => {
+                let p = PyDict::new(py);
+                for (k, v) in &params.0 {
+                    p.set_item(*k, value_to_py(py, v)?)?;
+                }
+                d.set_item(key, p)?
+            }
+            StatValue::Numbers(pairs) => d.set_item(key, numbers(&pairs)?)?,
         }
     }
-    let passes = PyDict::new(py);
-    for (k, v) in summed {
-        passes.set_item(k, v)?;
-    }
-    d.set_item("pass_times_ms", passes)?;
-    d.set_item("overflow_fragments", s.overflow_fragments)?;
-    d.set_item("wall_time_ms", s.wall_time_ms)?;
-    d.set_item("antialias", s.antialias)?;
-    d.set_item("antialias_mode", s.antialias_mode.name())?;
-    d.set_item("tiles", s.tiles)?;
-    d.set_item("geometry_chunks", s.geometry_chunks)?;
-    d.set_item("peak_memory_bytes", s.peak_memory_bytes)?;
-    let extra = PyDict::new(py);
-    for (k, v) in &s.extra {
-        extra.set_item(*k, v)?;
-    }
-    d.set_item("extra", extra)?;
     Ok(d)
 }
 
@@ -431,6 +416,13 @@ fn memory_bytes(method: &str, width: i64, height: i64, params: Bound<'_, PyDict>
     Ok(oit_core::memory_bytes(method, width as u32, height as u32, &plist, slots).map_err(Error::from)?)
 }
 
+/// The keys of a frame's stats: (name, Python type, meaning), in order
+/// (crates/oit-core/src/stats.rs).
+#[pyfunction]
+fn stats_schema() -> Vec<(&'static str, &'static str, &'static str)> {
+    oit_core::stats::SCHEMA.iter().map(|k| (k.name, k.ty, k.doc)).collect()
+}
+
 /// The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs).
 #[pyfunction]
 fn constants<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -485,5 +477,6 @@ fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reference, m)?)?;
     m.add_function(wrap_pyfunction!(memory_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(constants, m)?)?;
+    m.add_function(wrap_pyfunction!(stats_schema, m)?)?;
     Ok(())
 }

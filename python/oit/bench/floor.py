@@ -51,6 +51,12 @@ TARGETS: dict[tuple[str, str], float] = {
 }
 # A row is flagged when its ratio passes the baseline's by more than this fraction.
 GROWTH = 0.15
+# A row keeps pairing renders past `repeat` until ours have taken this long (at most
+# MAX_PAIRS pairs): a short row's ratio moves with a few milliseconds of the machine's jitter
+# (glass and foliage `unsorted`, about 20 ms a frame, moved by a fifth between runs of one
+# build at 7 pairs), a long row's does not. Not in quick runs.
+MIN_ROW_MS = 2000.0
+MAX_PAIRS = 100
 # The lit rows' surface and lights: the same on every mesh, ours and pygfx's.
 LIT_SURFACE = {"specular": 0.3, "shininess": 32.0}
 LIT_LIGHT = ((-0.3, -0.6, -1.0), (1.0, 1.0, 1.0), 1.0)
@@ -60,7 +66,7 @@ QUICK_SIZE = 128
 FLOOR_COLUMNS = [
     ("scene", "{}"), ("shading", "{}"), ("method", "{}"), ("params", "{}"), ("peer", "{}"), ("ours_ms", "{:.1f}"),
     ("peer_ms", "{:.1f}"), ("ratio", "{:.2f}"), ("target", "{:.1f}"), ("meets", "{}"), ("baseline", "{:.2f}"),
-    ("growth", "{:+.0%}"), ("flag", "{}"), ("ns_per_fragment", "{:.1f}"), ("gpu_ms", "{:.1f}"),
+    ("growth", "{:+.0%}"), ("flag", "{}"), ("ns_per_fragment", "{:.1f}"), ("gpu_ms", "{:.1f}"), ("pairs", "{}"),
 ]
 
 
@@ -131,7 +137,8 @@ def peers_floor(scenes: tuple[str, ...] = SCENES, repeat: int = 5, quick: bool =
     """Every ROWS method on each scene, unlit and lit, against its pygfx mode: wall medians of
     `repeat` alternating renders after a warm-up of each, the ratio, its target and its growth
     over `baseline` (a `load_baseline()` dict, compared only when it was measured at this run's
-    frame size: 512 x 512, or QUICK_SIZE with `quick`)."""
+    frame size: 512 x 512, or QUICK_SIZE with `quick`). Short rows take more pairs, until ours
+    have taken MIN_ROW_MS."""
     missing = peers.pygfx_missing()
     if missing:
         raise RuntimeError(f"--peers-floor measures against pygfx: {missing}")
@@ -154,14 +161,14 @@ def peers_floor(scenes: tuple[str, ...] = SCENES, repeat: int = 5, quick: bool =
             for method, params, mode in ROWS:
                 progress.show(f"{name} {shading} {method}")
                 result.rows.append(_floor_row(renderer, peer, built, name, shading, method, params, mode, repeat, fragments,
-                                              base, version))
+                                              base, version, 0.0 if quick else MIN_ROW_MS))
                 progress.step(f"{name} {shading} {method}")
     return result
 
 
 def _floor_row(renderer: Renderer, peer: peers.PygfxRenderer, built: scene_lib.BuiltScene, name: str, shading: str,
                method: str, params: dict[str, Any], mode: str, repeat: int, fragments: int, base: dict[str, float],
-               version: str) -> dict:
+               version: str, min_ms: float) -> dict:
     def ours() -> tuple[float, float | None]:
         t0 = time.perf_counter()
         frame = renderer.render(built.scene, built.camera, method=method, background=(1.0, 1.0, 1.0), **params)
@@ -170,7 +177,7 @@ def _floor_row(renderer: Renderer, peer: peers.PygfxRenderer, built: scene_lib.B
     ours()
     peer.render(built, mode)  # warm-up: pipelines, pools, uploads
     walls, gpus, peer_walls = [], [], []
-    for _ in range(max(1, repeat)):
+    while len(walls) < max(1, repeat) or (sum(walls) < min_ms and len(walls) < MAX_PAIRS):
         wall, gpu = ours()
         walls.append(wall)
         if gpu is not None:
@@ -189,7 +196,8 @@ def _floor_row(renderer: Renderer, peer: peers.PygfxRenderer, built: scene_lib.B
         "ours_ms": ours_ms, "peer_ms": peer_ms, "ratio": ratio, "target": target if target is not None else math.nan,
         "meets": "" if target is None else ("yes" if ratio <= target else "no"), "baseline": old if old else math.nan,
         "growth": growth, "flag": "slower" if growth > GROWTH else "", "ns_per_fragment": ours_ms * 1e6 / max(fragments, 1),
-        "gpu_ms": statistics.median(gpus) if gpus else math.nan, "fragments": fragments, "status": "ok", "message": "",
+        "gpu_ms": statistics.median(gpus) if gpus else math.nan, "fragments": fragments, "pairs": len(walls), "status": "ok",
+        "message": "",
         "adapter": renderer.adapter_info["name"], "size": f"{renderer.width}x{renderer.height}",
     }
 

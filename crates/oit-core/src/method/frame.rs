@@ -181,7 +181,13 @@ impl<'a> FrameCtx<'a> {
 
     /// Records a dispatch of `pipeline` with the shared groups and `own` bound, of the
     /// workgroups `dispatch` says.
-    pub fn bind_dispatch_with(&self, pass: &mut wgpu::ComputePass<'_>, pipeline: &wgpu::ComputePipeline, own: &wgpu::BindGroup, dispatch: Dispatch<'_>) {
+    pub fn bind_dispatch_with(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        pipeline: &wgpu::ComputePipeline,
+        own: &wgpu::BindGroup,
+        dispatch: Dispatch<'_>,
+    ) {
         record_dispatch(pass, self.scene, self.targets_group(), self.tile, pipeline, own, dispatch);
     }
 

@@ -409,7 +409,8 @@ impl ListMethod {
                 }
                 if sweeps.iter().any(|&n| n > 0) {
                     {
-                        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("deep list"), timestamp_writes: None });
+                        let mut pass =
+                            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("deep list"), timestamp_writes: None });
                         cx.bind_dispatch_with(&mut pass, groups, group, Dispatch::One);
                     }
                     enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);

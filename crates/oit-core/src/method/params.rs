@@ -28,7 +28,7 @@ pub enum ParamValue {
 }
 
 /// Parameters after validation, every declared one present (defaults filled in).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Params(pub BTreeMap<&'static str, ParamValue>);
 
 impl Params {

@@ -1,0 +1,187 @@
+//! What a frame reports, defined once: [`Stats`], and [`SCHEMA`], the keys a frame's stats have
+//! outside Rust, with their Python types and meanings. [`Stats::entries`] gives the values in the
+//! schema's order; oit-py converts them without naming a key, `oit._oit.stats_schema()` exports
+//! the schema, and tests/test_contract.py holds the Python `Stats` TypedDict and the `.pyi`
+//! against it.
+
+use crate::method::{AntialiasMode, Params};
+
+/// Numbers about one frame (see the contract in README and docs/methods.md).
+#[derive(Clone, Debug, Default)]
+pub struct Stats {
+    pub method: String,
+    pub params: Params,
+    /// Whether the fragment census ran: without it `fragments` and `max_depth_complexity` are 0
+    /// and the frame's `depth_complexity` is empty (methods that need no census run none unless
+    /// `Renderer::set_census` asks for it).
+    pub census: bool,
+    /// Transparent fragments that passed the opaque depth test.
+    pub fragments: u64,
+    pub max_depth_complexity: u32,
+    /// GPU memory the method allocated for this frame (excludes the shared targets).
+    pub memory_bytes: u64,
+    /// Shared frame targets: base color, depth, output, census counts.
+    pub target_bytes: u64,
+    pub scene_bytes: u64,
+    pub gpu_time_ms: Option<f64>,
+    pub pass_times_ms: Vec<(&'static str, f64)>,
+    pub overflow_fragments: u64,
+    pub wall_time_ms: f64,
+    pub extra: Vec<(&'static str, f64)>,
+    /// Samples a pixel (1: no antialiasing).
+    pub antialias: u32,
+    pub antialias_mode: AntialiasMode,
+    /// Screen tiles the frame was rendered in (1: untiled); summed over antialiasing samples.
+    pub tiles: u32,
+    /// Chunks the transparent geometry was uploaded in (1 unless it passes a binding).
+    pub geometry_chunks: u32,
+    /// The most GPU memory the frame held at once: the method's largest tile, the shared
+    /// targets and the scene.
+    pub peak_memory_bytes: u64,
+    /// The adapter's name.
+    pub adapter: String,
+    /// The largest value of the frame's error bound, where the method derives one.
+    pub error_bound_max: Option<f64>,
+}
+
+/// One key of a frame's stats outside Rust: its name, its Python type (as the TypedDict writes
+/// it) and what it means.
+#[derive(Clone, Copy, Debug)]
+pub struct StatKey {
+    pub name: &'static str,
+    pub ty: &'static str,
+    pub doc: &'static str,
+}
+
+const fn key(name: &'static str, ty: &'static str, doc: &'static str) -> StatKey {
+    StatKey { name, ty, doc }
+}
+
+/// Every key, in the order [`Stats::entries`] gives them. `error_bound_max` is present only
+/// where the method derives a bound.
+pub const SCHEMA: &[StatKey] = &[
+    key("method", "str", "the method's name"),
+    key("params", "dict[str, Any]", "every parameter, defaults filled in"),
+    key("census", "bool", "whether the fragment census ran (render(census=True), or a method that plans from it)"),
+    key("fragments", "int | None", "transparent fragments in front of the opaque depth (summed over samples); None without a census"),
+    key("max_depth_complexity", "int | None", "the most transparent fragments of a pixel; None without a census"),
+    key("memory_bytes", "int", "what the method allocated (oit.memory_bytes gives its formula)"),
+    key("target_bytes", "int", "the shared frame targets: base color, depth, output, census, bound"),
+    key("scene_bytes", "int", "the scene's GPU buffers"),
+    key("gpu_time_ms", "float | None", "the passes' GPU time; None where the adapter has no timestamp queries"),
+    key("pass_times_ms", "dict[str, float]", "GPU time per pass; a pass run more than once adds up"),
+    key("overflow_fragments", "int", "fragments a bounded structure could not hold"),
+    key("wall_time_ms", "float", "the render's wall time, readback included"),
+    key("antialias", "int", "samples a pixel (1: no antialiasing)"),
+    key("antialias_mode", "str", "'frames' or 'coverage'"),
+    key("tiles", "int", "screen tiles the frame was rendered in (1: untiled), summed over antialiasing samples"),
+    key("geometry_chunks", "int", "chunks the transparent geometry was uploaded in (1 unless it passes a binding)"),
+    key("peak_memory_bytes", "int", "the most held at once: the method's largest tile, the shared targets, the scene"),
+    key("adapter", "str", "the adapter's name"),
+    key(
+        "extra",
+        "dict[str, float]",
+        "method-specific: pool_nodes, pool_regrown, resolve_sweeps (list methods); tail_fragments (k-TAB methods); \
+         geometry_passes, peeled_fragments (peeling); auto_k, auto_mean_k, auto_slots, auto_predicted_k, auto_exact, \
+         auto_attempts (auto)",
+    ),
+    key("error_bound_max", "float", "the largest of frame.error_bound, where the method derives one"),
+];
+
+/// A value of a frame's stats, as [`Stats::entries`] gives it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StatValue<'a> {
+    Bool(bool),
+    Int(Option<u64>),
+    Float(Option<f64>),
+    Str(&'a str),
+    Params(&'a Params),
+    /// Named numbers in order; a name that repeats has been added up.
+    Numbers(Vec<(&'static str, f64)>),
+}
+
+impl Stats {
+    /// Every key of [`SCHEMA`] with its value, in its order (`error_bound_max` only where there
+    /// is a bound). Without a census, `fragments` and `max_depth_complexity` are None.
+    pub fn entries(&self) -> Vec<(&'static str, StatValue<'_>)> {
+        use StatValue::*;
+        let counted = |v: u64| Int(self.census.then_some(v));
+        let mut entries = vec![
+            ("method", Str(&self.method)),
+            ("params", Params(&self.params)),
+            ("census", Bool(self.census)),
+            ("fragments", counted(self.fragments)),
+            ("max_depth_complexity", counted(self.max_depth_complexity as u64)),
+            ("memory_bytes", Int(Some(self.memory_bytes))),
+            ("target_bytes", Int(Some(self.target_bytes))),
+            ("scene_bytes", Int(Some(self.scene_bytes))),
+            ("gpu_time_ms", Float(self.gpu_time_ms)),
+            ("pass_times_ms", Numbers(summed(&self.pass_times_ms))),
+            ("overflow_fragments", Int(Some(self.overflow_fragments))),
+            ("wall_time_ms", Float(Some(self.wall_time_ms))),
+            ("antialias", Int(Some(self.antialias as u64))),
+            ("antialias_mode", Str(self.antialias_mode.name())),
+            ("tiles", Int(Some(self.tiles as u64))),
+            ("geometry_chunks", Int(Some(self.geometry_chunks as u64))),
+            ("peak_memory_bytes", Int(Some(self.peak_memory_bytes))),
+            ("adapter", Str(&self.adapter)),
+            ("extra", Numbers(self.extra.clone())),
+        ];
+        if let Some(max) = self.error_bound_max {
+            entries.push(("error_bound_max", Float(Some(max))));
+        }
+        entries
+    }
+
+    /// What the renderer knows once the frame is whole: the adapter, and the bound's largest
+    /// value.
+    pub(crate) fn finish(&mut self, adapter: &str, error_bound: Option<&[f32]>) {
+        self.adapter = adapter.to_string();
+        self.error_bound_max = error_bound.map(|b| b.iter().fold(0.0f64, |m, &v| m.max(v as f64)));
+    }
+}
+
+/// Named numbers with repeats added up, in the order of first appearance (a pass that ran more
+/// than once: antialiasing samples, auto's attempts).
+fn summed(pairs: &[(&'static str, f64)]) -> Vec<(&'static str, f64)> {
+    let mut out: Vec<(&'static str, f64)> = Vec::new();
+    for &(k, v) in pairs {
+        match out.iter_mut().find(|(name, _)| *name == k) {
+            Some((_, total)) => *total += v,
+            None => out.push((k, v)),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_entries_are_the_schema_in_its_order() {
+        let mut stats = Stats { error_bound_max: Some(0.5), census: true, ..Default::default() };
+        let names: Vec<_> = stats.entries().iter().map(|(k, _)| *k).collect();
+        assert_eq!(names, SCHEMA.iter().map(|k| k.name).collect::<Vec<_>>());
+        stats.error_bound_max = None;
+        assert_eq!(stats.entries().len(), SCHEMA.len() - 1, "no error_bound_max without a bound");
+    }
+
+    #[test]
+    fn counts_are_unknown_without_a_census_and_repeated_passes_add_up() {
+        let stats = Stats { fragments: 7, pass_times_ms: vec![("a", 1.0), ("b", 2.0), ("a", 3.0)], ..Default::default() };
+        let entries = stats.entries();
+        let get = |name| entries.iter().find(|(k, _)| *k == name).map(|(_, v)| v.clone()).unwrap();
+        assert_eq!(get("fragments"), StatValue::Int(None));
+        assert_eq!(get("pass_times_ms"), StatValue::Numbers(vec![("a", 4.0), ("b", 2.0)]));
+    }
+
+    #[test]
+    fn finishing_takes_the_largest_bound() {
+        let mut stats = Stats::default();
+        stats.finish("lavapipe", Some(&[0.25, 0.75, 0.5]));
+        assert_eq!((stats.adapter.as_str(), stats.error_bound_max), ("lavapipe", Some(0.75)));
+        stats.finish("lavapipe", None);
+        assert_eq!(stats.error_bound_max, None);
+    }
+}
