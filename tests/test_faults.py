@@ -17,7 +17,6 @@ import subprocess
 import sys
 import textwrap
 import threading
-import time
 
 import numpy as np
 import pytest
@@ -219,34 +218,42 @@ def test_threads_with_their_own_renderers_get_correct_images(renderer):
 
 
 def test_the_gil_is_released_during_gpu_work(renderer):
-    # A CPU-bound Python thread keeps counting while the main thread waits on a long render
-    # (4,000 fragments at each of 16 pixels: ~0.3 s of GPU work on lavapipe). Were the GIL
-    # held, it could count only between native calls: close to nothing.
+    """Another Python thread makes progress while a render runs: the worker reads the main
+    thread's counter just before the native render and just after it. With a switch interval
+    of a second the interpreter does not take the GIL from the worker between the two reads,
+    so, were the render to hold it, the counter could not move at all; released, it moves by
+    however much the main thread counts during a render (4,000 fragments at each of 16 pixels).
+    No clock is read."""
+    interval = sys.getswitchinterval()
     deep = stacks(4, 4, 4000, seed=4, alpha=lambda rng, n: rng.uniform(1e-4, 2e-3, n))
     r = renderer(4, 4)
     r.render(deep.scene, IDENTITY, NAMES[0])  # warm: upload and pipelines
-    count, stop = [0], threading.Event()
+    count, seen, failure = [0], [], []
+    started, done = threading.Event(), threading.Event()
 
-    def spin():
-        while not stop.is_set():
-            count[0] += 1
+    def work():
+        try:
+            started.set()
+            before = count[0]
+            r._native.render(deep.scene._native, IDENTITY.view_proj, NAMES[0], (1.0, 1.0, 1.0), {}, 1, "frames", 0, False)
+            seen.append(count[0] - before)
+        except Exception as e:  # reported below
+            failure.append(e)
+        finally:
+            done.set()
 
-    t = threading.Thread(target=spin)
-    t.start()
+    sys.setswitchinterval(1.0)
     try:
-        time.sleep(0.05)
-        c0, t0 = count[0], time.perf_counter()
-        time.sleep(0.1)
-        solo_rate = (count[0] - c0) / (time.perf_counter() - t0)  # shares the GIL with a sleeping thread: ~all of it
-        c0, t0 = count[0], time.perf_counter()
-        r.render(deep.scene, IDENTITY, NAMES[0])
-        during, elapsed = count[0] - c0, time.perf_counter() - t0
-    finally:
-        stop.set()
+        t = threading.Thread(target=work)
+        t.start()
+        started.wait()
+        while not done.is_set():
+            count[0] += 1
         t.join()
-    assert elapsed > 0.05, "the render was too quick to tell"
-    # The render's own threads (llvmpipe) share the cores: ask for a tenth of the solo rate.
-    assert during >= 0.1 * solo_rate * elapsed, (during, solo_rate * elapsed)
+    finally:
+        sys.setswitchinterval(interval)
+    assert not failure, failure
+    assert seen[0] > 0, "the main thread could not count while the render ran: it holds the GIL"
 
 
 # ---- memory over 1,000 renders
@@ -257,21 +264,22 @@ def rss_bytes():
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 
-@pytest.mark.skipif(not os.path.exists("/proc/self/statm"), reason="needs /proc/self/statm (Linux)")
 def test_changing_k_does_not_rebuild_pipelines(renderer):
+    """Once every k has been rendered, cycling through them builds no pipeline: the device's
+    pipeline cache counts what it built."""
     name = "hybrid" if "hybrid" in NAMES else pytest.skip("no hybrid")
     scene = build_scene(random_meshes(1, transparent=4, opaque=1, triangles=3))
     r = renderer(8, 8)
-    for _ in range(2):
-        for k in range(1, 6):
-            r.render(scene, IDENTITY, name, k=k)
-    before = rss_bytes()
+    for k in range(1, 6):
+        r.render(scene, IDENTITY, name, k=k)
+    built = r.pipelines_built
+    assert built > 0
     for i in range(50):
         r.render(scene, IDENTITY, name, k=1 + i % 5)
-    grown = rss_bytes() - before
-    # 1 MiB: well above what 50 frames of a cached configuration cost (nothing measurable),
-    # well below what rebuilding costs.
-    assert grown < 2 ** 20, f"RSS grew by {grown / 2 ** 20:.1f} MiB over 50 frames cycling k"
+    assert r.pipelines_built == built, "a frame of a configuration rendered before built a pipeline"
+    # A k not rendered before does build its own.
+    r.render(scene, IDENTITY, name, k=7)
+    assert r.pipelines_built > built
 
 
 @pytest.mark.skipif(not os.path.exists("/proc/self/statm"), reason="needs /proc/self/statm (Linux)")
@@ -296,14 +304,12 @@ def test_a_thousand_renders_do_not_grow_memory(renderer):
     for i in range(len(combos)):
         render(i)
     before = rss_bytes()
-    start = time.perf_counter()
     for i in range(len(combos), len(combos) + 1000):
         render(i)
     grown = rss_bytes() - before
     # Measured: < 0.5 MiB on lavapipe (whose GPU memory is this process's memory). 4 MiB is
     # what a leak of one small frame's image (4 KiB) per render would cost.
     assert grown <= 4 * 2 ** 20, f"RSS grew by {grown / 2 ** 20:.1f} MiB over 1,000 renders"
-    assert time.perf_counter() - start < 60
     for (size, name, _), mem in stats.items():
         if name in BOUNDED:
             assert len(set(mem)) == 1, (size, name, mem)  # bounded: the same bytes every frame

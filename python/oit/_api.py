@@ -453,6 +453,12 @@ class Renderer:
     def adapter_info(self) -> dict:
         return self._native.adapter_info
 
+    @property
+    def pipelines_built(self) -> int:
+        """Pipelines this adapter's device has compiled so far (renderers on one adapter share
+        them): a frame whose configuration was rendered before compiles none."""
+        return self._native.pipelines_built
+
     def render(self, scene: Scene, camera: Camera, method: str = "abuffer",
                background: Sequence[float] = (1.0, 1.0, 1.0), antialias: int = 1, antialias_mode: str = "frames",
                shading_cost: int = 0, census: bool = False, **params: Any) -> Frame:

@@ -271,6 +271,13 @@ impl Renderer {
         })
     }
 
+    /// Pipelines the adapter's device has built so far (render and compute; renderers on one
+    /// adapter share them): a frame that needs no new one leaves it as it was.
+    #[getter]
+    fn pipelines_built(&self) -> usize {
+        self.context.cache.pipelines()
+    }
+
     #[getter]
     fn adapter_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let i = &self.context.info;
