@@ -297,22 +297,6 @@ impl Renderer {
         antialias: u32,
         mode: AntialiasMode,
     ) -> Result<Frame> {
-        let mut frame = self.render_samples(scene, camera, method_name, params, background, antialias, mode)?;
-        frame.stats.finish(&self.gpu.info.name, frame.error_bound.as_deref());
-        Ok(frame)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn render_samples(
-        &mut self,
-        scene: &Scene,
-        camera: &Camera,
-        method_name: &str,
-        params: &[(String, ParamValue)],
-        background: [f32; 3],
-        antialias: u32,
-        mode: AntialiasMode,
-    ) -> Result<Frame> {
         let start = Instant::now();
         let offsets = antialias::sample_offsets(antialias)?;
         let info = method::lookup(method_name)?;
@@ -344,6 +328,7 @@ impl Renderer {
             frame.stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
             frame.stats.antialias = antialias;
             frame.stats.antialias_mode = if coverage { AntialiasMode::Coverage } else { mode };
+            frame.stats.finish(&self.gpu.info.name, frame.error_bound.as_deref());
             return Ok(frame);
         }
         let pixels = self.width as usize * self.height as usize;
@@ -383,12 +368,14 @@ impl Renderer {
         stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
         stats.antialias = antialias;
         stats.antialias_mode = AntialiasMode::Frames;
+        let error_bound: Option<Vec<f32>> = bound.map(|b| b.iter().map(|&v| (v / n) as f32).collect());
+        stats.finish(&self.gpu.info.name, error_bound.as_deref());
         Ok(Frame {
             width: self.width,
             height: self.height,
             image: image.iter().map(|&v| (v / n) as f32).collect(),
             depth_complexity,
-            error_bound: bound.map(|b| b.iter().map(|&v| (v / n) as f32).collect()),
+            error_bound,
             stats,
         })
     }
