@@ -514,11 +514,12 @@ fn cs_active(@builtin(global_invocation_id) gid: vec3<u32>) {
     state[active_list_at() + atomicAdd(&alloc.listed, 1u)] = px;
 }
 
+// An empty list gets no workgroups at all (x = y = 0).
 fn set_groups(at: u32, count: u32) {
     let groups = (count + LIST_GROUP - 1u) / LIST_GROUP;
     let x = min(groups, 65535u);
     alloc.groups[at] = x;
-    alloc.groups[at + 1u] = (groups + x - 1u) / max(x, 1u);
+    alloc.groups[at + 1u] = select(0u, (groups + x - 1u) / max(x, 1u), x > 0u);
     alloc.groups[at + 2u] = 1u;
 }
 
