@@ -238,10 +238,22 @@ impl<'a> FrameCtx<'a> {
         pipeline: &wgpu::ComputePipeline,
         own: &wgpu::BindGroup,
     ) {
+        self.dispatch_with(enc, label, pipeline, own, Dispatch::Pixels);
+    }
+
+    /// Records a compute pass of `pipeline`, timed as `label`, of the workgroups `dispatch` says.
+    pub fn dispatch_with(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        label: &'static str,
+        pipeline: &wgpu::ComputePipeline,
+        own: &wgpu::BindGroup,
+        dispatch: Dispatch<'_>,
+    ) {
         let (tile, targets, scene) = (self.tile, self.targets_group(), self.scene);
         let timestamp_writes = self.timer.compute_pass(label);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
-        record_dispatch(&mut pass, scene, targets, tile, pipeline, own, Dispatch::Pixels);
+        record_dispatch(&mut pass, scene, targets, tile, pipeline, own, dispatch);
     }
 
     pub fn encoder(&self) -> wgpu::CommandEncoder {

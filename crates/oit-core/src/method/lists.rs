@@ -402,17 +402,9 @@ impl ListMethod {
                     cx.bind_dispatch_with(&mut pass, groups, group, Dispatch::One);
                 }
                 enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);
-                {
-                    let timestamp_writes = cx.timer.compute_pass("sort");
-                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("sort"), timestamp_writes });
-                    cx.bind_dispatch_with(&mut pass, sort, group, Dispatch::Indirect(args, 0));
-                }
+                cx.dispatch_with(&mut enc, "sort", sort, group, Dispatch::Indirect(args, 0));
                 if sweeps.iter().any(|&n| n > 0) {
-                    {
-                        let mut pass =
-                            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("deep list"), timestamp_writes: None });
-                        cx.bind_dispatch_with(&mut pass, groups, group, Dispatch::One);
-                    }
+                    cx.dispatch_with(&mut enc, "deep list", groups, group, Dispatch::One);
                     enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);
                 }
                 for ((label, pipeline), n) in ["runs", "merge", "composite"].into_iter().zip(phases).zip(sweeps) {
