@@ -2,10 +2,13 @@
 // compact_abuffer): each pixel's list is sorted once, in place, in O(n log n), then
 // composited front to back; a full-screen pass adds the opaque scene or background.
 //   - A pixel of at most RUN fragments (most pixels) loads them into a local array, sorts it
-//     by insertion and composites it: one walk of its list.
+//     (insertion within blocks of BLOCK, then local merges) and composites it: one walk of
+//     its list.
 //   - A deeper pixel sorts its list in runs of RUN (each run sorted locally and relinked),
 //     then merges the runs bottom-up by relinking the nodes' `next` fields (no scratch
 //     memory), then walks the sorted list to composite it.
+//   - Each phase runs over a list of the pixels with work in it (cs_active, cs_sort), by
+//     indirect dispatch.
 // The work is a per-pixel state machine that stops after STEP_BUDGET steps and resumes in the
 // next dispatch, so any depth completes; the host dispatches enough sweeps for the deepest
 // pixel (oit_core::method::lists::resolve_steps mirrors the counts below). A step is one

@@ -128,8 +128,7 @@ impl NodePool {
     }
 
     pub fn bytes(&self) -> u64 {
-        let args = if self.state_words > 0 { LIST_ARGS_BYTES } else { 0 };
-        self.capacity * self.node_bytes + self.pixels * 4 * (1 + self.state_len()) + self.aux_len + ALLOC_BYTES + args
+        self.capacity * self.node_bytes + self.pixels * 4 * (1 + self.state_len()) + self.aux_len + ALLOC_BYTES + LIST_ARGS_BYTES
     }
 
     /// Makes room for `nodes` nodes, `pixels` heads and `triangles` per-triangle records,
