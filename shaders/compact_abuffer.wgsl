@@ -61,7 +61,8 @@ fn fs_capture(in: VsOut) {
 fn node_frag(node: Node, link: u32, px: u32) -> Frag {
     let s = shading[node.prim];
     let at = vec2<f32>(pixel_position(px)) + 0.5;
-    let ndc = vec2<f32>(at.x * 2.0 / f32(frame.size.x) - 1.0, 1.0 - at.y * 2.0 / f32(frame.size.y));
+    let fa = frame_xy(at);
+    let ndc = vec2<f32>(fa.x * 2.0 / f32(frame.size.x) - 1.0, 1.0 - fa.y * 2.0 / f32(frame.size.y));
     let b = barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
     var f: VsOut;
     f.clip = vec4<f32>(at, node.depth, 1.0);

@@ -53,9 +53,10 @@ fn fs_capture(raw: VsOut) {
         return;
     }
     let blk = blocks[in.prim];
-    // Offsets inside the box; left of or above it they wrap to large values.
-    let x = u32(in.clip.x) - (blk.origin & 0xffffu);
-    let y = u32(in.clip.y) - (blk.origin >> 16u);
+    // Offsets inside the box (in frame pixels); left of or above it they wrap to large values.
+    let at = vec2<u32>(frame_xy(in.clip.xy));
+    let x = at.x - (blk.origin & 0xffffu);
+    let y = at.y - (blk.origin >> 16u);
     let w = blk.extent & 0xffffu;
     if x >= w || y >= (blk.extent >> 16u) {
         atomicAdd(&alloc.escaped, 1u); // the bound was not conservative: reported as an error

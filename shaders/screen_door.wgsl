@@ -8,7 +8,7 @@ const BAYER: array<u32, 16> = array<u32, 16>(0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 
 @fragment
 fn fs_door(raw: VsOut) -> @location(0) vec4<f32> {
     let in = shaded(raw);
-    let p = vec2<u32>(in.clip.xy);
+    let p = vec2<u32>(frame_xy(in.clip.xy)); // the frame's pattern, whatever the tile
     let threshold = (f32(BAYER[(p.y % 4u) * 4u + p.x % 4u]) + 0.5) / 16.0;
     if in.color.a <= threshold {
         discard;

@@ -40,7 +40,7 @@ fn fs_depth(raw: VsOut) {
     }
     let px = pixel_index(in.clip);
     // The noise follows the frame's pixel, not the tile's, so tiles do not change it.
-    let at = vec2<u32>(in.clip.xy);
+    let at = vec2<u32>(frame_xy(in.clip.xy));
     let frame_px = at.y * frame.size.x + at.x;
     let key = ~bitcast<u32>(in.clip.z);
     for (var s = 0u; s < SAMPLES; s++) {

@@ -6,10 +6,13 @@ struct FrameUniform {
     size: vec2<u32>,
     triangle_count: u32,
     seed: u32,
-    // The screen tile this pass renders (the whole frame unless the renderer tiles): per-pixel
-    // storage is indexed within it, and passes are scissored to it.
+    // The screen tile this pass renders (the whole frame unless the renderer tiles), in its
+    // targets' pixels: per-pixel storage is indexed within it, and passes are scissored to it.
+    // The targets' pixel (0, 0) is the frame's pixel target_origin (tile-sized targets, tiles.rs).
     tile_origin: vec2<u32>,
     tile_size: vec2<u32>,
+    target_origin: vec2<u32>,
+    pad: vec2<u32>,
     // Shading (common/shading.wgsl): the inverse view-projection for a pixel's eye direction,
     // ambient RGB (w = 0, the factor of the shading-cost loop's result), the lights. Whether a
     // mesh is shaded, the light count and the shading-cost loop count are the constants SHADED,
@@ -83,15 +86,21 @@ fn scene_position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
 }
 
-// Index of a fragment's pixel in per-pixel storage: row-major within the tile.
+// Index of a fragment's pixel in per-pixel storage: row-major within the tile. Positions from
+// the rasterizer are in the targets' pixels (the frame's viewport moved by target_origin).
 fn pixel_index(pos: vec4<f32>) -> u32 {
     let p = vec2<u32>(pos.xy) - frame.tile_origin;
     return p.y * frame.tile_size.x + p.x;
 }
 
-// The frame position of pixel index `px` (the inverse of pixel_index).
+// The target position of pixel index `px` (the inverse of pixel_index).
 fn pixel_position(px: u32) -> vec2<u32> {
     return frame.tile_origin + vec2<u32>(px % frame.tile_size.x, px / frame.tile_size.x);
+}
+
+// The frame position of a target position (pixels): where the pixel is in the whole picture.
+fn frame_xy(at: vec2<f32>) -> vec2<f32> {
+    return at + vec2<f32>(frame.target_origin);
 }
 
 // Pixel index of a compute invocation laid over the tile; `OUTSIDE` past its edges.

@@ -21,8 +21,8 @@ struct PixelBox {
 
 fn pixel_box(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>) -> PixelBox {
     let size = vec2<f32>(frame.size);
-    let first = vec2<i32>(frame.tile_origin);
-    let last = vec2<i32>(frame.tile_origin + frame.tile_size) - 1;
+    let first = vec2<i32>(frame.tile_origin + frame.target_origin);
+    let last = vec2<i32>(frame.tile_origin + frame.target_origin + frame.tile_size) - 1;
     if c0.w <= 0.0 || c1.w <= 0.0 || c2.w <= 0.0 {
         return PixelBox(first, last);
     }

@@ -29,8 +29,9 @@ fn texture_sample(first: u32, size: vec2<i32>, uv: vec2<f32>) -> vec4<f32> {
 
 //!endif
 
-// Unit vector from a frame position (pixels) towards the eye: the pixel's ray, reversed.
-fn to_eye(at: vec2<f32>) -> vec3<f32> {
+// Unit vector from a target position (pixels) towards the eye: the pixel's ray, reversed.
+fn to_eye(tile_at: vec2<f32>) -> vec3<f32> {
+    let at = frame_xy(tile_at);
     let ndc = vec2<f32>(at.x * 2.0 / f32(frame.size.x) - 1.0, 1.0 - at.y * 2.0 / f32(frame.size.y));
     let near = frame.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
     let far = frame.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);

@@ -12,9 +12,13 @@ pub struct FrameUniform {
     pub size: [u32; 2],
     pub triangle_count: u32,
     pub seed: u32,
-    /// The screen tile a pass renders: per-pixel storage is indexed within it.
+    /// The screen tile a pass renders, in its targets' pixels: per-pixel storage is indexed
+    /// within it.
     pub tile_origin: [u32; 2],
     pub tile_size: [u32; 2],
+    /// The frame pixel of the targets' pixel (0, 0): (0, 0) unless the targets are tile-sized.
+    pub target_origin: [u32; 2],
+    pub pad: [u32; 2],
     /// The inverse of `view_proj`: the eye direction of a pixel (shaders/common/shading.wgsl).
     pub inv_view_proj: [[f32; 4]; 4],
     /// Ambient RGB; w is 0, a factor the shading-cost loop's result is multiplied by.

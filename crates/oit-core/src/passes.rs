@@ -30,19 +30,20 @@ pub fn capture_into<'e>(
     })
 }
 
-/// A pass that draws over the opaque scene: the base color is copied to the output first, and
-/// the pass blends into it against `depth` (read-only with `depth_ops` None).
+/// A pass over `tile` that draws over the opaque scene: the base color is copied to the output
+/// first, and the pass blends into it against `depth` (read-only with `depth_ops` None).
 pub fn over_base_pass<'e>(
     enc: &'e mut wgpu::CommandEncoder,
     label: &str,
     targets: &'e crate::targets::Targets,
     depth: &'e wgpu::TextureView,
     depth_ops: Option<wgpu::Operations<f32>>,
+    tile: crate::tiles::Tile,
     timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
 ) -> wgpu::RenderPass<'e> {
     let out = &targets.out_texture;
     enc.copy_texture_to_texture(targets.base_texture.as_image_copy(), out.as_image_copy(), out.size());
-    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
             view: &targets.out,
@@ -54,7 +55,9 @@ pub fn over_base_pass<'e>(
         timestamp_writes: timestamps,
         occlusion_query_set: None,
         multiview_mask: None,
-    })
+    });
+    tile.scissor(&mut pass);
+    pass
 }
 
 /// A resolve's target, kept as it is: the pass writes every pixel of its tile, and the tiles

@@ -1,25 +1,27 @@
-//! The renderer: frame targets, the scene upload cache, the opaque pass, the census of
-//! transparent fragments, and dispatch to the method by name.
+//! The renderer's public entry points: a renderer at one size, its settings, and frames of any
+//! method (averaged over samples when antialiased). The planner (`plan.rs`) decides a frame's
+//! tiles; the executor (`execute.rs`) runs the opaque pass, the census and the method tile by
+//! tile.
+
+mod execute;
+mod plan;
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use crate::antialias;
-use crate::bindings::{COLOR_FORMAT, COUNT_FORMAT};
-use crate::cache::{Draw, Layout, RenderDesc, ShaderKey};
+use crate::cache::Layout;
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
-use crate::gpu_types::{FrameUniform, GpuLight};
-use crate::method::{self, AntialiasMode, FrameCtx, Limits, Method, MethodInfo, MethodReport, ParamValue, Params, Tiling};
-use crate::passes;
-use crate::pipeline;
+use crate::gpu_types::FrameUniform;
+use crate::method::{self, AntialiasMode, Limits, Method, ParamValue};
 use crate::scene::{Camera, Scene};
 use crate::shader::SceneVariant;
-use crate::shading::{Light, Lighting, MAX_LIGHTS};
+use crate::shading::{Light, Lighting};
+use crate::stats::ExtraMerge;
 pub use crate::stats::Stats;
-use crate::targets::{read_buffer, read_rows, SampleTargets, Targets};
-use crate::tiles::{self, Footprint, Tile};
+use crate::targets::Targets;
 use crate::timer::PassTimer;
 use crate::upload::GpuScene;
 
@@ -70,83 +72,23 @@ impl Shared {
     }
 }
 
-/// The opaque pass's pipeline for `variant`: straight color, writes depth.
-fn opaque_pipeline(gpu: &GpuContext, variant: SceneVariant) -> wgpu::RenderPipeline {
-    let desc = RenderDesc {
-        shader: ShaderKey::new("opaque.wgsl", &variant.consts()),
-        entry: "fs_opaque",
-        groups: vec![Layout::Scene],
-        draw: Draw::Geometry { depth: pipeline::depth_write(), samples: 1 },
-        targets: vec![Some(COLOR_FORMAT.into())],
-    };
-    gpu.cache.render(&gpu.device, &desc)
-}
-
-/// How the census counts: by blending into the count target where the adapter blends float32
-/// (one pass, no atomics), else with an atomic a fragment into the counts buffer; a
-/// coverage-mask frame counts with atomics at each sample's coverage.
-#[derive(Clone, Copy, PartialEq)]
-enum CensusKind {
-    Blend,
-    Atomic,
-    Samples,
-}
-
-/// The census pipeline of `kind`. The census reads only positions: its variant is always the
-/// unlit one, whatever the scene.
-fn census_pipeline(gpu: &GpuContext, kind: CensusKind) -> wgpu::RenderPipeline {
-    let variant = SceneVariant::default().consts();
-    let add = wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    };
-    let desc = match kind {
-        CensusKind::Blend => RenderDesc {
-            shader: ShaderKey::new("census.wgsl", &variant),
-            entry: "fs_count",
-            groups: vec![Layout::Scene],
-            draw: Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
-            targets: vec![Some(wgpu::ColorTargetState {
-                format: COUNT_FORMAT,
-                blend: Some(wgpu::BlendState { color: add, alpha: add }),
-                write_mask: wgpu::ColorWrites::RED,
-            })],
-        },
-        CensusKind::Atomic => RenderDesc {
-            shader: ShaderKey::new("census.wgsl", &variant),
-            entry: "fs_census",
-            groups: vec![Layout::Scene, Layout::Targets, Layout::Storage(1)],
-            draw: Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
-            targets: vec![],
-        },
-        CensusKind::Samples => RenderDesc {
-            shader: ShaderKey::new("census_samples.wgsl", &variant),
-            entry: "fs_census",
-            groups: vec![Layout::Scene, Layout::SampleTargets, Layout::Storage(1)],
-            draw: Draw::Geometry { depth: pipeline::raster_only(), samples: COVERAGE_SAMPLES },
-            targets: vec![],
-        },
-    };
-    gpu.cache.render(&gpu.device, &desc)
-}
-
 /// Renders scenes at one size with any registered method.
 pub struct Renderer {
     gpu: Arc<GpuContext>,
     width: u32,
     height: u32,
     shared: Shared,
-    targets: Targets,
+    /// The frame's own targets, at the size of its largest tile (made at the first frame).
+    targets: Option<Targets>,
     scene: Option<((u64, u64), GpuScene)>,
     methods: HashMap<&'static str, Box<dyn Method>>,
     timer: PassTimer,
     limits: Limits,
-    /// Bytes a method may allocate for a frame (tiles keep it within); None: what the adapter's
-    /// bindings allow.
+    /// Bytes a frame may allocate (its method's storage and its own targets and readbacks: tiles
+    /// keep it within); None: what the adapter's bindings allow.
     memory_budget: Option<u64>,
-    /// Made at the first coverage-mask frame.
-    coverage: Option<Coverage>,
+    /// Made at the first coverage-mask frame, at the tile size.
+    coverage: Option<execute::Coverage>,
     /// The lights and ambient term of the scene being rendered (the frame uniform's).
     lights: (Vec<Light>, [f32; 3]),
     /// Extra light evaluations per shaded fragment that leave its color unchanged (docs/shading.md).
@@ -184,10 +126,6 @@ impl Renderer {
         // The census keeps a count per pixel in one storage binding.
         method::check_per_pixel(gpu.max_binding_bytes(), width, height, "the fragment census", 4)?;
         let shared = Shared::new(&gpu);
-        let targets = Targets::new(&gpu, width, height, &shared.targets_layout, &shared.counts_layout);
-        // Allocation failures are reported through the error handler: surface them now,
-        // rather than at the first render.
-        gpu.take_error()?;
         let timer = PassTimer::new(&gpu);
         let limits = Limits { max_binding_bytes: gpu.max_binding_bytes() };
         Ok(Self {
@@ -195,7 +133,7 @@ impl Renderer {
             width,
             height,
             shared,
-            targets,
+            targets: None,
             scene: None,
             methods: HashMap::new(),
             timer,
@@ -246,8 +184,9 @@ impl Renderer {
         Ok(())
     }
 
-    /// Keeps each method's own allocations for a frame within `bytes` (None: what the adapter's
-    /// bindings allow), rendering in screen tiles where needed (docs/methods.md, "Tiles").
+    /// Keeps what a frame allocates (the method's storage, the frame's targets and readbacks)
+    /// within `bytes` (None: what the adapter's bindings allow), rendering in screen tiles where
+    /// needed (docs/methods.md, "Tiles"). Under a budget no method keeps storage between frames.
     pub fn set_memory_budget(&mut self, bytes: Option<u64>) -> Result<()> {
         if bytes.is_some_and(|b| b < 1024) {
             return Err(invalid!("memory_budget must be at least 1024 bytes, got {}", bytes.unwrap_or(0)));
@@ -336,6 +275,7 @@ impl Renderer {
         let mut bound: Option<Vec<f64>> = None;
         let mut depth_complexity = Vec::new();
         let mut stats = Stats::default();
+        let mut extra = ExtraMerge::default();
         for (i, offset) in offsets.iter().enumerate() {
             let jittered = camera.jittered(*offset, self.width, self.height);
             let f = self.render_sample(&jittered, info, &params, background, false)?;
@@ -362,8 +302,9 @@ impl Renderer {
                 stats.tiles += s.tiles;
                 stats.pass_times_ms.extend(s.pass_times_ms);
             }
-            stats.extra = s.extra;
+            extra.add(&s.extra, 1.0);
         }
+        stats.extra = extra.finish();
         let n = offsets.len() as f64;
         stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
         stats.antialias = antialias;
@@ -380,213 +321,6 @@ impl Renderer {
         })
     }
 
-    /// One frame with the pixel centers where `camera` puts them (the scene is uploaded); with
-    /// `coverage`, a coverage-mask frame at COVERAGE_SAMPLES samples a pixel.
-    fn render_sample(
-        &mut self,
-        camera: &Camera,
-        info: &'static MethodInfo,
-        params: &Params,
-        background: [f32; 3],
-        coverage: bool,
-    ) -> Result<Frame> {
-        let start = Instant::now();
-        let gpu = self.gpu.clone();
-        if coverage && self.coverage.is_none() {
-            self.coverage = Some(Coverage::new(&gpu, self.width, self.height));
-            gpu.take_error()?;
-        }
-        let cov = if coverage { self.coverage.as_ref() } else { None };
-        let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
-        let census = info.census || self.census;
-        self.opaque_and_census(gpu_scene, camera, background, cov, census);
-        let depth_complexity = match census {
-            true => self.read_census(coverage)?,
-            false => Vec::new(),
-        };
-        let max_depth_complexity = depth_complexity.iter().copied().max().unwrap_or(0);
-        let fragments: u64 = depth_complexity.iter().map(|&c| c as u64).sum();
-
-        let limits = self.limits;
-        let variant = self.variant(gpu_scene);
-        // Out of the map while it renders, so that the loop can set each tile's uniform.
-        let mut method = self.methods.remove(info.name).unwrap_or_else(|| info.instantiate(&gpu, &limits));
-        // Tiles planned from the census; a method whose storage proves larger than planned (pall's
-        // pool follows its triangles' bounding boxes, not the fragments) is planned again with
-        // the budget divided by how far it went over.
-        let mut squeeze = 1.0f64;
-        let (tiles, report, pass_times) = loop {
-            let tiles = self.plan_tiles(info, params, &depth_complexity, coverage, squeeze)?;
-            let mut report = MethodReport::default();
-            let mut pass_times: Option<Vec<(&'static str, f64)>> = None;
-            for tile in &tiles {
-                let counts: std::borrow::Cow<[u32]> = match tiles.len() {
-                    _ if !census => (&[] as &[u32]).into(),
-                    1 => depth_complexity.as_slice().into(),
-                    _ => tile.crop(&depth_complexity, self.width).into(),
-                };
-                self.set_uniform(camera, gpu_scene, background, *tile);
-                self.timer.reset();
-                let mut cx = FrameCtx {
-                    gpu: &gpu,
-                    scene: gpu_scene,
-                    camera,
-                    targets: &self.targets,
-                    timer: &mut self.timer,
-                    params,
-                    tile: *tile,
-                    max_depth_complexity: counts.iter().copied().max().unwrap_or(0),
-                    frame_max_depth_complexity: max_depth_complexity,
-                    fragments: counts.iter().map(|&c| c as u64).sum(),
-                    depth_complexity: &counts,
-                    frame_uniform: &self.shared.uniform,
-                    limits: self.limits,
-                    coverage: cov.map(|c| &c.targets),
-                    variant,
-                };
-                let r = method.render(&mut cx)?;
-                if let Some(short) = r.pool_short {
-                    report.pool_short = Some(report.pool_short.unwrap_or(1.0).max(short));
-                    break;
-                }
-                if let Some(t) = self.timer.read(&gpu)? {
-                    pass_times.get_or_insert_with(Vec::new).extend(t);
-                }
-                report.memory_bytes = report.memory_bytes.max(r.memory_bytes);
-                report.overflow_fragments += r.overflow_fragments;
-                report.error_bound |= r.error_bound;
-                for (k, v) in r.extra {
-                    match report.extra.iter_mut().find(|(name, _)| *name == k) {
-                        // Counts add up over tiles; auto's k and the like keep their largest.
-                        Some((_, total)) if k.ends_with("_k") || k == "auto_exact" || k == "resolve_sweeps" => *total = total.max(v),
-                        Some((_, total)) => *total += v,
-                        None => report.extra.push((k, v)),
-                    }
-                }
-            }
-            if let Some(short) = report.pool_short {
-                if squeeze < 1e6 {
-                    squeeze *= 1.25 * short;
-                    continue;
-                }
-            }
-            match self.memory_budget {
-                Some(budget) if report.memory_bytes > budget && squeeze < 1e6 => {
-                    squeeze *= 1.25 * report.memory_bytes as f64 / budget as f64;
-                }
-                Some(budget) if report.memory_bytes > budget => {
-                    self.methods.insert(info.name, method);
-                    return Err(OitError::OutOfMemory(format!(
-                        "'{}' needed {} bytes in its smallest tiles, past the memory_budget of {budget} bytes: raise \
-                         memory_budget or use a bounded method (e.g. hybrid)",
-                        info.name, report.memory_bytes
-                    )));
-                }
-                _ => break (tiles, report, pass_times),
-            }
-        };
-        self.methods.insert(info.name, method);
-        self.set_camera(camera, gpu_scene, background);
-        let t = &self.targets;
-        let image = read_rows(&gpu, &t.out_texture, &t.image_readback, 16)?;
-        let error_bound = if report.error_bound { Some(read_rows(&gpu, &t.bound_texture, &t.bound_readback, 4)?) } else { None };
-        let target_bytes = self.targets.bytes() + cov.map_or(0, |c| c.targets.bytes());
-        let scene_bytes = gpu_scene.transparent.bytes + gpu_scene.opaque.bytes;
-        let stats = Stats {
-            method: info.name.to_string(),
-            params: params.clone(),
-            census,
-            fragments,
-            max_depth_complexity,
-            memory_bytes: report.memory_bytes,
-            target_bytes,
-            scene_bytes,
-            gpu_time_ms: pass_times.as_ref().map(|p| p.iter().map(|(_, t)| t).sum()),
-            pass_times_ms: pass_times.unwrap_or_default(),
-            overflow_fragments: report.overflow_fragments,
-            wall_time_ms: start.elapsed().as_secs_f64() * 1e3,
-            extra: report.extra,
-            antialias: 1,
-            antialias_mode: AntialiasMode::Frames,
-            tiles: tiles.len() as u32,
-            geometry_chunks: gpu_scene.transparent.chunks.len() as u32,
-            peak_memory_bytes: report.memory_bytes + target_bytes + scene_bytes,
-            ..Default::default()
-        };
-        Ok(Frame { width: self.width, height: self.height, image, depth_complexity, error_bound, stats })
-    }
-
-    /// The screen tiles `info`'s method renders this frame in: one unless its storage would pass
-    /// a binding or the memory budget (docs/methods.md, "Tiles").
-    fn plan_tiles(&self, info: &MethodInfo, params: &Params, counts: &[u32], coverage: bool, squeeze: f64) -> Result<Vec<Tile>> {
-        let (w, h) = (self.width, self.height);
-        let budget = self.memory_budget.unwrap_or(u64::MAX);
-        // What tiles can make smaller, divided by `squeeze` when a first plan proved too loose.
-        let variable = |rest: u64| if rest == u64::MAX { rest } else { (rest as f64 / squeeze) as u64 };
-        let binding = self.limits.max_binding_bytes;
-        let fp = match info.tiling {
-            Tiling::Whole => {
-                let bytes = info.memory_bytes(w as u64 * h as u64, params, None).unwrap_or(0);
-                if bytes > budget {
-                    return Err(OitError::OutOfMemory(format!(
-                        "'{}' keeps {bytes} bytes of render targets for a {w} x {h} frame, past the memory_budget of {budget} \
-                         bytes, and renders in one piece: raise memory_budget or use a method that tiles (e.g. hybrid)",
-                        info.name
-                    )));
-                }
-                return Ok(vec![Tile::frame(w, h)]);
-            }
-            Tiling::Formula { targets } => {
-                let one = info.memory_bytes(1, params, None).unwrap_or(0);
-                let per_pixel = info.memory_bytes(2, params, None).unwrap_or(0) - one - targets;
-                // Frame-sized render targets, which no tile makes smaller.
-                let shared = targets * w as u64 * h as u64;
-                if shared > 0 && shared >= budget {
-                    return Err(OitError::OutOfMemory(format!(
-                        "'{}' keeps {shared} bytes of frame-sized render targets for a {w} x {h} frame, which no tile \
-                         can make smaller and which pass the memory_budget of {budget} bytes: raise memory_budget",
-                        info.name
-                    )));
-                }
-                // Every buffer of the method within one binding: at most all of a tile's bytes.
-                let fits = binding / per_pixel.max(1);
-                Footprint {
-                    per_pixel,
-                    per_fragment: 0,
-                    budget: variable(budget.saturating_sub(one - per_pixel - targets).saturating_sub(shared)),
-                    max_pixels: fits,
-                    max_fragments: u64::MAX,
-                }
-            }
-            Tiling::Storage { per_pixel, per_fragment, per_triangle } => {
-                // A coverage-mask frame keeps sweep state per sample and a mask per node.
-                let (per_pixel, per_fragment) = if coverage {
-                    (crate::method::lists::pixel_bytes(COVERAGE_SAMPLES), per_fragment + 8)
-                } else {
-                    (per_pixel, per_fragment)
-                };
-                let pool = crate::method::lists::POOL_BINDINGS * (binding / per_fragment);
-                let fixed = per_triangle * self.scene.as_ref().map_or(0, |(_, s)| s.transparent.triangles as u64);
-                if fixed >= budget {
-                    return Err(OitError::OutOfMemory(format!(
-                        "'{}' keeps {per_triangle} bytes for each transparent triangle, {fixed} bytes in all, which no tile \
-                         can make smaller and which pass the memory_budget of {budget} bytes: raise memory_budget or use \
-                         abuffer or sbuffer, which keep nothing per triangle",
-                        info.name
-                    )));
-                }
-                Footprint {
-                    per_pixel,
-                    per_fragment,
-                    budget: variable(budget - fixed),
-                    max_pixels: binding / per_pixel,
-                    max_fragments: (pool as f64 / squeeze) as u64,
-                }
-            }
-        };
-        tiles::plan(w, h, counts, &fp)
-    }
-
     fn upload(&mut self, scene: &Scene) -> Result<()> {
         if self.scene.as_ref().map(|(k, _)| *k) != Some(scene.key()) {
             self.scene = None; // free the old buffers first
@@ -594,25 +328,6 @@ impl Renderer {
             self.scene = Some((scene.key(), s));
         }
         Ok(())
-    }
-
-    /// How this frame's census counts (`CensusKind`).
-    fn census_kind(&self, coverage: bool) -> CensusKind {
-        match coverage {
-            true => CensusKind::Samples,
-            false if !self.atomic_census && self.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) => CensusKind::Blend,
-            false => CensusKind::Atomic,
-        }
-    }
-
-    /// The census's per-pixel counts, row-major.
-    fn read_census(&self, coverage: bool) -> Result<Vec<u32>> {
-        let t = &self.targets;
-        Ok(match self.census_kind(coverage) {
-            // Whole numbers below 2^24, exact in float32.
-            CensusKind::Blend => read_rows(&self.gpu, &t.count_texture, &t.counts_readback, 4)?.iter().map(|&c| c as u32).collect(),
-            _ => bytemuck::pod_collect_to_vec(&read_buffer(&self.gpu, &t.counts_readback, self.width as u64 * self.height as u64 * 4)?),
-        })
     }
 
     /// What `scene`'s passes compile for: its surfaces, its light count (the headlight when it
@@ -624,132 +339,5 @@ impl Renderer {
             textured: scene.textured,
             shading_cost: self.shading_cost,
         }
-    }
-
-    /// Writes the frame uniform for `camera`.
-    fn set_camera(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3]) {
-        self.set_uniform(camera, scene, bg, Tile::frame(self.width, self.height));
-    }
-
-    /// Writes the frame uniform for `camera` and the screen tile `tile`.
-    fn set_uniform(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3], tile: Tile) {
-        let lighting = Lighting::new(&self.lights.0, self.lights.1, camera.view_direction());
-        let mut lights = [GpuLight::default(); MAX_LIGHTS as usize];
-        for (g, (l, radiance)) in lights.iter_mut().zip(&lighting.lights) {
-            g.to_light = l.as_vec3().extend(0.0).to_array();
-            g.radiance = radiance.as_vec3().extend(0.0).to_array();
-        }
-        let a = lighting.ambient.as_vec3();
-        let uniform = FrameUniform {
-            view_proj: camera.matrix_f32().to_cols_array_2d(),
-            background: [bg[0], bg[1], bg[2], 0.0],
-            size: [self.width, self.height],
-            triangle_count: scene.transparent.triangles,
-            seed: 0,
-            tile_origin: [tile.x, tile.y],
-            tile_size: [tile.width, tile.height],
-            inv_view_proj: camera.view_proj.inverse().as_mat4().to_cols_array_2d(),
-            ambient: [a.x, a.y, a.z, 0.0],
-            lights,
-        };
-        self.gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
-    }
-
-    /// Opaque geometry into a base color and depth target (under the current uniform).
-    fn opaque_pass(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        color: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-        bg: [f32; 3],
-    ) {
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("opaque"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: color,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 0.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&opaque_pipeline(&self.gpu, self.variant(scene)));
-        scene.opaque.draw_all(&mut pass);
-    }
-
-    /// The opaque pass under `camera` (for a coverage-mask frame, one per sample position into
-    /// the sample targets), then with `census` the untimed fragment census, copied to its readback.
-    fn opaque_and_census(&self, scene: &GpuScene, camera: &Camera, bg: [f32; 3], coverage: Option<&Coverage>, census: bool) {
-        let t = &self.targets;
-        if let Some(c) = coverage {
-            let offsets = antialias::sample_offsets(c.targets.samples).expect("a supported sample count");
-            for (s, offset) in offsets.iter().enumerate() {
-                self.set_camera(&camera.jittered(*offset, self.width, self.height), scene, bg);
-                let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-                self.opaque_pass(&mut enc, scene, &c.targets.base_layers[s], &c.targets.depth_layers[s], bg);
-                self.gpu.queue.submit([enc.finish()]);
-            }
-        }
-        self.set_camera(camera, scene, bg);
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        if coverage.is_none() {
-            self.opaque_pass(&mut enc, scene, &t.base, &t.depth, bg);
-        }
-        if census {
-            match self.census_kind(coverage.is_some()) {
-                CensusKind::Blend => {
-                    let count = wgpu::RenderPassColorAttachment {
-                        view: &t.count,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
-                    };
-                    let mut pass = passes::capture_into(&mut enc, "census", &t.depth, &[Some(count)], None);
-                    pass.set_pipeline(&census_pipeline(&self.gpu, CensusKind::Blend));
-                    scene.transparent.draw_all(&mut pass);
-                }
-                kind => {
-                    enc.clear_buffer(&t.counts, 0, None);
-                    let (group, depth) = match coverage {
-                        Some(c) => (&c.targets.group, &c.targets.raster_depth),
-                        None => (&t.group, &t.depth),
-                    };
-                    {
-                        let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
-                        pass.set_pipeline(&census_pipeline(&self.gpu, kind));
-                        pass.set_bind_group(1, group, &[]);
-                        pass.set_bind_group(2, &t.counts_group, &[]);
-                        scene.transparent.draw_all(&mut pass);
-                    }
-                    let bytes = t.counts.size().min(t.counts_readback.size());
-                    enc.copy_buffer_to_buffer(&t.counts, 0, &t.counts_readback, 0, bytes);
-                }
-            }
-        }
-        self.gpu.queue.submit([enc.finish()]);
-    }
-}
-
-/// What a coverage-mask frame needs besides the frame targets: the per-sample targets (the
-/// census is multisampled: `census_pipeline`).
-struct Coverage {
-    targets: SampleTargets,
-}
-
-impl Coverage {
-    fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
-        let layout = gpu.cache.layout(&gpu.device, Layout::SampleTargets);
-        Self { targets: SampleTargets::new(gpu, width, height, COVERAGE_SAMPLES, &layout) }
     }
 }

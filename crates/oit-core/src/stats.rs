@@ -18,10 +18,13 @@ pub struct Stats {
     /// Transparent fragments that passed the opaque depth test.
     pub fragments: u64,
     pub max_depth_complexity: u32,
-    /// GPU memory the method allocated for this frame (excludes the shared targets).
+    /// GPU memory the method allocated for this frame (its largest tile's; excludes the frame's
+    /// own targets).
     pub memory_bytes: u64,
-    /// Shared frame targets: base color, depth, output, census counts.
+    /// The frame's own targets and readbacks, at the tile size: base color, depth, output,
+    /// error bound, census counts, and a coverage-mask frame's per-sample targets.
     pub target_bytes: u64,
+    /// The scene's buffers (vertices, indices, materials, textures), apart from the frame's.
     pub scene_bytes: u64,
     pub gpu_time_ms: Option<f64>,
     pub pass_times_ms: Vec<(&'static str, f64)>,
@@ -35,8 +38,9 @@ pub struct Stats {
     pub tiles: u32,
     /// Chunks the transparent geometry was uploaded in (1 unless it passes a binding).
     pub geometry_chunks: u32,
-    /// The most GPU memory the frame held at once: the method's largest tile, the shared
-    /// targets and the scene.
+    /// The most GPU memory the frame allocated at once: the method's largest tile and the
+    /// frame's targets and readbacks (`memory_bytes + target_bytes`), within the memory budget
+    /// when one is set; the scene's own buffers are `scene_bytes`.
     pub peak_memory_bytes: u64,
     /// The adapter's name.
     pub adapter: String,
@@ -141,6 +145,67 @@ impl Stats {
     }
 }
 
+/// How a method's extra number combines over the tiles of a frame and over the samples of an
+/// antialiased frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Merge {
+    /// Counts: they add up.
+    Sum,
+    /// Choices and flags (auto's largest k, whether it fell back): the largest.
+    Max,
+    /// Per-pixel means: weighted by each part's pixels (tiles) or equally (samples).
+    Mean,
+}
+
+/// Every extra number a method reports, with its merge rule: declared once (tests/test_contract.py
+/// checks that every method's extras are here).
+pub const EXTRAS: &[(&str, Merge)] = &[
+    ("tail_fragments", Merge::Sum),
+    ("geometry_passes", Merge::Sum),
+    ("peeled_fragments", Merge::Sum),
+    ("pool_regrown", Merge::Sum),
+    ("resolve_sweeps", Merge::Max),
+    ("pool_nodes", Merge::Sum),
+    ("auto_k", Merge::Max),
+    ("auto_mean_k", Merge::Mean),
+    ("auto_slots", Merge::Sum),
+    ("auto_predicted_k", Merge::Max),
+    ("auto_exact", Merge::Max),
+    ("auto_attempts", Merge::Max),
+];
+
+/// The merge rule of extra `name` (a count unless declared otherwise).
+pub fn merge_rule(name: &str) -> Merge {
+    EXTRAS.iter().find(|(n, _)| *n == name).map_or(Merge::Sum, |(_, m)| *m)
+}
+
+/// Extra numbers of several parts of a frame (tiles or samples), merged by their rules; each part
+/// has a weight (its pixels, or 1 a sample) for the means.
+#[derive(Default)]
+pub(crate) struct ExtraMerge {
+    values: Vec<(&'static str, f64, f64)>,
+}
+
+impl ExtraMerge {
+    pub fn add(&mut self, extra: &[(&'static str, f64)], weight: f64) {
+        for &(name, v) in extra {
+            let rule = merge_rule(name);
+            let x = if rule == Merge::Mean { v * weight } else { v };
+            match self.values.iter_mut().find(|(n, _, _)| *n == name) {
+                Some((_, total, w)) => {
+                    *total = if rule == Merge::Max { total.max(x) } else { *total + x };
+                    *w += weight;
+                }
+                None => self.values.push((name, x, weight)),
+            }
+        }
+    }
+
+    pub fn finish(self) -> Vec<(&'static str, f64)> {
+        self.values.into_iter().map(|(name, v, w)| (name, if merge_rule(name) == Merge::Mean && w > 0.0 { v / w } else { v })).collect()
+    }
+}
+
 /// Named numbers with repeats added up, in the order of first appearance (a pass that ran more
 /// than once: antialiasing samples, auto's attempts).
 fn summed(pairs: &[(&'static str, f64)]) -> Vec<(&'static str, f64)> {
@@ -174,6 +239,16 @@ mod tests {
         let get = |name| entries.iter().find(|(k, _)| *k == name).map(|(_, v)| v.clone()).unwrap();
         assert_eq!(get("fragments"), StatValue::Int(None));
         assert_eq!(get("pass_times_ms"), StatValue::Numbers(vec![("a", 4.0), ("b", 2.0)]));
+    }
+
+    #[test]
+    fn extras_merge_by_their_declared_rules() {
+        let mut m = ExtraMerge::default();
+        m.add(&[("tail_fragments", 3.0), ("auto_k", 4.0), ("auto_mean_k", 2.0)], 100.0);
+        m.add(&[("tail_fragments", 5.0), ("auto_k", 2.0), ("auto_mean_k", 4.0)], 300.0);
+        assert_eq!(m.finish(), vec![("tail_fragments", 8.0), ("auto_k", 4.0), ("auto_mean_k", 3.5)]);
+        let names: Vec<_> = EXTRAS.iter().map(|(n, _)| *n).collect();
+        assert!(names.iter().enumerate().all(|(i, n)| !names[..i].contains(n)), "an extra declared twice");
     }
 
     #[test]

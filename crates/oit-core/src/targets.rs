@@ -127,10 +127,16 @@ impl Targets {
         }
     }
 
-    /// Bytes of the shared targets (base, depth, out, census counts as a buffer and as a
-    /// target, error bound), not counted per method.
+    /// Bytes of the frame's own targets (base, depth, out, census counts as a buffer and as a
+    /// target, error bound) and their readbacks, not counted per method.
     pub fn bytes(&self) -> u64 {
-        self.width as u64 * self.height as u64 * (16 + 4 + 16 + 4 + 4 + 4)
+        Self::bytes_for(self.width, self.height)
+    }
+
+    /// What `Targets::new` allocates at `width` x `height`.
+    pub fn bytes_for(width: u32, height: u32) -> u64 {
+        let readbacks = height as u64 * (padded_row(width, 16) + 2 * padded_row(width, 4)) as u64;
+        width as u64 * height as u64 * (16 + 4 + 16 + 4 + 4 + 4) + readbacks
     }
 }
 
@@ -169,17 +175,6 @@ pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> crate:
     };
     waited?;
     data
-}
-
-/// A texture's pixels, row-major, as f32 (`bytes_per_pixel` / 4 values a pixel).
-pub fn read_rows(
-    gpu: &GpuContext,
-    texture: &wgpu::Texture,
-    readback: &wgpu::Buffer,
-    bytes_per_pixel: u32,
-) -> crate::error::Result<Vec<f32>> {
-    let size = texture.size();
-    read_region(gpu, texture, readback, bytes_per_pixel, Tile::frame(size.width, size.height))
 }
 
 /// The pixels of `tile` of a texture, row-major within the tile, as f32.
@@ -286,5 +281,10 @@ impl SampleTargets {
     /// Bytes: base color and depth per sample, and the multisampled raster depth.
     pub fn bytes(&self) -> u64 {
         self.pixels * self.samples as u64 * (16 + 4 + 4)
+    }
+
+    /// What `SampleTargets::new` allocates at `width` x `height` and `samples`.
+    pub fn bytes_for(width: u32, height: u32, samples: u32) -> u64 {
+        width as u64 * height as u64 * samples as u64 * (16 + 4 + 4)
     }
 }

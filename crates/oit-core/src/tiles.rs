@@ -1,33 +1,57 @@
-//! Screen tiles: a frame whose method storage would pass a storage binding or the memory budget
-//! is rendered as several tiles of the same projection, each pass scissored to its tile and the
-//! method's per-pixel storage indexed within it (shaders/common/scene.wgsl, `pixel_index`), so a
-//! tile rasterizes exactly the fragments it has in the whole frame. Tiles are planned from the
-//! census: bands of whole rows while they fit, a row cut into runs of pixels where one row does
-//! not (docs/methods.md, "Tiles").
+//! Screen tiles: a frame whose storage (the method's, and the frame's own targets and readbacks)
+//! would pass a storage binding or the memory budget is rendered as several tiles of the same
+//! projection. A tile's targets are tile-sized: each pass draws with the frame's viewport moved
+//! by the tile's origin, scissored to the tile, and the method's per-pixel storage is indexed
+//! within it (shaders/common/scene.wgsl, `pixel_index`), so a tile rasterizes the fragments it
+//! has in the whole frame. Tiles are planned from the census: bands of whole rows while they
+//! fit, a row cut into runs of pixels where one row does not (docs/methods.md, "Tiles").
 
 use crate::error::{OitError, Result};
 
-/// A rectangle of pixels: columns x .. x + width, rows y .. y + height.
+/// A rectangle of pixels of a `frame.0` x `frame.1` frame: columns x .. x + width, rows
+/// y .. y + height, drawn into targets whose pixel (0, 0) is the frame's pixel `origin`: (0, 0)
+/// for frame-sized targets, the tile's own first pixel for tile-sized ones.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Tile {
     pub x: u32,
     pub y: u32,
     pub width: u32,
     pub height: u32,
+    pub frame: (u32, u32),
+    pub origin: (u32, u32),
 }
 
 impl Tile {
     pub fn frame(width: u32, height: u32) -> Self {
-        Self { x: 0, y: 0, width, height }
+        Self { x: 0, y: 0, width, height, frame: (width, height), origin: (0, 0) }
+    }
+
+    /// The tile drawn into targets of its own size.
+    pub fn own_targets(self) -> Self {
+        Self { origin: (self.x, self.y), ..self }
     }
 
     pub fn pixels(&self) -> u64 {
         self.width as u64 * self.height as u64
     }
 
-    /// Restricts `pass` to the tile.
+    /// Whether the tile is the whole frame.
+    pub fn is_whole(&self) -> bool {
+        (self.width, self.height) == self.frame
+    }
+
+    /// The tile's rectangle in its targets' pixels.
+    pub fn local(&self) -> Tile {
+        Tile { x: self.x - self.origin.0, y: self.y - self.origin.1, ..*self }
+    }
+
+    /// Restricts `pass` to the tile: the frame's viewport moved by the targets' origin (so every
+    /// fragment lands where it does in the whole frame, less the origin), scissored to the
+    /// tile's pixels.
     pub fn scissor(&self, pass: &mut wgpu::RenderPass<'_>) {
-        pass.set_scissor_rect(self.x, self.y, self.width, self.height);
+        let (ox, oy) = self.origin;
+        pass.set_viewport(-(ox as f32), -(oy as f32), self.frame.0 as f32, self.frame.1 as f32, 0.0, 1.0);
+        pass.set_scissor_rect(self.x - ox, self.y - oy, self.width, self.height);
     }
 
     /// The values of `frame` (row-major, `frame_width` a row) that lie in the tile, row-major.
@@ -40,8 +64,9 @@ impl Tile {
 }
 
 /// What one tile may hold: `per_pixel` bytes for each of its pixels and `per_fragment` bytes for
-/// each of its fragments, at most `budget` bytes in all, and at most `max_pixels` pixels and
-/// `max_fragments` fragments (what the method's bindings hold).
+/// each of its fragments, at most `budget` bytes in all, at most `max_pixels` pixels and
+/// `max_fragments` fragments (what the method's bindings hold), and at most `max_rows` rows (the
+/// frame's targets are sized to the tallest tile).
 #[derive(Clone, Copy, Debug)]
 pub struct Footprint {
     pub per_pixel: u64,
@@ -49,6 +74,7 @@ pub struct Footprint {
     pub budget: u64,
     pub max_pixels: u64,
     pub max_fragments: u64,
+    pub max_rows: u32,
 }
 
 impl Footprint {
@@ -70,19 +96,22 @@ pub fn plan(width: u32, height: u32, counts: &[u32], fp: &Footprint) -> Result<V
         true => vec![0; height as usize],
         false => counts.chunks(width as usize).map(|r| r.iter().map(|&c| c as u64).sum()).collect(),
     };
-    if fp.fits(width as u64 * height as u64, row_fragments.iter().sum()) {
+    if height <= fp.max_rows && fp.fits(width as u64 * height as u64, row_fragments.iter().sum()) {
         return Ok(vec![Tile::frame(width, height)]);
     }
     let mut tiles = Vec::new();
     let mut y = 0;
     while y < height {
         let (mut rows, mut fragments) = (0u32, 0u64);
-        while y + rows < height && fp.fits((rows as u64 + 1) * width as u64, fragments + row_fragments[(y + rows) as usize]) {
+        while y + rows < height
+            && rows < fp.max_rows
+            && fp.fits((rows as u64 + 1) * width as u64, fragments + row_fragments[(y + rows) as usize])
+        {
             fragments += row_fragments[(y + rows) as usize];
             rows += 1;
         }
         if rows > 0 {
-            tiles.push(Tile { x: 0, y, width, height: rows });
+            tiles.push(Tile { x: 0, y, width, height: rows, frame: (width, height), origin: (0, 0) });
             y += rows;
             continue;
         }
@@ -104,7 +133,7 @@ pub fn plan(width: u32, height: u32, counts: &[u32], fp: &Footprint) -> Result<V
                     fp.max_fragments.min(fp.budget.saturating_sub(fp.per_pixel) / fp.per_fragment.max(1))
                 )));
             }
-            tiles.push(Tile { x, y, width: n, height: 1 });
+            tiles.push(Tile { x, y, width: n, height: 1, frame: (width, height), origin: (0, 0) });
             x += n;
         }
         y += 1;
@@ -117,7 +146,7 @@ mod tests {
     use super::*;
 
     fn fp(per_pixel: u64, per_fragment: u64, budget: u64) -> Footprint {
-        Footprint { per_pixel, per_fragment, budget, max_pixels: u64::MAX, max_fragments: u64::MAX }
+        Footprint { per_pixel, per_fragment, budget, max_pixels: u64::MAX, max_fragments: u64::MAX, max_rows: u32::MAX }
     }
 
     fn covers_once(tiles: &[Tile], w: u32, h: u32) {
@@ -141,7 +170,11 @@ mod tests {
     fn bands_of_rows_then_runs_of_pixels() {
         // 4 x 3, 10 bytes a pixel: two rows fit in 80 bytes, one row of 40 plus fragments may not.
         let tiles = plan(4, 3, &[0; 12], &fp(10, 0, 80)).unwrap();
-        assert_eq!(tiles, vec![Tile { x: 0, y: 0, width: 4, height: 2 }, Tile { x: 0, y: 2, width: 4, height: 1 }]);
+        let band = |y, height| Tile { x: 0, y, width: 4, height, frame: (4, 3), origin: (0, 0) };
+        assert_eq!(tiles, vec![band(0, 2), band(2, 1)]);
+        // At most one row a tile: three bands.
+        let tiles = plan(4, 3, &[0; 12], &Footprint { max_rows: 1, ..fp(10, 0, 1000) }).unwrap();
+        assert_eq!(tiles, vec![band(0, 1), band(1, 1), band(2, 1)]);
         let counts = [0, 0, 0, 0, 9, 1, 1, 9, 0, 0, 0, 0];
         let tiles = plan(4, 3, &counts, &fp(1, 10, 100)).unwrap();
         covers_once(&tiles, 4, 3);
@@ -161,6 +194,6 @@ mod tests {
     #[test]
     fn crop_takes_the_tile_row_major() {
         let frame: Vec<u32> = (0..12).collect();
-        assert_eq!(Tile { x: 1, y: 1, width: 2, height: 2 }.crop(&frame, 4), vec![5, 6, 9, 10]);
+        assert_eq!(Tile { x: 1, y: 1, width: 2, height: 2, frame: (4, 3), origin: (0, 0) }.crop(&frame, 4), vec![5, 6, 9, 10]);
     }
 }

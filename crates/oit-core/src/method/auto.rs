@@ -193,7 +193,7 @@ impl Method for Auto {
         while let Some(current) = slots.take() {
             attempts += 1;
             let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current), ktab::Sums::Exact)?;
-            let bound = read_region(cx.gpu, &t.bound_texture, &t.bound_readback, 4, tile)?;
+            let bound = read_region(cx.gpu, &t.bound_texture, &t.bound_readback, 4, tile.local())?;
             let worst = bound.iter().copied().fold(0.0f32, f32::max) as f64;
             hybrid_bytes = report.memory_bytes;
             if worst <= tolerance {
@@ -223,7 +223,7 @@ impl Method for Auto {
             wgpu::TexelCopyTextureInfo {
                 texture: &t.bound_texture,
                 mip_level: 0,
-                origin: wgpu::Origin3d { x: tile.x, y: tile.y, z: 0 },
+                origin: wgpu::Origin3d::ZERO,
                 aspect: wgpu::TextureAspect::All,
             },
             bytemuck::cast_slice(&fill),

@@ -21,7 +21,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
     error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
+    tiling: Tiling::Formula,
     census: false,
     create: |_, _| Box::new(Blend { kind: Kind::Unsorted }),
 };
@@ -115,7 +115,7 @@ impl Method for Blend {
         let t = cx.targets;
         let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
         {
-            let mut pass = passes::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.timer.render_pass("blend"));
+            let mut pass = passes::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.tile, cx.timer.render_pass("blend"));
             pass.set_pipeline(&pipeline);
             for i in order {
                 let m = geo.meshes[i];

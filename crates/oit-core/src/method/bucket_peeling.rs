@@ -22,7 +22,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·(8 + 24·buckets) + 4", bytes: |px, p| memory_bytes(px, p.int("buckets") as u64) },
     error_bound: ErrorBound::None,
-    tiling: Tiling::Formula { targets: 0 },
+    tiling: Tiling::Formula,
     census: false,
     create: |_, _| Box::new(Buckets { buffers: None, dropped: None }),
 };

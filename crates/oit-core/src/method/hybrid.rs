@@ -32,7 +32,7 @@ pub const HYBRID: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::PerPixel,
-    tiling: Tiling::Formula { targets: 0 },
+    tiling: Tiling::Formula,
     census: false,
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
 };

@@ -28,7 +28,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·(8k + 36) + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) },
     error_bound: ErrorBound::PerPixel,
-    tiling: Tiling::Formula { targets: 0 },
+    tiling: Tiling::Formula,
     census: false,
     create: |_, _| Box::new(Hybrid64 { buffers: None, tail: None }),
 };

@@ -119,25 +119,20 @@ impl Memory {
 /// How the renderer plans a method's screen tiles (tiles.rs, docs/methods.md "Tiles").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tiling {
-    /// By its memory formula (`Memory::Frame`): bytes grow with the tile's pixels, except
-    /// `targets` bytes a frame pixel of render targets, which are frame-sized and shared by the
-    /// tiles (the formula includes them).
-    Formula { targets: u64 },
+    /// By its memory formula (`Memory::Frame`): bytes grow with the tile's pixels (render
+    /// targets of its own included: like the frame's, they are the tile's size).
+    Formula,
     /// From the census: `per_pixel` bytes a pixel and `per_fragment` bytes a stored fragment
     /// (a node of its pool), the pool spread over `lists::POOL_BINDINGS` bindings, and
     /// `per_triangle` bytes of each transparent triangle, whatever the tile.
     Storage { per_pixel: u64, per_fragment: u64, per_triangle: u64 },
-    /// In one piece: it keeps nothing per pixel, or keeps it in render targets, which are not
-    /// bound as storage (their bytes still count against a memory budget).
-    Whole,
 }
 
 impl Tiling {
     pub fn name(self) -> &'static str {
         match self {
-            Tiling::Formula { .. } => "formula",
+            Tiling::Formula => "formula",
             Tiling::Storage { .. } => "census",
-            Tiling::Whole => "whole",
         }
     }
 }

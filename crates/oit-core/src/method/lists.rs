@@ -348,7 +348,7 @@ impl ListMethod {
         )?;
         // A tile of a larger frame gets a pool of its counted fragments, so that tiles planned
         // within a memory budget stay in it; a whole frame keeps the pool it has while it fits.
-        let tiled = tile != crate::tiles::Tile::frame(cx.targets.width, cx.targets.height);
+        let tiled = !tile.is_whole();
         let initial = match (tiled, self.pool.capacity) {
             (true, _) => cx.fragments.clamp(1, self.pool.max_nodes()),
             (false, 0) => pixels.min(self.pool.max_nodes()),

@@ -29,7 +29,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Formula { targets: 0 },
+    tiling: Tiling::Formula,
     census: true,
     create: |_, _| Box::new(Peel { dual: false, buffers: None, peeled: None }),
 };

@@ -23,7 +23,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·4", bytes: |px, _| memory_bytes(px) },
     error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
+    tiling: Tiling::Formula,
     census: false,
     create: |_, _| Box::new(ScreenDoor { depth: None }),
 };
@@ -61,7 +61,8 @@ impl Method for ScreenDoor {
         enc.copy_texture_to_texture(t.depth_texture.as_image_copy(), depth_tex.as_image_copy(), depth_tex.size());
         {
             let depth_ops = Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store });
-            let mut pass = passes::over_base_pass(&mut enc, "screen door", t, depth_view, depth_ops, cx.timer.render_pass("dither"));
+            let mut pass =
+                passes::over_base_pass(&mut enc, "screen door", t, depth_view, depth_ops, cx.tile, cx.timer.render_pass("dither"));
             pass.set_pipeline(&pipeline);
             cx.scene.transparent.draw_all(&mut pass);
         }

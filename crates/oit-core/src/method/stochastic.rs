@@ -36,7 +36,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Frame { formula: "W·H·(4·samples + 20)", bytes: |px, p| memory_bytes(px, p.int("samples") as u64) },
     error_bound: ErrorBound::None,
-    tiling: Tiling::Formula { targets: super::accum::TARGET_BYTES },
+    tiling: Tiling::Formula,
     census: false,
     create: |_, _| Box::new(Stochastic { samples: None, targets: None }),
 };

@@ -29,7 +29,7 @@ pub const WSUM: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::None,
-    tiling: Tiling::Whole,
+    tiling: Tiling::Formula,
     census: false,
     create: |_, _| Box::new(Weighted::new(Kind::Sum)),
 };
