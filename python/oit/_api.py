@@ -381,8 +381,8 @@ class Stats(TypedDict, total=False):
     fragments: int | None  # transparent fragments in front of the opaque depth (summed over samples); None without a census
     max_depth_complexity: int | None  # the most transparent fragments of a pixel; None without a census
     memory_bytes: int  # what the method allocated (oit.memory_bytes gives its formula)
-    target_bytes: int  # the shared frame targets: base color, depth, output, census, bound
-    scene_bytes: int  # the scene's GPU buffers
+    target_bytes: int  # the frame's targets and readbacks as allocated (tile-sized under a small budget)
+    scene_bytes: int  # the scene's GPU buffers, apart from the frame's
     gpu_time_ms: float | None  # the passes' GPU time; None where the adapter has no timestamp queries
     pass_times_ms: dict[str, float]  # GPU time per pass; a pass run more than once adds up
     overflow_fragments: int  # fragments a bounded structure could not hold
@@ -391,7 +391,7 @@ class Stats(TypedDict, total=False):
     antialias_mode: str  # 'frames' or 'coverage'
     tiles: int  # screen tiles the frame was rendered in (1: untiled), summed over antialiasing samples
     geometry_chunks: int  # chunks the transparent geometry was uploaded in (1 unless it passes a binding)
-    peak_memory_bytes: int  # the most held at once: the method's largest tile, the shared targets, the scene
+    peak_memory_bytes: int  # memory_bytes + target_bytes: all the frame allocated at once, within memory_budget
     adapter: str  # the adapter's name
     extra: dict[str, float]  # method-specific (the schema lists them)
     error_bound_max: float  # the largest of frame.error_bound, where the method derives one
@@ -416,9 +416,11 @@ class Frame:
 class Renderer:
     """Renders scenes at one size. `adapter` (or the OIT_ADAPTER variable) picks an adapter by
     a substring of its name; otherwise a hardware adapter is preferred over a software one.
-    `memory_budget` (bytes) bounds what a method allocates for a frame: where its storage would
-    pass the budget or a storage binding, the frame is rendered in screen tiles
-    (`frame.stats["tiles"]`), with the same image (docs/methods.md, "Tiles")."""
+    `memory_budget` (bytes) bounds everything a frame allocates (the method's storage, the
+    frame's targets and readbacks: `stats["peak_memory_bytes"]`): where that would pass the
+    budget, or the storage a binding, the frame is rendered in screen tiles
+    (`frame.stats["tiles"]`), with the same image, or within float32 rounding of it where the
+    targets themselves are tiled (docs/methods.md, "Tiles")."""
 
     def __init__(self, width: int, height: int, adapter: str | None = None, max_binding_bytes: int | None = None,
                  memory_budget: int | None = None) -> None:

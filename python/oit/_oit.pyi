@@ -36,11 +36,10 @@ class _MemoryInfo(TypedDict):
     formula: str
 
 class _TilingInfo(TypedDict, total=False):
-    kind: Literal["formula", "census", "whole"]
+    kind: Literal["formula", "census"]
     per_pixel: int  # census only: bytes a pixel, a stored fragment, a transparent triangle
     per_fragment: int
     per_triangle: int
-    target_bytes_per_pixel: int  # formula only: frame-sized render targets the tiles share
 
 class _Stats(TypedDict, total=False):
     # crates/oit-core/src/stats.rs, SCHEMA; tests/test_contract.py checks these against it.

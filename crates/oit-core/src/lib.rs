@@ -30,7 +30,7 @@ pub use method::{
     memory_bytes, methods, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, ParamInfo, ParamKind, ParamValue, Params, Tiling,
 };
 pub use reference::{reference, reference_antialiased, ReferenceImage};
-pub use renderer::{coverage_methods, shared_context, Frame, Renderer, COVERAGE_SAMPLES};
+pub use renderer::{coverage_methods, shared_context, Frame, Renderer, Target, COVERAGE_SAMPLES};
 pub use scene::{Camera, Mesh, Scene};
 pub use shading::{Light, Material, Shading, Texture, MAX_LIGHTS};
 pub use stats::Stats;

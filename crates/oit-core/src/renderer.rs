@@ -4,7 +4,10 @@
 //! tile.
 
 mod execute;
+mod into;
 mod plan;
+
+pub use into::Target;
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -15,7 +18,7 @@ use crate::cache::Layout;
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
 use crate::gpu_types::FrameUniform;
-use crate::method::{self, AntialiasMode, Limits, Method, ParamValue};
+use crate::method::{self, AntialiasMode, Limits, Method, MethodInfo, ParamValue, Params};
 use crate::scene::{Camera, Scene};
 use crate::shader::SceneVariant;
 use crate::shading::{Light, Lighting};
@@ -97,6 +100,8 @@ pub struct Renderer {
     census: bool,
     /// Whether the census counts with atomics even where the adapter blends float32.
     atomic_census: bool,
+    /// The caller's textures while `render_into` renders into them.
+    into: Option<into::IntoTarget>,
 }
 
 /// One device per adapter choice, shared by every renderer in the process.
@@ -144,6 +149,7 @@ impl Renderer {
             shading_cost: 0,
             census: false,
             atomic_census: false,
+            into: None,
         })
     }
 
@@ -238,12 +244,7 @@ impl Renderer {
     ) -> Result<Frame> {
         let start = Instant::now();
         let offsets = antialias::sample_offsets(antialias)?;
-        let info = method::lookup(method_name)?;
-        let params = info.resolve_params(params)?;
-        method::check_features(info, &self.gpu)?;
-        if background.iter().any(|c| !c.is_finite() || !(0.0..=1.0).contains(c)) {
-            return Err(invalid!("background {background:?} must be three linear RGB values in [0, 1]"));
-        }
+        let (info, params) = self.prepare(scene, method_name, params, background)?;
         let coverage = mode == AntialiasMode::Coverage && antialias > 1;
         if coverage {
             if !info.antialias_modes.contains(&AntialiasMode::Coverage) {
@@ -260,8 +261,6 @@ impl Renderer {
                 ));
             }
         }
-        self.upload(scene)?;
-        self.lights = (scene.lights().to_vec(), scene.ambient());
         if offsets.len() == 1 || coverage {
             let mut frame = self.render_sample(camera, info, &params, background, coverage)?;
             frame.stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -319,6 +318,25 @@ impl Renderer {
             error_bound,
             stats,
         })
+    }
+
+    /// The method and its parameters, checked, with the scene uploaded and its lights taken.
+    fn prepare(
+        &mut self,
+        scene: &Scene,
+        method_name: &str,
+        params: &[(String, ParamValue)],
+        background: [f32; 3],
+    ) -> Result<(&'static MethodInfo, Params)> {
+        let info = method::lookup(method_name)?;
+        let params = info.resolve_params(params)?;
+        method::check_features(info, &self.gpu)?;
+        if background.iter().any(|c| !c.is_finite() || !(0.0..=1.0).contains(c)) {
+            return Err(invalid!("background {background:?} must be three linear RGB values in [0, 1]"));
+        }
+        self.upload(scene)?;
+        self.lights = (scene.lights().to_vec(), scene.ambient());
+        Ok((info, params))
     }
 
     fn upload(&mut self, scene: &Scene) -> Result<()> {

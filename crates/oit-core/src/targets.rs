@@ -76,7 +76,8 @@ impl Targets {
         let d = &gpu.device;
         use wgpu::TextureUsages as U;
         let base_texture = texture(d, "base", width, height, COLOR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
-        let depth_texture = texture(d, "depth", width, height, DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
+        let depth_texture =
+            texture(d, "depth", width, height, DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST);
         let out_texture =
             texture(d, "out", width, height, COLOR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST);
         let bound_texture = texture(d, "error bound", width, height, BOUND_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC | U::COPY_DST);

@@ -100,8 +100,10 @@ struct FrameArrays {
 }
 
 impl FrameArrays {
-    fn new(width: u32, height: u32) -> Self {
-        Self { width, image: vec![0.0; width as usize * height as usize * 4], bound: None }
+    /// Arrays for a `width` x `height` frame (none for a frame into a caller's texture).
+    fn new(width: u32, height: u32, read: bool) -> Self {
+        let pixels = if read { width as usize * height as usize } else { 0 };
+        Self { width, image: vec![0.0; pixels * 4], bound: None }
     }
 
     /// Copies `values` (`tile`'s pixels row-major, `channels` a pixel) into `frame` at the tile.
@@ -164,6 +166,11 @@ impl Renderer {
             self.methods.insert(info.name, method);
         }
         let (tiles, report, pass_times, arrays) = result?;
+        if let (Some(into), Some(t)) = (&self.into, &self.targets) {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            self.blit(&mut enc, &t.out, &into.color);
+            gpu.queue.submit([enc.finish()]);
+        }
         let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
         self.set_uniform(camera, gpu_scene, background, Tile::frame(w, h));
         let target_bytes = self.held_target_bytes();
@@ -212,6 +219,14 @@ impl Renderer {
         let mut squeeze = 1.0f64;
         loop {
             let plan = self.plan_tiles(info, params, counts, coverage, squeeze)?;
+            if self.into.is_some() && plan.targets != (w, h) {
+                return Err(OitError::OutOfMemory(format!(
+                    "render_into draws into frame-sized targets ({} bytes at {w} x {h}), which the memory_budget of {} bytes \
+                     cannot hold beside the method: raise memory_budget, or render() in tiles",
+                    Self::target_bytes(w, h, coverage),
+                    self.memory_budget.unwrap_or(0)
+                )));
+            }
             let tiles = plan.tiles;
             if self.ensure_targets(plan.targets.0, plan.targets.1, coverage)? {
                 drawn = None;
@@ -219,7 +234,7 @@ impl Renderer {
             let mut report = MethodReport::default();
             let mut extra = ExtraMerge::default();
             let mut pass_times: Option<Vec<(&'static str, f64)>> = None;
-            let mut arrays = FrameArrays::new(w, h);
+            let mut arrays = FrameArrays::new(w, h, self.into.is_none());
             for tile in &tiles {
                 let tile_counts: std::borrow::Cow<[u32]> = match tiles.len() {
                     _ if counts.is_empty() => (&[] as &[u32]).into(),
@@ -302,8 +317,8 @@ impl Renderer {
             self.targets = Some(Targets::new(&self.gpu, width, height, &self.shared.targets_layout, &self.shared.counts_layout));
             made = true;
         }
-        if !coverage && self.coverage.as_ref().is_some_and(|c| c.size != (width, height)) {
-            self.coverage = None;
+        if !coverage {
+            self.coverage = None; // a frame holds only the targets it uses
         }
         if coverage && self.coverage.as_ref().is_none_or(|c| c.size != (width, height)) {
             self.coverage = None;
@@ -317,9 +332,13 @@ impl Renderer {
         Ok(made)
     }
 
-    /// Reads `tile`'s output (and its error bound, with `bound`) into the frame's arrays.
+    /// Reads `tile`'s output (and its error bound, with `bound`) into the frame's arrays; a
+    /// frame into a caller's texture is copied there instead, once whole.
     fn read_tile(&self, tile: Tile, bound: bool, arrays: &mut FrameArrays) -> Result<()> {
         let t = self.targets.as_ref().expect("made by ensure_targets");
+        if self.into.is_some() {
+            return Ok(());
+        }
         let image = read_region(&self.gpu, &t.out_texture, &t.image_readback, 16, tile.local())?;
         FrameArrays::place(&mut arrays.image, arrays.width, tile, &image, 4);
         if bound {
@@ -377,23 +396,34 @@ impl Renderer {
         self.gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
-    /// Opaque geometry into a base color and depth target over `tile` (under the current uniform).
+    /// Opaque geometry into a base color and depth target over `tile` (under the current
+    /// uniform), over the background or, in a frame into a caller's texture with its depth, over
+    /// the caller's picture and depth.
     fn opaque_pass(&self, enc: &mut wgpu::CommandEncoder, tile: Tile, color: &wgpu::TextureView, depth: &wgpu::TextureView, bg: [f32; 3]) {
         let (_, scene) = self.scene.as_ref().expect("uploaded by the caller");
+        let over = self.into.as_ref().and_then(|i| i.depth.as_ref().map(|d| (&i.color, d)));
+        let (color_load, depth_load) = match over {
+            Some((picture, caller_depth)) => {
+                let t = self.targets.as_ref().expect("made by ensure_targets");
+                enc.copy_texture_to_texture(caller_depth.as_image_copy(), t.depth_texture.as_image_copy(), caller_depth.size());
+                self.blit(enc, &picture.create_view(&Default::default()), &t.base_texture);
+                (wgpu::LoadOp::Load, wgpu::LoadOp::Load)
+            }
+            None => {
+                (wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 0.0 }), wgpu::LoadOp::Clear(1.0))
+            }
+        };
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("opaque"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: color,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 0.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
+                ops: wgpu::Operations { load: color_load, store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                depth_ops: Some(wgpu::Operations { load: depth_load, store: wgpu::StoreOp::Store }),
                 stencil_ops: None,
             }),
             timestamp_writes: None,

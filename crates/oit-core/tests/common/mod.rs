@@ -1,0 +1,2 @@
+//! Helpers shared by the GPU tests and the examples.
+pub mod caller;
