@@ -80,6 +80,7 @@ class _MethodInfo(TypedDict):
     error_bound: Literal["exact", "per_pixel", "none"]
     tiling: _TilingInfo
     census: bool  # whether it plans from the fragment census (and so always runs it)
+    main: str | None  # the int parameter its trade moves along (what `oit compare` sweeps)
 
 @final
 class Scene:

@@ -105,28 +105,11 @@ def _add_render(p: argparse.ArgumentParser) -> None:
     p.add_argument("--adapter", default=None, help="substring of the adapter name (default: OIT_ADAPTER or the best one)")
 
 
-def load_for_viewing(args: argparse.Namespace) -> Any:
-    """The file of `render` and `compare` through the core's loader, with the command line's
-    alpha (--alpha, or 0.4 for every mesh when nothing is transparent: said on stdout) and
-    lighting (--light, --ambient)."""
-    from ._api import load_file
-
-    scene, note = load_file(args.file, args.alpha, shading=args.shading, specular=args.specular, viewing=True)
-    if note:
-        print(f"{args.file}: {note}")
-    for light in args.light:
-        scene.add_light(light)
-    scene.ambient = tuple(args.ambient)
-    return scene
-
-
 def _render(args: argparse.Namespace) -> int:
     from ._api import Renderer
     from .imageio import write_png
-    from .views import fit_camera, orbit_cameras
+    from .views import fit_camera, load_for_viewing, orbit_cameras
 
-    if args.specular < 0:
-        raise ValueError(f"--specular must be >= 0, got {args.specular}")
     stem = os.path.splitext(os.path.basename(args.file))[0]
     if args.orbit is not None:
         from .sequence import check_animation_path
@@ -169,6 +152,27 @@ def _render(args: argparse.Namespace) -> int:
     print(f"  adapter: {s['adapter']}")
     print(f"wrote {output}")
     return 0
+
+
+# ---- compare
+
+
+def _add_compare(p: argparse.ArgumentParser) -> None:
+    from .comparison import add_arguments
+
+    p.add_argument("file", help="a mesh file: OBJ (with its MTL), glTF, GLB, PLY or STL (docs/loading.md)")
+    p.add_argument("--alpha", type=_unit_float, default=None,
+                   help="make every mesh transparent at this alpha (default: the file's; 0.4 when nothing is transparent)")
+    p.add_argument("--shading", choices=("smooth", "flat", "unlit"), default="smooth", help="(default: %(default)s)")
+    p.add_argument("--specular", type=float, default=0.25, help="Blinn-Phong highlight weight (default: %(default)s)")
+    add_arguments(p)
+
+
+def _compare(args: argparse.Namespace) -> int:
+    from .comparison import run_cli
+    from .views import load_for_viewing
+
+    return run_cli(args, load_for_viewing(args))
 
 
 # ---- methods
@@ -267,6 +271,8 @@ Subcommand = tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable
 SUBCOMMANDS: Sequence[Subcommand] = (
     ("demo", "render the built-in scene with every blending method and their errors into one PNG", _add_demo, _demo),
     ("render", "render a mesh file with one method into a PNG", _add_render, _render),
+    ("compare", "every method on a mesh file of yours: time, memory, error, and the cheapest that meets your limits",
+     _add_compare, _compare),
     ("methods", "list the methods with their properties and parameters", _add_methods, _methods),
     ("bench", "time, memory and error of every method against the exact A-buffer", _add_bench, _bench),
     ("view", "open meshes or a built-in scene in the interactive viewer (crates/oit-viewer)", _add_view, _view),

@@ -1,14 +1,15 @@
-"""Cameras for a scene nobody placed one in: one that frames its bounding box, and N views
-around it (an orbit about the vertical axis through the box's center), for `python -m oit
-render` and `compare`."""
+"""Mesh files and cameras for the command line's `render` and `compare`: the file with the
+command line's alpha and lights, a camera that frames the bounding box, and N views around it
+(an orbit about the vertical axis through the box's center)."""
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
-from ._api import Camera, Scene
+from ._api import Camera, Scene, load_file
 
 # The direction the default view looks from (towards the scene), as Camera.fit has it.
 DIRECTION = (0.3, 0.35, 1.0)
@@ -48,3 +49,18 @@ def scene_views(scene: Scene, views: int | None, aspect: float = 1.0) -> list[Ca
     if views is None and scene.cameras:
         return [c.camera(aspect) for c in scene.cameras]
     return orbit_cameras(scene, 3 if views is None else views, aspect)
+
+
+def load_for_viewing(args: Any) -> Scene:
+    """The FILE of `render` and `compare` through the core's loader, with the command line's
+    alpha (--alpha, or 0.4 for every mesh when nothing is transparent: said on stdout) and
+    lighting (--light, --ambient where the command has them)."""
+    if args.specular < 0:
+        raise ValueError(f"--specular must be >= 0, got {args.specular}")
+    scene, note = load_file(args.file, args.alpha, shading=args.shading, specular=args.specular, viewing=True)
+    if note:
+        print(f"{args.file}: {note}")
+    for light in getattr(args, "light", []):
+        scene.add_light(light)
+    scene.ambient = tuple(getattr(args, "ambient", (0.1, 0.1, 0.1)))
+    return scene

@@ -396,6 +396,7 @@ fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         }
         d.set_item("tiling", tiling)?;
         d.set_item("census", m.census)?;
+        d.set_item("main", m.main)?;
         let params = PyList::empty(py);
         for p in m.params {
             let pd = PyDict::new(py);

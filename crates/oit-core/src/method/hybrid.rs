@@ -34,6 +34,7 @@ pub const HYBRID: MethodInfo = MethodInfo {
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Formula { targets: 0 },
     census: false,
+    main: Some("k"),
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
 };
 
