@@ -147,3 +147,23 @@ def test_bad_arguments(tmp_path):
         oit.Scene.from_file(path, shading="phong")
     done = run_oit("render", str(tmp_path / "nope.glb"), cwd=tmp_path)
     assert done.returncode == 2 and "no such file" in done.stderr
+
+
+def test_obj_textures_map_kd_and_map_d(tmp_path, renderer):
+    """map_Kd (sRGB) times map_d (its first channel as alpha) on the file's UVs (v up the image)."""
+    from oit.imageio import encode_png
+
+    color = np.zeros((1, 2, 4), np.uint8)
+    color[0, 0], color[0, 1] = (255, 0, 0, 255), (0, 0, 255, 255)
+    (tmp_path / "kd.png").write_bytes(encode_png(color))
+    (tmp_path / "d.png").write_bytes(encode_png(np.full((1, 1, 4), 128, np.uint8)))
+    (tmp_path / "t.mtl").write_text("newmtl t\nKd 1 1 1\nmap_Kd kd.png\nmap_d d.png\n")
+    (tmp_path / "t.obj").write_text("mtllib t.mtl\nusemtl t\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                                    "vt 0.25 0\nvt 0.25 0\nvt 0.25 1\nvt 0.25 1\nf 1/1 2/2 3/3 4/4\n")
+    scene = oit.Scene.from_file(tmp_path / "t.obj", shading="unlit")
+    (m,) = scene.materials
+    assert m["textured"] and m["has_uvs"] and not m["opaque"]
+    camera = oit.Camera.look_at((0, 0, 3), (0, 0, 0), fov_y=30.0, near=1.0, far=5.0)
+    frame = renderer(SIZE, SIZE).render(scene, camera, "abuffer", background=(0.0, 0.0, 0.0))
+    # u = 0.25 is the red texel's center; alpha 128/255 from map_d, over black.
+    assert np.allclose(frame.image[SIZE // 2, SIZE // 2, :3], [128 / 255, 0, 0], atol=1e-6)

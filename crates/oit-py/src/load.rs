@@ -41,22 +41,22 @@ pub fn load_file<'py>(
         let d = PyDict::new(py);
         d.set_item("name", &c.name)?;
         d.set_item("view", c.view.to_vec())?;
-        match c.projection {
+        let (near, far) = match c.projection {
             Projection::Perspective { yfov, aspect, near, far } => {
                 d.set_item("type", "perspective")?;
                 d.set_item("yfov", yfov)?;
                 d.set_item("aspect", aspect)?;
-                d.set_item("near", near)?;
-                d.set_item("far", far)?;
+                (near, far)
             }
             Projection::Orthographic { xmag, ymag, near, far } => {
                 d.set_item("type", "orthographic")?;
                 d.set_item("xmag", xmag)?;
                 d.set_item("ymag", ymag)?;
-                d.set_item("near", near)?;
-                d.set_item("far", far)?;
+                (near, far)
             }
-        }
+        };
+        d.set_item("near", near)?;
+        d.set_item("far", far)?;
         cameras.append(d)?;
     }
     let names = file.meshes.iter().map(|m| m.name.clone()).collect();
