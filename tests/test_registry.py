@@ -114,3 +114,11 @@ def test_stats_have_the_documented_keys(renderer, name):
     keys = set(frame.stats)
     assert keys <= documented and documented - keys <= {"error_bound_max"}, keys ^ documented
     assert all(isinstance(v, float) for v in frame.stats["extra"].values())
+
+
+def test_the_main_parameter_is_an_int_parameter_of_its_method():
+    """`main` (what `oit compare` sweeps) names an int parameter; every method with an int
+    parameter besides its seed has one."""
+    for m in oit.methods():
+        ints = [p["name"] for p in m["params"] if p["type"] == "int" and p["name"] != "seed"]
+        assert m["main"] == (ints[0] if ints else None), m["name"]

@@ -214,3 +214,18 @@ def test_builtin_scene_through_python_keeps_its_camera(tmp_path):
     shot = screenshot(tmp_path, ["glass", "--method", "abuffer"], size=(256, 256), through_python=True)
     frame = oit.Renderer(256, 256).render(built.scene, built.camera, method="abuffer")
     assert_matches(shot, frame.image)
+
+
+@needs_screen
+def test_the_viewer_draws_an_opaque_gltf_box_opaque(tmp_path):
+    """The viewer reads files with the core's loader: the OPAQUE red box in front of the BLEND
+    blue panel hides it. Lit red has equal green and blue (the white highlight alone), so a box
+    pixel with more blue than green would be the panel showing through."""
+    from files import box_and_panel_glb
+
+    shot = screenshot(tmp_path, [str(box_and_panel_glb(tmp_path / "two.glb")), "--method", "abuffer"], size=(160, 120))
+    rgb = shot[..., :3].astype(np.int16)
+    box = rgb[..., 0] > rgb[..., 1] + 40
+    assert box.mean() > 0.02, "the box is in view"
+    assert (rgb[box][:, 1] == rgb[box][:, 2]).all(), "the box is exactly opaque"
+    assert (rgb[..., 2] > rgb[..., 1] + 20).any(), "the panel blends beside it"

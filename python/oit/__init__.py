@@ -19,7 +19,9 @@ if not _os.environ.get("XDG_RUNTIME_DIR"):
     _os.makedirs(_runtime, mode=0o700, exist_ok=True)
     _os.environ["XDG_RUNTIME_DIR"] = _runtime
 
-from ._api import Camera, Frame, Renderer, Scene, Stats, constants, memory_bytes, methods, reference
+from ._api import Camera, FileCamera, Frame, Renderer, Scene, Stats, constants, memory_bytes, methods, reference
+from .comparison import Comparison, compare
 
-__all__ = ["Camera", "Frame", "Renderer", "Scene", "Stats", "constants", "memory_bytes", "methods", "reference"]
+__all__ = ["Camera", "Comparison", "FileCamera", "Frame", "Renderer", "Scene", "Stats", "compare", "constants", "memory_bytes",
+           "methods", "reference"]
 __version__ = "0.1.0"

@@ -3,6 +3,7 @@ messages that name the argument and say what to do."""
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypedDict
@@ -10,115 +11,10 @@ from typing import Any, TypedDict
 import numpy as np
 
 from . import _oit
+from ._checks import _I64_MAX, _U32_MAX, SHADINGS, _float_array, _int, _number, _rows, _surface, _vector
 from ._memory import available_memory
-from ._trimesh import srgb_to_linear, trimesh_arrays
-
-
-def _float_array(value: Any, name: str) -> np.ndarray:
-    a = np.asarray(value)
-    if a.dtype == object or not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)) or a.dtype == bool:
-        raise TypeError(f"{name} must be a float array (float32 preferred), got dtype {a.dtype}")
-    with np.errstate(over="ignore", invalid="ignore"):
-        out = np.ascontiguousarray(a, dtype=np.float32)
-    if not np.isfinite(out).all():
-        bad = np.argwhere(~np.isfinite(out))[0]
-        raise ValueError(f"{name} has a NaN or Inf (or a value too large for float32) at index {tuple(int(i) for i in bad)}")
-    return out
-
-
-def _rows(a: np.ndarray, cols: int, name: str) -> np.ndarray:
-    if a.ndim != 2 or a.shape[1] != cols:
-        raise ValueError(f"{name} must have shape (n, {cols}), got {a.shape}")
-    return a
-
-
-def _int(value: Any, name: str, what: str = "an int") -> int:
-    """A Python or numpy integer (not a bool, not a float that happens to be whole)."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be {what}, got {type(value).__name__}")
-    return int(value)
-
-
-# The native layer takes sizes as u32 and byte counts as i64; larger Python ints would
-# surface as OverflowError without the argument's name.
-_U32_MAX = 2 ** 32 - 1
-_I64_MAX = 2 ** 63 - 1
-
-
-def _number(value: Any, name: str) -> float:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"{name} must be a number, got {type(value).__name__}")
-    v = float(value)
-    if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {v}")
-    return v
-
-
-def _vector(value: Any, n: int, name: str) -> np.ndarray:
-    a = _float_array(value, name)
-    if a.shape != (n,):
-        raise ValueError(f"{name} must be {n} numbers, got shape {a.shape}")
-    return a
-
-
-SHADINGS = ("unlit", "flat", "smooth")
-
-
-def _texture(texture: Any) -> np.ndarray:
-    """(h, w, 4) float32 linear RGBA: uint8 is decoded from sRGB (alpha stays linear)."""
-    t = np.asarray(texture)
-    if t.ndim != 3 or t.shape[2] != 4 or t.shape[0] == 0 or t.shape[1] == 0:
-        raise ValueError(f"texture must have shape (h, w, 4) (straight RGBA), got {t.shape}: add an alpha channel "
-                         "of 1 (or 255) to an RGB image")
-    if t.dtype == np.uint8:
-        out = t.astype(np.float64) / 255.0
-        out[..., :3] = srgb_to_linear(out[..., :3])
-        return np.ascontiguousarray(out, dtype=np.float32)
-    out = _float_array(t, "texture")
-    if out.min() < 0.0 or out.max() > 1.0:
-        raise ValueError(f"a float texture must be linear RGBA in [0, 1], got values in [{out.min():g}, {out.max():g}]: "
-                         "clip it, or pass uint8 sRGB")
-    return out
-
-
-def _surface(n: int, normals: Any, uvs: Any, texture: Any, shading: str | None, specular: float, shininess: float,
-             opacity: float, two_sided: bool) -> dict[str, Any]:
-    """The keyword arguments of the native add_mesh that describe the surface, checked."""
-    out: dict[str, Any] = {}
-    if normals is not None:
-        nrm = _float_array(normals, "normals")
-        if nrm.shape != (n, 3):
-            raise ValueError(f"normals must have shape ({n}, 3) (one per vertex), got {nrm.shape}")
-        zero = np.flatnonzero(~np.any(nrm, axis=1))
-        if len(zero):
-            raise ValueError(f"normals[{zero[0]}] is zero: pass unit vertex normals, or none to have them computed")
-        out["normals"] = nrm
-    if uvs is not None:
-        uv = _float_array(uvs, "uvs")
-        if uv.shape != (n, 2):
-            raise ValueError(f"uvs must have shape ({n}, 2) (one (u, v) per vertex), got {uv.shape}")
-        out["uvs"] = uv
-    if texture is not None:
-        if uvs is None:
-            raise ValueError("a texture needs uvs: pass one (u, v) per vertex")
-        out["texture"] = _texture(texture)
-    if shading is None:
-        shading = "smooth" if normals is not None else "unlit"
-    if not isinstance(shading, str) or shading not in SHADINGS:
-        raise ValueError(f"shading must be one of {SHADINGS}, got {shading!r}")
-    out["shading"] = shading
-    for name, v in (("specular", specular), ("shininess", shininess), ("opacity", opacity)):
-        out[name] = _number(v, name)
-    if out["specular"] < 0:
-        raise ValueError(f"specular must be >= 0, got {specular}")
-    if out["shininess"] <= 0:
-        raise ValueError(f"shininess must be > 0, got {shininess}")
-    if not 0.0 <= out["opacity"] <= 1.0:
-        raise ValueError(f"opacity must be in [0, 1], got {opacity}")
-    if not isinstance(two_sided, (bool, np.bool_)):
-        raise TypeError(f"two_sided must be a bool, got {type(two_sided).__name__}")
-    out["two_sided"] = bool(two_sided)
-    return out
+from ._trimesh import trimesh_arrays
+from .imageio import encode_png
 
 
 class Scene:
@@ -127,10 +23,14 @@ class Scene:
 
     def __init__(self) -> None:
         self._native = _oit.Scene()
+        # What `from_file` read besides the meshes: their names and the file's cameras.
+        self.mesh_names: list[str] = []
+        self.cameras: list[FileCamera] = []
 
     def add_mesh(self, positions: Any, indices: Any, colors: Any, opaque: bool = False, *, normals: Any = None,
                  uvs: Any = None, texture: Any = None, shading: str | None = None, specular: float = 0.0,
-                 shininess: float = 32.0, opacity: float = 1.0, two_sided: bool = True) -> int:
+                 shininess: float = 32.0, opacity: float = 1.0, two_sided: bool = True,
+                 cull_back_faces: bool = False) -> int:
         """Adds a triangle mesh and returns its index.
 
         positions: (n, 3) float; indices: (m, 3) non-negative integers below n (converted to
@@ -145,7 +45,8 @@ class Scene:
         default is "smooth" when `normals` is given, else "unlit". `specular` >= 0 and
         `shininess` > 0 weigh a Blinn-Phong highlight; `opacity` in [0, 1] multiplies alpha;
         `two_sided` turns the normal towards the viewer (else the back is lit as the front's
-        reverse side, and stays drawn).
+        reverse side, and stays drawn); `cull_back_faces` drops the triangles seen from behind
+        (clockwise on screen), as glTF's `doubleSided: false` asks.
         """
         pos = _rows(_float_array(positions, "positions"), 3, "positions")
         idx = np.asarray(indices)
@@ -173,7 +74,8 @@ class Scene:
             )
         if not isinstance(opaque, (bool, np.bool_)):
             raise TypeError(f"opaque must be a bool, got {type(opaque).__name__}")
-        surface = _surface(len(pos), normals, uvs, texture, shading, specular, shininess, opacity, two_sided)
+        surface = _surface(len(pos), normals, uvs, texture, shading, specular, shininess, opacity, two_sided,
+                           cull_back_faces)
         return self._native.add_mesh(pos, idx, col, bool(opaque), **surface)
 
     def add_light(self, direction: Sequence[float], color: Sequence[float] = (1.0, 1.0, 1.0), intensity: float = 1.0) -> int:
@@ -231,6 +133,31 @@ class Scene:
     @property
     def triangle_count(self) -> int:
         return self._native.triangle_count
+
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The (lo, hi) corners of the box around every vertex; None for an empty scene."""
+        b = self._native.bounds()
+        return None if b is None else (np.array(b[0], dtype=np.float64), np.array(b[1], dtype=np.float64))
+
+    @property
+    def materials(self) -> list[dict[str, Any]]:
+        """Per mesh: opaque, shading, textured, two_sided, cull_back_faces, has_normals, has_uvs,
+        the vertex alphas' range (alpha_min, alpha_max) and the mean vertex RGBA (color_mean)."""
+        return self._native.mesh_materials()
+
+    @classmethod
+    def from_file(cls, path: str | os.PathLike, alpha: float | None = None, *, shading: str = "smooth",
+                  specular: float = 0.25) -> Scene:
+        """A scene from a mesh file, as the file has it (docs/loading.md): OBJ with its MTL
+        (Kd, d or Tr, map_Kd, map_d), glTF/GLB (the node tree flattened to world space, every
+        primitive, baseColorFactor and baseColorTexture, alphaMode and alphaCutoff, doubleSided:
+        false culls back faces), PLY (vertex colors with alpha) or STL. `alpha` makes every mesh
+        transparent at it; `shading` ("smooth" with the file's normals, "flat" or "unlit") and
+        `specular` style every surface. `scene.mesh_names` names the meshes, and
+        `scene.cameras` lists the file's cameras (`FileCamera.camera(aspect)` gives an oit.Camera).
+        The same loader (oit-core's) reads files for the viewer and `python -m oit render`."""
+        return load_file(path, alpha, shading=shading, specular=specular)[0]
 
     @classmethod
     def from_trimesh(cls, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False,
@@ -370,6 +297,59 @@ class Camera:
         return cls.look_at(center + d * dist, center, fov_y, near=near, far=far, aspect=aspect)
 
 
+@dataclass
+class FileCamera:
+    """A camera of a loaded file: `view` (4 x 4, world to camera, looking down -z with y up) and
+    its `projection` dict ("type" "perspective" with yfov in radians, aspect (the file's, or
+    None), near and far; or "orthographic" with xmag, ymag, near and far)."""
+
+    name: str
+    view: np.ndarray
+    projection: dict[str, Any]
+
+    def camera(self, aspect: float | None = None) -> Camera:
+        """The oit.Camera of this view at `aspect` (width / height; default: the file's, else 1)."""
+        p = self.projection
+        if p["type"] == "orthographic":
+            return Camera(Camera.orthographic(-p["xmag"], p["xmag"], -p["ymag"], p["ymag"], p["near"], p["far"]).view_proj
+                          @ self.view)
+        aspect = aspect or p["aspect"] or 1.0
+        f = 1.0 / np.tan(p["yfov"] / 2.0)
+        proj = np.zeros((4, 4))
+        proj[0, 0], proj[1, 1] = f / aspect, f
+        proj[2, 2], proj[2, 3] = p["far"] / (p["near"] - p["far"]), p["near"] * p["far"] / (p["near"] - p["far"])
+        proj[3, 2] = -1.0
+        return Camera(proj @ self.view)
+
+
+FORMATS = (".obj", ".gltf", ".glb", ".ply", ".stl")
+
+
+def load_file(path: str | os.PathLike, alpha: float | None = None, *, shading: str = "smooth", specular: float = 0.25,
+              viewing: bool = False) -> tuple[Scene, str | None]:
+    """`Scene.from_file`, and with `viewing` the command line's convenience: when nothing in
+    the file is transparent every mesh is drawn at alpha 0.4, and the second value says so."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__}")
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"no such file: {path}: check the path")
+    if os.path.splitext(path)[1].lower() not in FORMATS:
+        raise ValueError(f"{path}: unknown file type {os.path.splitext(path)[1]!r}: oit reads {', '.join(FORMATS)} files")
+    if alpha is not None and not 0.0 <= _number(alpha, "alpha") <= 1.0:
+        raise ValueError(f"alpha must be in [0, 1], got {alpha}")
+    if shading not in SHADINGS:
+        raise ValueError(f"shading must be one of {SHADINGS}, got {shading!r}")
+    if _number(specular, "specular") < 0:
+        raise ValueError(f"specular must be >= 0, got {specular}")
+    native, names, cameras, note = _oit.load_file(path, shading, float(specular), alpha, viewing)
+    scene = Scene()
+    scene._native, scene.mesh_names = native, list(names)
+    scene.cameras = [FileCamera(c["name"], np.array(c["view"], dtype=np.float64),
+                                {k: v for k, v in c.items() if k not in ("name", "view")}) for c in cameras]
+    return scene, note
+
+
 class Stats(TypedDict, total=False):
     """`frame.stats`: what every frame reports; method-specific figures are under `extra`. The
     keys, their types and meanings are the core's (`oit._oit.stats_schema()`,
@@ -411,6 +391,10 @@ class Frame:
     depth_complexity: np.ndarray | None = field(repr=False)
     error_bound: np.ndarray | None = field(default=None, repr=False)
     error_bound_reason: str = ""
+
+    def _repr_png_(self) -> bytes:
+        """The image as PNG (sRGB), so that a frame shows inline in Jupyter."""
+        return encode_png(self.image[..., :3])
 
 
 class Renderer:

@@ -79,6 +79,7 @@ class _MethodInfo(TypedDict):
     error_bound: Literal["exact", "per_pixel", "none"]
     tiling: _TilingInfo
     census: bool  # whether it plans from the fragment census (and so always runs it)
+    main: str | None  # the int parameter its trade moves along (what `oit compare` sweeps)
 
 @final
 class Scene:
@@ -99,6 +100,7 @@ class Scene:
         shininess: float = 32.0,
         opacity: float = 1.0,
         two_sided: bool = True,
+        cull_back_faces: bool = False,
     ) -> int:
         """positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
         surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
@@ -119,6 +121,10 @@ class Scene:
     def mesh_count(self) -> int: ...
     @property
     def triangle_count(self) -> int: ...
+    def mesh_materials(self) -> list[dict[str, Any]]:
+        """Per mesh: what its material and colors are (tests and `Scene.materials`)."""
+    def bounds(self) -> tuple[list[float], list[float]] | None:
+        """The smallest and largest corner of every vertex's box; None for an empty scene."""
     def mesh_summary(self) -> list[tuple[int, int, bool]]:
         """(triangles, vertices, opaque) per mesh."""
 
@@ -174,3 +180,9 @@ def reference(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_], npt.NDArray[np.uint32]]:
     """CPU float64 reference: (image (h, w, 4) float64, ambiguous (h, w) bool, depth complexity),
     the mean over the standard pattern's positions when `antialias` > 1."""
+def load_file(
+    path: str, shading: str = "smooth", specular: float = 0.25, alpha: float | None = None, viewing: bool = False
+) -> tuple[Scene, list[str], list[dict[str, Any]], str | None]:
+    """Reads `path`; `shading` and `specular` style every surface (`load::Surface`). `alpha`
+    makes every mesh transparent at it; `viewing` adds the command line's convenience (every
+    mesh at VIEWING_ALPHA when nothing blends) and returns its note."""

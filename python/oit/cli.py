@@ -78,17 +78,24 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _add_render(p: argparse.ArgumentParser) -> None:
-    p.add_argument("file", help="any mesh file trimesh can load (OBJ, PLY, STL, GLB, ...)")
+    p.add_argument("file", help="a mesh file: OBJ (with its MTL), glTF, GLB, PLY or STL (docs/loading.md)")
     p.add_argument("-m", "--method", default="abuffer", help="see `python -m oit methods` (default: %(default)s)")
-    p.add_argument("--alpha", type=_unit_float, default=0.4, help="alpha of every vertex (default: %(default)s)")
-    p.add_argument("-o", "--output", default=None, help="PNG to write (default: out/<file stem>-<method>.png)")
+    p.add_argument("--alpha", type=_unit_float, default=None,
+                   help="make every mesh transparent at this alpha (default: the file's materials; when nothing in "
+                        "the file is transparent, every mesh at 0.4)")
+    p.add_argument("-o", "--output", default=None,
+                   help="PNG to write, or with --orbit a .gif or .mp4 (default: out/<file stem>-<method>.png or .gif)")
+    p.add_argument("--orbit", type=_positive_int, default=None, metavar="N",
+                   help="render N views around the scene into an animation (-o out.gif or out.mp4) and report the "
+                        "sequence's temporal error against the exact frames")
+    p.add_argument("--fps", type=float, default=12.0, help="frames a second of the --orbit animation (default: %(default)s)")
     p.add_argument("--size", type=_positive_int, nargs=2, metavar=("W", "H"), default=(512, 512))
     p.add_argument("--background", type=_unit_float, nargs=3, metavar=("R", "G", "B"), default=(1.0, 1.0, 1.0),
                    help="linear RGB in [0, 1] (default: white)")
     p.add_argument("--param", type=parse_param, action="append", default=[], metavar="NAME=VALUE",
                    help="a method parameter; repeat for several")
     p.add_argument("--shading", choices=("smooth", "flat", "unlit"), default="smooth",
-                   help="smooth (the mesh's vertex normals), flat or unlit (default: %(default)s; docs/shading.md)")
+                   help="smooth (the file's vertex normals), flat or unlit (default: %(default)s; docs/shading.md)")
     p.add_argument("--light", type=float, nargs=3, action="append", default=[], metavar=("DX", "DY", "DZ"),
                    help="a white directional light travelling along DX DY DZ (world space); repeat for several "
                         "(default: a headlight along the view)")
@@ -99,37 +106,45 @@ def _add_render(p: argparse.ArgumentParser) -> None:
 
 
 def _render(args: argparse.Namespace) -> int:
-    import trimesh
-
-    from ._api import Camera, Renderer, Scene
+    from ._api import Renderer
     from .imageio import write_png
+    from .views import fit_camera, load_for_viewing, orbit_cameras
 
-    if not os.path.isfile(args.file):
-        raise ValueError(f"no such file: {args.file}")
-    mesh = trimesh.load(args.file, force="mesh")
-    if len(mesh.faces) == 0:
-        raise ValueError(f"{args.file} has no triangles")
-    if args.specular < 0:
-        raise ValueError(f"--specular must be >= 0, got {args.specular}")
-    scene = Scene.from_trimesh(mesh, alpha=args.alpha, shading=args.shading, specular=args.specular)
-    for light in args.light:
-        scene.add_light(light)
-    scene.ambient = tuple(args.ambient)
-    width, height = args.size
-    camera = Camera.fit(mesh.vertices, aspect=width / height)
-    params: dict[str, Any] = dict(args.param)
-    frame = Renderer(width, height, adapter=args.adapter).render(
-        scene, camera, method=args.method, background=tuple(args.background), census=True, **params
-    )
     stem = os.path.splitext(os.path.basename(args.file))[0]
-    output = args.output or os.path.join("out", f"{stem}-{args.method}.png")
+    if args.orbit is not None:
+        from .sequence import check_animation_path
+
+        output = args.output or os.path.join("out", f"{stem}-{args.method}.gif")
+        check_animation_path(output)
+    else:
+        output = args.output or os.path.join("out", f"{stem}-{args.method}.png")
+    scene = load_for_viewing(args)
+    width, height = args.size
+    renderer = Renderer(width, height, adapter=args.adapter)
+    params: dict[str, Any] = dict(args.param)
+    lights = f"{len(args.light)} lights" if args.light else "headlight"
+    alpha = "the file's alpha" if args.alpha is None else f"alpha {args.alpha}"
+    print(f"{args.file}: {scene.mesh_count} meshes, {scene.triangle_count} triangles, {alpha}, {args.shading} shading "
+          f"({lights}), {width} x {height}, method {args.method}")
+    if args.orbit is not None:
+        from .sequence import render_sequence, write_animation
+
+        cameras = orbit_cameras(scene, args.orbit, aspect=width / height)
+        orbit = render_sequence(renderer, scene, cameras, args.method, tuple(args.background), **params)
+        _ensure_parent(output)
+        write_animation(output, orbit.images, args.fps)
+        t = orbit.temporal
+        print(f"  {args.orbit} views; against the exact frames: mean error {t['mean_err']:.5f}, max {t['max_err']:.4f}"
+              + (f"; flicker {t['flicker']:.5f} (max {t['max_flicker']:.4f}) of a frame-to-frame change of "
+                 f"{t['change']:.5f}" if "flicker" in t else ""))
+        print(f"wrote {output}")
+        return 0
+    camera = scene.cameras[0].camera(width / height) if scene.cameras else fit_camera(scene, aspect=width / height)
+    frame = renderer.render(scene, camera, method=args.method, background=tuple(args.background), census=True, **params)
     _ensure_parent(output)
     write_png(output, frame.image[..., :3])
     s = frame.stats
     gpu = f"{s['gpu_time_ms']:.2f} ms" if s.get("gpu_time_ms") is not None else "n/a (no timestamp queries)"
-    lights = f"{len(args.light)} lights" if args.light else "headlight"
-    print(f"{args.file}: {scene.triangle_count} triangles, alpha {args.alpha}, {args.shading} shading ({lights}), "
-          f"{width} x {height}, method {s['method']}")
     print(f"  params: {s['params'] or '{}'}")
     print(f"  fragments {s['fragments']}, max depth complexity {s['max_depth_complexity']}, "
           f"overflow {s['overflow_fragments']}")
@@ -137,6 +152,27 @@ def _render(args: argparse.Namespace) -> int:
     print(f"  adapter: {s['adapter']}")
     print(f"wrote {output}")
     return 0
+
+
+# ---- compare
+
+
+def _add_compare(p: argparse.ArgumentParser) -> None:
+    from .comparison import add_arguments
+
+    p.add_argument("file", help="a mesh file: OBJ (with its MTL), glTF, GLB, PLY or STL (docs/loading.md)")
+    p.add_argument("--alpha", type=_unit_float, default=None,
+                   help="make every mesh transparent at this alpha (default: the file's; 0.4 when nothing is transparent)")
+    p.add_argument("--shading", choices=("smooth", "flat", "unlit"), default="smooth", help="(default: %(default)s)")
+    p.add_argument("--specular", type=float, default=0.25, help="Blinn-Phong highlight weight (default: %(default)s)")
+    add_arguments(p)
+
+
+def _compare(args: argparse.Namespace) -> int:
+    from .comparison import run_cli
+    from .views import load_for_viewing
+
+    return run_cli(args, load_for_viewing(args))
 
 
 # ---- methods
@@ -196,7 +232,7 @@ def _add_view(p: argparse.ArgumentParser) -> None:
     p.add_argument("files", nargs="*", metavar="FILE", help=".oitscene, OBJ, PLY, STL, glTF or GLB files")
     p.add_argument("--scene", default=None, help="a built-in scene: hair, smoke, foliage, dragons, glass, stacks")
     p.add_argument("-m", "--method", default=None, help="the method to start with (default: hybrid)")
-    p.add_argument("--alpha", type=_unit_float, default=None, help="alpha of every transparent mesh")
+    p.add_argument("--alpha", type=_unit_float, default=None, help="make every mesh transparent at this alpha")
     p.add_argument("--param", type=str, action="append", default=[], metavar="NAME=VALUE",
                    help="a parameter of the method; repeat for several")
     p.add_argument("--screenshot", default=None, metavar="PATH", help="save the window as PNG and exit")
@@ -235,6 +271,8 @@ Subcommand = tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable
 SUBCOMMANDS: Sequence[Subcommand] = (
     ("demo", "render the built-in scene with every blending method and their errors into one PNG", _add_demo, _demo),
     ("render", "render a mesh file with one method into a PNG", _add_render, _render),
+    ("compare", "every method on a mesh file of yours: time, memory, error, and the cheapest that meets your limits",
+     _add_compare, _compare),
     ("methods", "list the methods with their properties and parameters", _add_methods, _methods),
     ("bench", "time, memory and error of every method against the exact A-buffer", _add_bench, _bench),
     ("view", "open meshes or a built-in scene in the interactive viewer (crates/oit-viewer)", _add_view, _view),
@@ -263,7 +301,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args.passthrough = passthrough
     try:
         return args.run(args)
-    except (ValueError, MemoryError, RuntimeError, OSError) as e:
+    except (ValueError, TypeError, MemoryError, RuntimeError, OSError) as e:
         # Engine and input errors carry messages that say what to do; no traceback.
         print(f"{parser.prog} {args.command}: error: {e}", file=sys.stderr)
-        return EXIT_USAGE if isinstance(e, ValueError) else 1
+        return EXIT_USAGE if isinstance(e, (ValueError, TypeError, FileNotFoundError)) else 1

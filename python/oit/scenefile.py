@@ -184,12 +184,14 @@ def scene_of(meshes: Sequence[MeshArrays], lights: Sequence[tuple[Any, Any, floa
 
 
 def _surface_bytes(surface: dict[str, Any], n: int) -> bytes:
-    from ._api import _surface
+    from ._checks import _surface
 
     s = _surface(n, surface.get("normals"), surface.get("uvs"), surface.get("texture"), surface.get("shading"),
                  surface.get("specular", 0.0), surface.get("shininess", 32.0), surface.get("opacity", 1.0),
-                 surface.get("two_sided", True))
-    out = [struct.pack("<2I3f", SHADING_CODES[s["shading"]], int(s["two_sided"]), s["specular"], s["shininess"], s["opacity"])]
+                 surface.get("two_sided", True), surface.get("cull_back_faces", False))
+    # The sidedness word: bit 0 two-sided lighting, bit 1 back faces culled (docs/viewer.md).
+    sides = int(s["two_sided"]) | int(s["cull_back_faces"]) << 1
+    out = [struct.pack("<2I3f", SHADING_CODES[s["shading"]], sides, s["specular"], s["shininess"], s["opacity"])]
     for key, width in (("normals", 3), ("uvs", 2)):
         a = s.get(key)
         out.append(struct.pack("<I", 0 if a is None else n))
@@ -203,9 +205,10 @@ def _surface_bytes(surface: dict[str, Any], n: int) -> bytes:
 
 
 def _read_surface(data: bytes, at: int, n: int) -> tuple[dict[str, Any], int]:
-    code, two_sided, specular, shininess, opacity = struct.unpack_from("<2I3f", data, at)
+    code, sides, specular, shininess, opacity = struct.unpack_from("<2I3f", data, at)
     at += 20
-    surface: dict[str, Any] = {"shading": {v: k for k, v in SHADING_CODES.items()}[code], "two_sided": bool(two_sided),
+    surface: dict[str, Any] = {"shading": {v: k for k, v in SHADING_CODES.items()}[code], "two_sided": bool(sides & 1),
+                               "cull_back_faces": bool(sides & 2),
                                "specular": specular, "shininess": shininess, "opacity": opacity}
     for key, width in (("normals", 3), ("uvs", 2)):
         (count,) = struct.unpack_from("<I", data, at)

@@ -78,8 +78,24 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     out.material = bitcast<u32>(a.w);
     out.normal = a.xyz;
     out.uv = attributes[2u * v + 1u].xy;
+    if (bitcast<u32>(surfaces[2u * out.material].w) & CULL_BACK) != 0u && !faces_front(vi) {
+        // A culled back face: all three corners behind the near plane, so nothing is drawn.
+        out.clip = vec4<f32>(0.0, 0.0, -1.0, 1.0);
+    }
 //!endif
     return out;
+}
+
+// Whether the triangle of vertex `vi` is counter-clockwise on screen (wgpu's front face): the
+// sign of det[x y w] of its clip corners, right for corners behind the eye too (Olano and
+// Greer, "Triangle scan conversion using 2D homogeneous coordinates"). Every corner computes
+// the same value, so a triangle is kept or dropped whole; the reference's test is the same.
+fn faces_front(vi: u32) -> bool {
+    let first = vi - vi % 3u;
+    let a = frame.view_proj * vec4<f32>(scene_position(indices[first]), 1.0);
+    let b = frame.view_proj * vec4<f32>(scene_position(indices[first + 1u]), 1.0);
+    let c = frame.view_proj * vec4<f32>(scene_position(indices[first + 2u]), 1.0);
+    return determinant(mat3x3<f32>(a.xyw, b.xyw, c.xyw)) > 0.0;
 }
 
 fn scene_position(v: u32) -> vec3<f32> {

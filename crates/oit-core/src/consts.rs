@@ -75,6 +75,7 @@ pub const SHARED: &[Const] = &[
     Const::U32("SHADING_SMOOTH", crate::shading::Shading::Smooth as u32),
     Const::U32("TWO_SIDED", crate::shading::TWO_SIDED),
     Const::U32("TEXTURED", crate::shading::TEXTURED),
+    Const::U32("CULL_BACK", crate::shading::CULL_BACK),
     Const::U32("SWEEP_LOAD_STEPS", SWEEP_LOAD_STEPS),
     Const::U32("SWEEP_LINK_STEPS", SWEEP_LINK_STEPS),
     Const::U32("SWEEP_MERGE_STEPS", SWEEP_MERGE_STEPS),

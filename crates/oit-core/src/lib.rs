@@ -8,6 +8,7 @@ pub mod consts;
 pub mod context;
 pub mod error;
 pub mod gpu_types;
+pub mod load;
 pub mod method;
 mod passes;
 mod pipeline;

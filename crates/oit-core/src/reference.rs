@@ -40,6 +40,10 @@ struct Tri {
     opaque: bool,
     /// Vertex positions in pixels when all three are in front of the eye (w > 0).
     screen: Option<[DVec2; 3]>,
+    /// Whether the material culls back faces, and whether the triangle is one under the
+    /// frame's camera (clockwise on screen: `back_facing`).
+    cull: bool,
+    back: bool,
 }
 
 struct Bounds(Aabb);
@@ -76,6 +80,14 @@ fn edge_distances(s: &[DVec2; 3], p: DVec2) -> [f64; 3] {
         d[i] = sign * flip * (hi - lo).perp_dot(p - lo) / len;
     }
     d
+}
+
+/// Whether a triangle is clockwise on screen, wgpu's back face: det[x y w] of its clip corners
+/// is not positive, the vertex shader's test (`faces_front` in shaders/common/scene.wgsl).
+fn back_facing(vp: &DMat4, v: &[DVec3; 3]) -> bool {
+    let c = v.map(|p| *vp * p.extend(1.0));
+    let [a, b, c] = c.map(|c| DVec3::new(c.x, c.y, c.w));
+    glam::DMat3::from_cols(a, b, c).determinant() <= 0.0
 }
 
 /// Möller-Trumbore in f64 on the line o + t * d: returns (t, u, v) without range checks.
@@ -146,7 +158,7 @@ pub fn reference_antialiased(
                 _ => ix.map(|i| DVec3::from(m.normals[i as usize].map(|x| x as f64))),
             };
             let uv = if m.uvs.is_empty() { [DVec2::ZERO; 3] } else { ix.map(|i| DVec2::from(m.uvs[i as usize].map(|x| x as f64))) };
-            tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None });
+            tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull: m.material.cull_back_faces, back: false });
         }
     }
     let materials: Vec<&Material> = scene.meshes().iter().map(|m| &m.material).collect();
@@ -215,6 +227,7 @@ fn trace_frame(
             (Some(a), Some(b), Some(c)) => Some([a, b, c]),
             _ => None,
         };
+        t.back = t.cull && back_facing(&vp, &t.v);
     }
     let tris = &*tris;
     let pixels = width as usize * height as usize;
@@ -289,6 +302,9 @@ fn trace(bvh: &Bvh2, tris: &[Tri], looks: &Looks<'_>, o: DVec3, d: DVec3, center
     let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()), -1e-3, 1.0 + 1e-3);
     bvh.ray_traverse_anyhit(ray, |_, id| {
         let t = &tris[bvh.primitive_indices[id] as usize];
+        if t.back {
+            return;
+        }
         let Some((tt, u, v)) = intersect(t, o, d) else { return };
         let inside = match &t.screen {
             Some(s) => {

@@ -13,6 +13,8 @@ pub const MAX_LIGHTS: u32 = 8;
 pub const SHADING_MODE: u32 = 0xff;
 pub const TWO_SIDED: u32 = 0x100;
 pub const TEXTURED: u32 = 0x200;
+/// Back faces (clockwise on screen) are not drawn: the vertex shader moves them off screen.
+pub const CULL_BACK: u32 = 0x400;
 
 /// How a mesh's normal is found; `Unlit` keeps the vertex color (times texture and opacity).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -50,7 +52,10 @@ impl Shading {
 
     /// The material flags word of the shaders (`GpuMaterial::flags`).
     pub fn flags(material: &Material) -> u32 {
-        material.shading.code() | if material.two_sided { TWO_SIDED } else { 0 } | if material.texture.is_some() { TEXTURED } else { 0 }
+        material.shading.code()
+            | if material.two_sided { TWO_SIDED } else { 0 }
+            | if material.texture.is_some() { TEXTURED } else { 0 }
+            | if material.cull_back_faces { CULL_BACK } else { 0 }
     }
 }
 
@@ -106,12 +111,23 @@ pub struct Material {
     pub shininess: f32,
     pub opacity: f32,
     pub two_sided: bool,
+    /// Whether back faces (clockwise on screen, as wgpu's counter-clockwise front has it) are
+    /// dropped, as glTF's `doubleSided: false` asks.
+    pub cull_back_faces: bool,
     pub texture: Option<Texture>,
 }
 
 impl Default for Material {
     fn default() -> Self {
-        Self { shading: Shading::Unlit, specular: 0.0, shininess: 32.0, opacity: 1.0, two_sided: true, texture: None }
+        Self {
+            shading: Shading::Unlit,
+            specular: 0.0,
+            shininess: 32.0,
+            opacity: 1.0,
+            two_sided: true,
+            cull_back_faces: false,
+            texture: None,
+        }
     }
 }
 
@@ -129,9 +145,10 @@ impl Material {
         Ok(())
     }
 
-    /// Whether the material leaves the vertex color as it is (today's unlit meshes).
+    /// Whether the material leaves the vertex color as it is and every triangle drawn (today's
+    /// unlit meshes): else the scene is drawn with its material table.
     pub fn is_plain(&self) -> bool {
-        self.shading == Shading::Unlit && self.texture.is_none() && self.opacity == 1.0
+        self.shading == Shading::Unlit && self.texture.is_none() && self.opacity == 1.0 && !self.cull_back_faces
     }
 }
 

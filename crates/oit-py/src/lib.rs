@@ -11,6 +11,8 @@ use pyo3::types::{PyDict, PyList};
 
 use oit_core::{OitError, ParamKind, ParamValue};
 
+mod load;
+
 struct Error(OitError);
 
 impl From<OitError> for Error {
@@ -72,7 +74,7 @@ impl Scene {
     /// surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
     /// shading "unlit", "flat" or "smooth".
     #[pyo3(signature = (positions, indices, colors, opaque, normals=None, uvs=None, texture=None, shading="unlit",
-                        specular=0.0, shininess=32.0, opacity=1.0, two_sided=true))]
+                        specular=0.0, shininess=32.0, opacity=1.0, two_sided=true, cull_back_faces=false))]
     #[allow(clippy::too_many_arguments)]
     fn add_mesh(
         &mut self,
@@ -88,6 +90,7 @@ impl Scene {
         shininess: f32,
         opacity: f32,
         two_sided: bool,
+        cull_back_faces: bool,
     ) -> PyResult<usize> {
         let mesh = oit_core::Mesh::new(rows(&positions, "positions")?, rows(&indices, "indices")?, rows(&colors, "colors")?, opaque)
             .map_err(Error::from)?;
@@ -110,6 +113,7 @@ impl Scene {
             shininess,
             opacity,
             two_sided,
+            cull_back_faces,
             texture,
         };
         let normals = normals.map(|n| rows(&n, "normals")).transpose()?;
@@ -164,6 +168,20 @@ impl Scene {
     #[getter]
     fn triangle_count(&self) -> usize {
         self.inner.meshes().iter().map(|m| m.triangle_count()).sum()
+    }
+
+    /// Per mesh: what its material and colors are (tests and `Scene.materials`).
+    fn mesh_materials<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        load::mesh_materials(py, &self.inner)
+    }
+
+    /// The smallest and largest corner of every vertex's box; None for an empty scene.
+    fn bounds(&self) -> Option<([f32; 3], [f32; 3])> {
+        let mut points = self.inner.meshes().iter().flat_map(|m| m.positions.iter().copied());
+        let first = points.next()?;
+        Some(
+            points.fold((first, first), |(lo, hi), p| (std::array::from_fn(|i| lo[i].min(p[i])), std::array::from_fn(|i| hi[i].max(p[i])))),
+        )
     }
 
     /// (triangles, vertices, opaque) per mesh.
@@ -375,6 +393,7 @@ fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         }
         d.set_item("tiling", tiling)?;
         d.set_item("census", m.census)?;
+        d.set_item("main", m.main)?;
         let params = PyList::empty(py);
         for p in m.params {
             let pd = PyDict::new(py);
@@ -482,5 +501,6 @@ fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(memory_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(constants, m)?)?;
     m.add_function(wrap_pyfunction!(stats_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(load::load_file, m)?)?;
     Ok(())
 }

@@ -16,7 +16,7 @@ usage: oit-viewer FILE ... [--method NAME] [--param NAME=VALUE ...] [--alpha A]
 FILE           .oitscene (from `python -m oit view --scene NAME --export PATH`), .obj, .ply,
                .stl, .gltf or .glb
 --method NAME  the method to start with (default: hybrid); --param sets its parameters
---alpha A      alpha of every transparent mesh (mesh files default to their own or 0.4)
+--alpha A      make every mesh transparent at A (default: the files' alphas; 0.4 when nothing in a mesh file is transparent)
 --background   linear RGB in [0, 1] (default: 1 1 1)
 --size W H     window size in points (default: 1280 800)
 --adapter NAME substring of the adapter name (default: OIT_ADAPTER or the best adapter)

@@ -20,11 +20,8 @@ pub enum CameraSpec {
     LookAt { eye: [f64; 3], target: [f64; 3], up: [f64; 3], fov_y: f64, near: f64, far: f64 },
 }
 
-#[derive(Clone, Debug)]
-pub struct NamedMesh {
-    pub name: String,
-    pub mesh: Mesh,
-}
+/// A mesh and its name, as the core's loader gives them.
+pub use oit_core::load::NamedMesh;
 
 /// Meshes in submission order, the camera they come with (if any) and the frame size they
 /// are meant for.
@@ -139,7 +136,9 @@ fn read_surface(r: &mut Reader<'_>, mesh: Mesh, n: usize) -> Result<Mesh, String
         2 => Shading::Smooth,
         k => return Err(format!("unknown shading {k} (0: unlit, 1: flat, 2: smooth)")),
     };
-    let two_sided = r.u32("two-sidedness")? != 0;
+    // The sidedness word: bit 0 two-sided lighting, bit 1 back faces culled.
+    let sides = r.u32("two-sidedness")?;
+    let (two_sided, cull_back_faces) = (sides & 1 != 0, sides & 2 != 0);
     let [specular, shininess, opacity] = r.f32s("the material")?;
     let count = |r: &mut Reader<'_>, what: &str| -> Result<usize, String> {
         match r.u32(what)? as usize {
@@ -159,7 +158,7 @@ fn read_surface(r: &mut Reader<'_>, mesh: Mesh, n: usize) -> Result<Mesh, String
     } else {
         None
     };
-    let material = Material { shading, specular, shininess, opacity, two_sided, texture };
+    let material = Material { shading, specular, shininess, opacity, two_sided, cull_back_faces, texture };
     mesh.with_surface(normals, uvs, material).map_err(|e| e.to_string())
 }
 
@@ -202,7 +201,7 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
         out.extend(bytemuck::cast_slice(&m.mesh.indices));
         if surface {
             let mat = &m.mesh.material;
-            u32s(&mut out, &[mat.shading.code(), mat.two_sided as u32]);
+            u32s(&mut out, &[mat.shading.code(), mat.two_sided as u32 | (mat.cull_back_faces as u32) << 1]);
             out.extend(bytemuck::cast_slice(&[mat.specular, mat.shininess, mat.opacity]));
             u32s(&mut out, &[m.mesh.normals.len() as u32]);
             out.extend(bytemuck::cast_slice(&m.mesh.normals));

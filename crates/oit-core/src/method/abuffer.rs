@@ -22,6 +22,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
     census: true,
+    main: None,
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 

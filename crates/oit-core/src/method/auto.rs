@@ -44,6 +44,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Storage { per_pixel: 96, per_fragment: 24, per_triangle: 0 },
     census: true,
+    main: None,
     create: |gpu, limits| Box::new(Auto::new(gpu, limits)),
 };
 

@@ -23,6 +23,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    main: None,
     create: |_, _| Box::new(Blend { kind: Kind::Unsorted }),
 };
 

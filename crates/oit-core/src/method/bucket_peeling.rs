@@ -24,6 +24,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    main: Some("buckets"),
     create: |_, _| Box::new(Buckets { buffers: None, dropped: None }),
 };
 

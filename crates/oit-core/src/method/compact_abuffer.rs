@@ -24,6 +24,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 12, per_triangle: 176 },
     census: true,
+    main: None,
     create: |gpu, limits| {
         Box::new(Compact(ListMethod::new(
             gpu,

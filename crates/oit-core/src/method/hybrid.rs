@@ -34,6 +34,7 @@ pub const HYBRID: MethodInfo = MethodInfo {
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Formula,
     census: false,
+    main: Some("k"),
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
 };
 

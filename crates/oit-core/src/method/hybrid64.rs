@@ -30,6 +30,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Formula,
     census: false,
+    main: Some("k"),
     create: |_, _| Box::new(Hybrid64 { buffers: None, tail: None }),
 };
 

@@ -35,6 +35,9 @@ pub struct MethodInfo {
     /// pass count are planned from every pixel's fragment count). Methods that do not get no
     /// census pass unless the caller asks for the counts (`Renderer::set_census`).
     pub census: bool,
+    /// The integer parameter the method's speed-accuracy trade moves along (k, nodes, layers,
+    /// samples, buckets): what `oit compare` sweeps; None where there is none.
+    pub main: Option<&'static str>,
     pub(crate) create: fn(&GpuContext, &Limits) -> Box<dyn Method>,
 }
 

@@ -25,6 +25,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Storage { per_pixel: 4, per_fragment: 32, per_triangle: 0 },
     census: true,
+    main: Some("layers"),
     create: |gpu, limits| {
         Box::new(Mlab(ListMethod::new(
             gpu,

@@ -31,6 +31,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Formula,
     census: true,
+    main: Some("layers"),
     create: |_, _| Box::new(Peel { dual: false, buffers: None, peeled: None }),
 };
 

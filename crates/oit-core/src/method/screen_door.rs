@@ -25,6 +25,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    main: None,
     create: |_, _| Box::new(ScreenDoor { depth: None }),
 };
 

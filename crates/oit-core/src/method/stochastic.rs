@@ -38,6 +38,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    main: Some("samples"),
     create: |_, _| Box::new(Stochastic { samples: None, targets: None }),
 };
 

@@ -31,6 +31,7 @@ pub const WSUM: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    main: None,
     create: |_, _| Box::new(Weighted::new(Kind::Sum)),
 };
 

@@ -45,10 +45,11 @@ enum CensusKind {
     Samples,
 }
 
-/// The census pipeline of `kind`. The census reads only positions: its variant is always the
-/// unlit one, whatever the scene.
-fn census_pipeline(gpu: &GpuContext, kind: CensusKind) -> wgpu::RenderPipeline {
-    let variant = SceneVariant::default().consts();
+/// The census pipeline of `kind`. The census reads only positions: its variant is the unlit
+/// one, or for a scene with a material table (`shaded`) the shaded one without lights, whose
+/// vertex shader drops the back faces a material culls (common/scene.wgsl).
+fn census_pipeline(gpu: &GpuContext, kind: CensusKind, shaded: bool) -> wgpu::RenderPipeline {
+    let variant = SceneVariant { shaded, ..Default::default() }.consts();
     let add = wgpu::BlendComponent {
         src_factor: wgpu::BlendFactor::One,
         dst_factor: wgpu::BlendFactor::One,
@@ -467,7 +468,7 @@ impl Renderer {
                     };
                     let mut pass = passes::capture_into(&mut enc, "census", &t.depth, &[Some(count)], None);
                     tile.scissor(&mut pass);
-                    pass.set_pipeline(&census_pipeline(&self.gpu, CensusKind::Blend));
+                    pass.set_pipeline(&census_pipeline(&self.gpu, CensusKind::Blend, scene.shaded));
                     scene.transparent.draw_all(&mut pass);
                 }
                 kind => {
@@ -479,7 +480,7 @@ impl Renderer {
                     {
                         let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
                         tile.scissor(&mut pass);
-                        pass.set_pipeline(&census_pipeline(&self.gpu, kind));
+                        pass.set_pipeline(&census_pipeline(&self.gpu, kind, scene.shaded));
                         pass.set_bind_group(1, group, &[]);
                         pass.set_bind_group(2, &t.counts_group, &[]);
                         scene.transparent.draw_all(&mut pass);

@@ -1,0 +1,193 @@
+//! The one loader behind every entry point (`oit.Scene.from_file`, `python -m oit render` and
+//! `compare`, the viewer, the bench): OBJ with MTL, glTF/GLB, PLY and STL to meshes with their
+//! materials, and the file's cameras. A file is followed as it is written (docs/loading.md
+//! lists what each format brings); `viewing_alpha` is the one convenience the command line
+//! and the viewer add on top.
+
+mod gltf;
+mod obj;
+mod ply;
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::error::{invalid, Result};
+use crate::scene::{Mesh, Scene};
+use crate::shading::{Material, Shading, Texture};
+
+/// The alpha every mesh gets when nothing in a file is transparent (the command line and the
+/// viewer; `Scene.from_file` keeps the file's).
+pub const VIEWING_ALPHA: f32 = 0.4;
+/// Color of meshes whose file gives none: light gray, linear.
+pub const DEFAULT_RGB: [f32; 3] = [0.8, 0.8, 0.8];
+/// The ambient term a loaded scene gets (docs/shading.md): the lights are the headlight.
+pub const AMBIENT: [f32; 3] = [0.1; 3];
+/// The extensions `load_file` reads, as its messages list them.
+pub const FORMATS: &str = ".obj (with .mtl), .gltf, .glb, .ply and .stl";
+
+#[derive(Clone, Debug)]
+pub struct NamedMesh {
+    pub name: String,
+    pub mesh: Mesh,
+}
+
+/// How a file camera projects; `far` is the file's or, where it gives none (glTF's infinite
+/// perspective), one past the scene's farthest corner.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// `yfov` in radians; `aspect` the file's width / height, if it gives one.
+    Perspective { yfov: f64, aspect: Option<f64>, near: f64, far: f64 },
+    /// Half the view's width and height.
+    Orthographic { xmag: f64, ymag: f64, near: f64, far: f64 },
+}
+
+/// A camera of the file: world to camera (looking down -z, y up) and its projection.
+#[derive(Clone, Debug)]
+pub struct FileCamera {
+    pub name: String,
+    /// Row-major (`p_camera = view @ [x, y, z, 1]`).
+    pub view: [[f64; 4]; 4],
+    pub projection: Projection,
+}
+
+/// What a surface is shaded with where the file does not say (it never says in these
+/// formats): smooth with the file's normals (computed where it has none), a little specular.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface {
+    pub shading: Shading,
+    pub specular: f32,
+}
+
+impl Default for Surface {
+    fn default() -> Self {
+        Self { shading: Shading::Smooth, specular: 0.25 }
+    }
+}
+
+/// Everything a file holds, in the file's order.
+#[derive(Clone, Debug, Default)]
+pub struct LoadedFile {
+    pub meshes: Vec<NamedMesh>,
+    pub cameras: Vec<FileCamera>,
+}
+
+/// Reads `path` by its extension. Bad files are `InvalidInput` naming the file and the fault.
+pub fn load_file(path: &Path, surface: Surface) -> Result<LoadedFile> {
+    if !path.is_file() {
+        return Err(invalid!("no such file: {}: check the path", path.display()));
+    }
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_lowercase();
+    let fail = |e: String| invalid!("{}: {e}", path.display());
+    let mut file = match ext.as_str() {
+        "obj" => LoadedFile { meshes: obj::load(path).map_err(fail)?, cameras: Vec::new() },
+        "ply" => LoadedFile { meshes: vec![ply::load_ply(path).map_err(fail)?], cameras: Vec::new() },
+        "stl" => LoadedFile { meshes: vec![ply::load_stl(path).map_err(fail)?], cameras: Vec::new() },
+        "gltf" | "glb" => gltf::load(path).map_err(fail)?,
+        _ => return Err(invalid!("{}: unknown file type '.{ext}': oit reads {FORMATS}", path.display())),
+    };
+    if file.meshes.iter().all(|m| m.mesh.indices.is_empty()) {
+        return Err(invalid!("{} has no triangles: oit draws triangle meshes", path.display()));
+    }
+    file.meshes.retain(|m| !m.mesh.indices.is_empty());
+    for m in &mut file.meshes {
+        restyle(&mut m.mesh, surface).map_err(|e| invalid!("{}: '{}': {e}", path.display(), m.name))?;
+    }
+    Ok(file)
+}
+
+/// Applies `surface` to a loaded mesh, keeping what the file gave (normals, UVs, texture,
+/// sidedness); flat and unlit shading drop the normals.
+fn restyle(mesh: &mut Mesh, surface: Surface) -> Result<()> {
+    let normals = (surface.shading == Shading::Smooth && !mesh.normals.is_empty()).then(|| std::mem::take(&mut mesh.normals));
+    let uvs = (!mesh.uvs.is_empty()).then(|| std::mem::take(&mut mesh.uvs));
+    let material = Material { shading: surface.shading, specular: surface.specular, ..std::mem::take(&mut mesh.material) };
+    *mesh = std::mem::take(mesh).with_surface(normals, uvs, material)?;
+    Ok(())
+}
+
+/// Whether a mesh blends: not opaque, and some vertex alpha, texel alpha or its opacity lies
+/// strictly between 0 and 1 (alpha-tested surfaces, 0 or 1 everywhere, do not).
+pub fn blends(mesh: &Mesh) -> bool {
+    let partial = |a: f32| a > 0.0 && a < 1.0;
+    let texture = mesh.material.texture.as_ref().is_some_and(|t| t.texels.iter().any(|c| partial(c[3])));
+    !mesh.opaque && (partial(mesh.material.opacity) || texture || mesh.colors.iter().any(|c| partial(c[3])))
+}
+
+/// Makes every mesh transparent at `alpha` (vertex alpha; textures keep theirs).
+pub fn set_alpha(meshes: &mut [NamedMesh], alpha: f32) -> Result<()> {
+    if !(0.0..=1.0).contains(&alpha) {
+        return Err(invalid!("alpha {alpha} is outside [0, 1]"));
+    }
+    for m in meshes {
+        m.mesh.opaque = false;
+        m.mesh.colors.iter_mut().for_each(|c| c[3] = alpha);
+    }
+    Ok(())
+}
+
+/// The command line's and the viewer's alpha: `alpha` for every mesh when given; otherwise,
+/// when nothing in the file blends, VIEWING_ALPHA for every mesh, and the sentence saying so.
+pub fn viewing_alpha(meshes: &mut [NamedMesh], alpha: Option<f32>) -> Result<Option<String>> {
+    if let Some(a) = alpha {
+        set_alpha(meshes, a)?;
+        return Ok(None);
+    }
+    if meshes.iter().any(|m| blends(&m.mesh)) {
+        return Ok(None);
+    }
+    set_alpha(meshes, VIEWING_ALPHA)?;
+    Ok(Some(format!("nothing in the file is transparent: every mesh is drawn at alpha {VIEWING_ALPHA} (--alpha A sets another)")))
+}
+
+impl LoadedFile {
+    /// The meshes as a scene, in file order, with the loader's ambient term.
+    pub fn scene(&self) -> Scene {
+        let mut scene = Scene::new();
+        for m in &self.meshes {
+            scene.add_mesh(m.mesh.clone());
+        }
+        scene.set_ambient(AMBIENT).expect("a valid ambient term");
+        scene
+    }
+}
+
+pub(crate) fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// A validated mesh (colors clamped to [0, 1]) under its name.
+pub(crate) fn named(
+    name: String,
+    positions: Vec<[f32; 3]>,
+    indices: Vec<[u32; 3]>,
+    colors: Vec<[f32; 4]>,
+    opaque: bool,
+) -> std::result::Result<NamedMesh, String> {
+    let colors = colors.into_iter().map(|c| c.map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) })).collect();
+    let mesh = Mesh::new(positions, indices, colors, opaque).map_err(|e| format!("'{name}': {e}"))?;
+    Ok(NamedMesh { name, mesh })
+}
+
+/// An 8-bit image to a linear texture: RGB decoded from sRGB, alpha as it is.
+pub(crate) fn texture_from_rgba8(width: u32, height: u32, rgba: &[u8]) -> std::result::Result<Texture, String> {
+    let texels = rgba.chunks_exact(4).map(|p| [srgb8(p[0]), srgb8(p[1]), srgb8(p[2]), p[3] as f32 / 255.0]).collect();
+    Texture::new(width, height, texels).map_err(|e| e.to_string())
+}
+
+fn srgb8(c: u8) -> f32 {
+    srgb_to_linear(c as f32 / 255.0)
+}
+
+/// The axis-aligned bounds of every mesh (for file cameras without a far plane).
+pub(crate) fn bounds(meshes: &[NamedMesh]) -> (DVec3, DVec3) {
+    let points = meshes.iter().flat_map(|m| m.mesh.positions.iter()).map(|p| DVec3::from(p.map(|x| x as f64)));
+    points.fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), p| (lo.min(p), hi.max(p)))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,88 @@
+//! The core's loader (`oit_core::load`) for `oit.Scene.from_file` and the command line: the
+//! scene, its mesh names, the file's cameras as dicts, and the viewing-alpha note.
+
+use std::path::PathBuf;
+
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use oit_core::load::{self, Projection, Surface};
+
+use crate::{Error, Scene};
+
+/// Reads `path`; `shading` and `specular` style every surface (`load::Surface`). `alpha`
+/// makes every mesh transparent at it; `viewing` adds the command line's convenience (every
+/// mesh at VIEWING_ALPHA when nothing blends) and returns its note.
+#[pyfunction]
+#[pyo3(signature = (path, shading="smooth", specular=0.25, alpha=None, viewing=false))]
+#[allow(clippy::type_complexity)]
+pub fn load_file<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    shading: &str,
+    specular: f32,
+    alpha: Option<f32>,
+    viewing: bool,
+) -> PyResult<(Scene, Vec<String>, Bound<'py, PyList>, Option<String>)> {
+    let surface = Surface { shading: oit_core::Shading::from_name(shading).map_err(Error::from)?, specular };
+    let (file, note) = py
+        .detach(|| -> oit_core::Result<_> {
+            let mut file = load::load_file(&path, surface)?;
+            let note = match (viewing, alpha) {
+                (true, a) => load::viewing_alpha(&mut file.meshes, a)?,
+                (false, Some(a)) => load::set_alpha(&mut file.meshes, a).map(|_| None)?,
+                (false, None) => None,
+            };
+            Ok((file, note))
+        })
+        .map_err(Error::from)?;
+    let cameras = PyList::empty(py);
+    for c in &file.cameras {
+        let d = PyDict::new(py);
+        d.set_item("name", &c.name)?;
+        d.set_item("view", c.view.to_vec())?;
+        let (near, far) = match c.projection {
+            Projection::Perspective { yfov, aspect, near, far } => {
+                d.set_item("type", "perspective")?;
+                d.set_item("yfov", yfov)?;
+                d.set_item("aspect", aspect)?;
+                (near, far)
+            }
+            Projection::Orthographic { xmag, ymag, near, far } => {
+                d.set_item("type", "orthographic")?;
+                d.set_item("xmag", xmag)?;
+                d.set_item("ymag", ymag)?;
+                (near, far)
+            }
+        };
+        d.set_item("near", near)?;
+        d.set_item("far", far)?;
+        cameras.append(d)?;
+    }
+    let names = file.meshes.iter().map(|m| m.name.clone()).collect();
+    Ok((Scene { inner: file.scene() }, names, cameras, note))
+}
+
+/// One dict a mesh: opaque, shading, textured, two_sided, cull_back_faces, the vertex
+/// alphas' range and the mean vertex color.
+pub fn mesh_materials<'py>(py: Python<'py>, scene: &oit_core::Scene) -> PyResult<Bound<'py, PyList>> {
+    let out = PyList::empty(py);
+    for m in scene.meshes() {
+        let d = PyDict::new(py);
+        let n = m.colors.len().max(1) as f64;
+        let mean: [f64; 4] = std::array::from_fn(|i| m.colors.iter().map(|c| c[i] as f64).sum::<f64>() / n);
+        let alphas = m.colors.iter().map(|c| c[3]);
+        d.set_item("opaque", m.opaque)?;
+        d.set_item("shading", m.material.shading.name())?;
+        d.set_item("textured", m.material.texture.is_some())?;
+        d.set_item("two_sided", m.material.two_sided)?;
+        d.set_item("cull_back_faces", m.material.cull_back_faces)?;
+        d.set_item("alpha_min", alphas.clone().fold(f32::INFINITY, f32::min))?;
+        d.set_item("alpha_max", alphas.fold(f32::NEG_INFINITY, f32::max))?;
+        d.set_item("color_mean", mean)?;
+        d.set_item("has_normals", !m.normals.is_empty())?;
+        d.set_item("has_uvs", !m.uvs.is_empty())?;
+        out.append(d)?;
+    }
+    Ok(out)
+}

@@ -1,0 +1,140 @@
+"""Small mesh files written by the tests, for the loader (oit-core's, behind Scene.from_file,
+the command line and the viewer): a GLB built by hand (JSON and binary chunks), OBJ with MTL,
+PLY with RGBA vertex colors and binary STL."""
+
+from __future__ import annotations
+
+import json
+import struct
+from pathlib import Path
+
+import numpy as np
+
+from oit.imageio import encode_png
+
+# A unit cube's corners and its 12 triangles, counter-clockwise seen from outside.
+CUBE = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)], dtype=np.float32)
+CUBE_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                       [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]], dtype=np.uint32)
+QUAD = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], dtype=np.float32)
+QUAD_FACES = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.uint32)
+QUAD_UVS = np.array([[0, 1], [1, 1], [1, 0], [0, 0]], dtype=np.float32)
+
+
+class Gltf:
+    """A glTF document grown call by call; `glb()` packs it with its one binary buffer."""
+
+    def __init__(self) -> None:
+        self.bin = bytearray()
+        self.doc: dict = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": []}], "nodes": [], "meshes": [],
+                          "materials": [], "accessors": [], "bufferViews": []}
+
+    def _view(self, data: bytes) -> int:
+        self.bin += b"\0" * (-len(self.bin) % 4)
+        self.doc["bufferViews"].append({"buffer": 0, "byteOffset": len(self.bin), "byteLength": len(data)})
+        self.bin += data
+        return len(self.doc["bufferViews"]) - 1
+
+    def _accessor(self, a: np.ndarray, kind: str) -> int:
+        component = 5125 if a.dtype == np.uint32 else 5126
+        acc = {"bufferView": self._view(a.tobytes()), "componentType": component, "count": len(a), "type": kind}
+        if kind == "VEC3" and component == 5126:
+            acc["min"], acc["max"] = a.min(0).tolist(), a.max(0).tolist()
+        self.doc["accessors"].append(acc)
+        return len(self.doc["accessors"]) - 1
+
+    def material(self, **m) -> int:
+        self.doc["materials"].append(m)
+        return len(self.doc["materials"]) - 1
+
+    def texture(self, rgba8: np.ndarray) -> int:
+        """A PNG texture (sRGB color, linear alpha) of an (h, w, 4) uint8 image."""
+        view = self._view(encode_png(rgba8))
+        self.doc.setdefault("images", []).append({"bufferView": view, "mimeType": "image/png"})
+        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1})
+        return len(self.doc["textures"]) - 1
+
+    def mesh(self, positions, indices, material: int | None = None, uvs=None, name: str = "") -> int:
+        attributes = {"POSITION": self._accessor(np.asarray(positions, np.float32), "VEC3")}
+        if uvs is not None:
+            attributes["TEXCOORD_0"] = self._accessor(np.asarray(uvs, np.float32), "VEC2")
+        prim = {"attributes": attributes, "indices": self._accessor(np.asarray(indices, np.uint32).reshape(-1), "SCALAR")}
+        if material is not None:
+            prim["material"] = material
+        self.doc["meshes"].append({"name": name, "primitives": [prim]})
+        return len(self.doc["meshes"]) - 1
+
+    def node(self, root: bool = True, **n) -> int:
+        self.doc["nodes"].append(n)
+        if root:
+            self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+        return len(self.doc["nodes"]) - 1
+
+    def glb(self) -> bytes:
+        doc = {**self.doc, "buffers": [{"byteLength": len(self.bin)}]}
+        text = json.dumps(doc).encode()
+        text += b" " * (-len(text) % 4)
+        blob = bytes(self.bin) + b"\0" * (-len(self.bin) % 4)
+        chunks = struct.pack("<I4s", len(text), b"JSON") + text + struct.pack("<I4s", len(blob), b"BIN\0") + blob
+        return struct.pack("<4sII", b"glTF", 2, 12 + len(chunks)) + chunks
+
+
+def box_and_panel_glb(path: Path, panel: bool = True) -> Path:
+    """An OPAQUE red box (the material gives no alphaMode: OPAQUE is the spec's default) in front
+    of a BLEND blue panel at alpha 0.5, seen from +z: the issue's example."""
+    g = Gltf()
+    red = g.material(name="red", pbrMetallicRoughness={"baseColorFactor": [1, 0, 0, 1]})
+    g.node(mesh=g.mesh(CUBE, CUBE_FACES, red, name="box"), translation=[0, 0, 0.5])
+    if panel:
+        blue = g.material(name="blue", alphaMode="BLEND", doubleSided=True,
+                          pbrMetallicRoughness={"baseColorFactor": [0, 0, 1, 0.5]})
+        g.node(mesh=g.mesh(QUAD * [2, 2, 1], QUAD_FACES, blue, name="panel"), translation=[0, 0, -0.5])
+    path.write_bytes(g.glb())
+    return path
+
+
+def textured_multi_node_glb(path: Path) -> Path:
+    """A textured, double-sided quad under a parent node (translated, scaled) and a second
+    instance of it on another node (rotated a half turn about y), with a camera on +z."""
+    g = Gltf()
+    texels = np.zeros((2, 2, 4), np.uint8)
+    texels[..., 3] = 255
+    texels[0, 0, :3], texels[0, 1, :3], texels[1, 0, :3], texels[1, 1, :3] = (255, 0, 0), (0, 255, 0), (0, 0, 255), (255, 255, 255)
+    tex = g.material(name="checker", doubleSided=True, alphaMode="BLEND",
+                     pbrMetallicRoughness={"baseColorFactor": [1, 1, 1, 0.6], "baseColorTexture": {"index": g.texture(texels)}})
+    quad = g.mesh(QUAD, QUAD_FACES, tex, uvs=QUAD_UVS, name="quad")
+    child = g.node(root=False, mesh=quad, scale=[0.5, 0.5, 0.5])
+    g.node(children=[child], translation=[1, 0, 0])
+    g.node(mesh=quad, translation=[-1, 0, 0], rotation=[0, 1, 0, 0])
+    g.doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1, "zfar": 20, "aspectRatio": 1.0}}]
+    g.node(camera=0, translation=[0, 0, 4])
+    path.write_bytes(g.glb())
+    return path
+
+
+def obj_with_dissolve(path: Path) -> Path:
+    """Two quads: 'glass' with d 0.25 (Kd red) and 'wall' with Tr 0.5 (Kd blue, sRGB 0.5)."""
+    path.with_suffix(".mtl").write_text("newmtl glass\nKd 1 0 0\nd 0.25\nnewmtl wall\nKd 0 0 0.5\nTr 0.5\n")
+    v = "".join(f"v {x} {y} {z}\n" for x, y, z in QUAD.tolist()) + "".join(f"v {x} {y} -1\n" for x, y, _ in QUAD.tolist())
+    path.write_text(f"mtllib {path.with_suffix('.mtl').name}\n{v}o glass\nusemtl glass\nf 1 2 3 4\n"
+                    "o wall\nusemtl wall\nf 5 6 7\nf 5 7 8\n")
+    return path
+
+
+def ply_rgba(path: Path) -> Path:
+    """A quad (one polygon, fanned) with 8-bit RGBA vertex colors, alpha 128/255."""
+    head = ("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+            "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n"
+            "element face 1\nproperty list uchar int vertex_indices\nend_header\n")
+    rows = "".join(f"{x} {y} {z} 0 255 0 128\n" for x, y, z in QUAD.tolist())
+    path.write_text(head + rows + "4 0 1 2 3\n")
+    return path
+
+
+def stl_cube(path: Path) -> Path:
+    """The cube as binary STL (12 facets)."""
+    data = bytearray(80) + struct.pack("<I", len(CUBE_FACES))
+    for f in CUBE_FACES:
+        data += struct.pack("<3f", 0, 0, 0) + CUBE[f].astype("<f4").tobytes() + b"\0\0"
+    path.write_bytes(bytes(data))
+    return path
