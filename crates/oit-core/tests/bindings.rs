@@ -173,3 +173,26 @@ fn every_binding_of_a_method_group_is_declared_by_a_shader() {
         assert!(missing.is_empty(), "{} at group {}: no shader that binds it declares bindings {missing:?}", key.0, key.1);
     }
 }
+
+/// A binding or struct written the same way in two files belongs in one shared include
+/// (shaders/common/), so that the files cannot drift apart.
+#[test]
+fn no_binding_or_struct_is_written_twice() {
+    let mut seen: BTreeMap<String, &str> = BTreeMap::new();
+    for (path, src) in oit_core::shader::SOURCES {
+        let lines: Vec<&str> = src.lines().map(|l| l.split("//").next().unwrap_or("").trim()).filter(|l| !l.is_empty()).collect();
+        for (i, line) in lines.iter().enumerate() {
+            let decl = if line.starts_with("@group(") {
+                line.to_string()
+            } else if line.starts_with("struct ") {
+                let end = lines[i..].iter().position(|l| *l == "}").map_or(lines.len(), |e| i + e + 1);
+                lines[i..end].join(" ")
+            } else {
+                continue;
+            };
+            if let Some(first) = seen.insert(decl.clone(), path) {
+                panic!("{first} and {path} both declare `{decl}`: move it to a shared include under shaders/common/");
+            }
+        }
+    }
+}
