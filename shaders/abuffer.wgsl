@@ -5,16 +5,8 @@
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
-// Mirrors oit_core::gpu_types::PoolNode.
-struct Node {
-    depth: f32,
-    next: u32,
-    rg: vec2<f32>,
-    ba: vec2<f32>,
-}
+//!include common/pool_node.wgsl
 //!include common/pool.wgsl
-
-@group(2) @binding(6) var<storage, read_write> state: array<u32>;
 
 @fragment @early_depth_test(force)
 fn fs_capture(raw: VsOut) {

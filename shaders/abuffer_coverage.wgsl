@@ -18,8 +18,6 @@ struct Node {
 }
 //!include common/pool.wgsl
 
-@group(2) @binding(6) var<storage, read_write> state: array<u32>;
-
 @fragment
 fn fs_capture(raw: VsOut, @builtin(sample_mask) coverage: u32) {
     let in = shaded(raw);

@@ -7,7 +7,7 @@
 //!include common/scene.wgsl
 //!include common/targets.wgsl
 
-@group(2) @binding(0) var<storage, read_write> counts: array<atomic<u32>>;
+//!include common/census_counts.wgsl
 
 @fragment @early_depth_test(force)
 fn fs_census(in: VsOut) {

@@ -3,7 +3,7 @@
 //!include common/scene.wgsl
 //!include common/targets_samples.wgsl
 
-@group(2) @binding(0) var<storage, read_write> counts: array<atomic<u32>>;
+//!include common/census_counts.wgsl
 
 @fragment
 fn fs_census(in: VsOut, @builtin(sample_mask) coverage: u32) {

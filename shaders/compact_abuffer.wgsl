@@ -16,8 +16,6 @@ struct Node {
 }
 //!include common/pool.wgsl
 
-@group(2) @binding(6) var<storage, read_write> state: array<u32>;
-
 // Mirrors oit_core::gpu_types::PrimShading: clip-space corners and their colors, and (shaded
 // scenes) their shading normals with the material index in w, and UVs.
 struct PrimShading {

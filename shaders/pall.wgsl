@@ -10,16 +10,8 @@
 //!include common/fullscreen.wgsl
 //!include common/setup.wgsl
 
-// Mirrors oit_core::gpu_types::PoolNode.
-struct Node {
-    depth: f32,
-    next: u32,
-    rg: vec2<f32>,
-    ba: vec2<f32>,
-}
+//!include common/pool_node.wgsl
 //!include common/pool.wgsl
-
-@group(2) @binding(6) var<storage, read_write> state: array<u32>;
 // Per triangle: its block's first node and its box (origin and extent, 16 bits each).
 // Mirrors oit_core::gpu_types::PallBlock.
 struct Block {

@@ -6,18 +6,11 @@
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
-// Mirrors oit_core::gpu_types::PoolNode. Capture links each range's nodes in order, so that the
-// resolve sorts a range by relinking it like a list.
-struct Node {
-    depth: f32,
-    next: u32,
-    rg: vec2<f32>,
-    ba: vec2<f32>,
-}
+// Capture links each range's nodes in order, so that the resolve sorts a range by relinking it
+// like a list.
+//!include common/pool_node.wgsl
 // `heads` serves as each pixel's fill cursor (a copy of its range start).
 //!include common/pool.wgsl
-
-@group(2) @binding(6) var<storage, read_write> state: array<u32>;
 // Counts, then (scanned in place) range starts; entry W * H is the total.
 @group(2) @binding(7) var<storage, read_write> offsets: array<atomic<u32>>;
 

@@ -50,10 +50,7 @@ fn fs_depth(raw: VsOut) {
     }
 }
 
-struct Accum {
-    @location(0) accum: vec4<f32>,
-    @location(1) aux: vec4<f32>,
-}
+//!include common/accum_targets.wgsl
 
 @fragment
 fn fs_accum(raw: VsOut) -> Accum {

@@ -10,10 +10,7 @@
 @group(2) @binding(0) var accum_tex: texture_2d<f32>;
 @group(2) @binding(1) var aux_tex: texture_2d<f32>;
 
-struct Accum {
-    @location(0) accum: vec4<f32>,
-    @location(1) aux: vec4<f32>,
-}
+//!include common/accum_targets.wgsl
 
 @fragment
 fn fs_sum(raw: VsOut) -> Accum {

@@ -1,6 +1,8 @@
 // Per-pixel linked lists over the node pool of common/nodes.wgsl. Links (heads, next) store
 // a node's index + 1, so that a zero-cleared head buffer means empty lists. The including
-// shader defines `struct Node` with a `next: u32` field (abuffer.wgsl, adaptive.wgsl, ...).
+// shader defines `struct Node` with a `next: u32` field (common/pool_node.wgsl,
+// adaptive.wgsl, ...). Group 2 is the pool's (oit_core::method::list_pipelines::POOL_LAYOUT):
+// heads, allocator, the pool bindings, sweep state (6) and the method's binding 7.
 
 struct Alloc {
     count: atomic<u32>,
@@ -34,3 +36,7 @@ fn push_node(px: u32, n: Node) {
     node.next = atomicExchange(&heads[px], i + 1u);
     store_node(i, node);
 }
+
+// Per-pixel state carried between the sorted resolve's sweeps (common/sweep.wgsl); unused by
+// the submission-order methods, which resolve in one dispatch.
+@group(2) @binding(6) var<storage, read_write> state: array<u32>;

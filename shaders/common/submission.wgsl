@@ -15,8 +15,6 @@ struct Node {
 }
 //!include common/pool.wgsl
 
-@group(2) @binding(6) var<storage, read_write> state: array<u32>; // unused: one dispatch
-
 struct Frag {
     prim: u32,
     depth: f32,

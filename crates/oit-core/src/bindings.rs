@@ -1,6 +1,7 @@
-//! The formats and bind-group layouts every pass shares: the frame's target formats, group 0
-//! (the scene), group 1 (the opaque targets, single or per sample) and the entries of method
-//! groups. Depends on wgpu alone, so that everything that builds pipelines can use it.
+//! The formats and bind-group layout entries every pass shares: the frame's target formats,
+//! group 0 (the scene), group 1 (the opaque targets, single or per sample) and the entries of
+//! method groups (`cache::Layout::entries` puts them together). Depends on wgpu alone, so that
+//! everything that builds pipelines can use it.
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
@@ -12,70 +13,52 @@ pub const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 /// Per-pixel error bound written by methods that derive one.
 pub const BOUND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
-pub fn targets_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    opaque_layout(device, "targets", wgpu::TextureViewDimension::D2)
-}
-
-/// Group 1 of storage-writing and resolve passes: the opaque depth (binding 0) and base
-/// color (binding 1), as single textures or, for coverage-mask frames, arrays of layers.
-fn opaque_layout(device: &wgpu::Device, label: &str, view_dimension: wgpu::TextureViewDimension) -> wgpu::BindGroupLayout {
+/// Group 1 of storage-writing and resolve passes (`cache::Layout::Targets` and
+/// `SampleTargets`): the opaque depth (binding 0) and base color (binding 1), as single
+/// textures or, for coverage-mask frames (shaders/common/targets_samples.wgsl), as 2D arrays
+/// with a layer per sample position.
+pub fn opaque_entries(view_dimension: wgpu::TextureViewDimension) -> Vec<wgpu::BindGroupLayoutEntry> {
     let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
         ty: wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false },
         count: None,
     };
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &[tex(0, wgpu::TextureSampleType::Depth), tex(1, wgpu::TextureSampleType::Float { filterable: false })],
-    })
+    vec![tex(0, wgpu::TextureSampleType::Depth), tex(1, wgpu::TextureSampleType::Float { filterable: false })]
 }
 
-/// Group 1 of a coverage-mask frame (shaders/common/targets_samples.wgsl): the opaque depth
-/// and base color of each sample position, as layers of 2D arrays.
-pub fn samples_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    opaque_layout(device, "sample targets", wgpu::TextureViewDimension::D2Array)
-}
-
-pub fn scene_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let storage_in = |binding, visibility| wgpu::BindGroupLayoutEntry {
+fn buffer_entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
         count: None,
-    };
-    let storage = |binding| storage_in(binding, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE);
-    let uniform = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
-        count: None,
-    };
-    // The frame uniform, positions, colors, indices, the chunk's place in the scene, the
-    // vertex attributes of shading, and the material table that fragments shade with.
+    }
+}
+
+/// Group 0 (shaders/common/scene.wgsl): the frame uniform, positions, colors, indices, the
+/// chunk's place in the scene, the vertex attributes of shading, and the material table that
+/// fragments shade with.
+pub fn scene_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("scene"),
-        entries: &[uniform(0), storage(1), storage(2), storage(3), uniform(4), storage(5), storage_in(6, all)],
-    })
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    let storage = |binding| buffer_entry(binding, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE, read);
+    let uniform = |binding| buffer_entry(binding, all, wgpu::BufferBindingType::Uniform);
+    vec![uniform(0), storage(1), storage(2), storage(3), uniform(4), storage(5), buffer_entry(6, all, read)]
+}
+
+/// The prefix sum's group (shaders/scan.wgsl): the data and the block sums, read-write, and
+/// the level's uniform.
+pub fn scan_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+    let storage = wgpu::BufferBindingType::Storage { read_only: false };
+    let compute = wgpu::ShaderStages::COMPUTE;
+    vec![buffer_entry(0, compute, storage), buffer_entry(1, compute, storage), buffer_entry(2, compute, wgpu::BufferBindingType::Uniform)]
 }
 
 /// Layout entry of a read-write storage buffer visible to fragment and compute shaders.
 pub fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: false },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
+    let visibility = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+    buffer_entry(binding, visibility, wgpu::BufferBindingType::Storage { read_only: false })
 }
 
 /// Layout entry of an unfilterable float texture read by fragment shaders (accumulation

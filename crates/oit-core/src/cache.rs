@@ -67,18 +67,33 @@ pub enum Layout {
     Storage(u32),
     /// Unfilterable float textures at these bindings (accumulation targets a resolve reads).
     Textures(&'static [u32]),
+    /// The prefix sum's group (scan.rs): the data and block sums, read-write, and its uniform.
+    Scan,
 }
 
 impl Layout {
-    fn create(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        let entries: Vec<wgpu::BindGroupLayoutEntry> = match self {
-            Layout::Scene => return bindings::scene_layout(device),
-            Layout::Targets => return bindings::targets_layout(device),
-            Layout::SampleTargets => return bindings::samples_layout(device),
+    /// The entries of the layout: what `PipelineCache::layout` creates, and what
+    /// tests/bindings.rs checks each shader's bindings against.
+    pub fn entries(self) -> Vec<wgpu::BindGroupLayoutEntry> {
+        match self {
+            Layout::Scene => bindings::scene_entries(),
+            Layout::Targets => bindings::opaque_entries(wgpu::TextureViewDimension::D2),
+            Layout::SampleTargets => bindings::opaque_entries(wgpu::TextureViewDimension::D2Array),
             Layout::Storage(n) => (0..n).map(bindings::storage_entry).collect(),
             Layout::Textures(at) => at.iter().map(|&b| bindings::float_texture_entry(b)).collect(),
+            Layout::Scan => bindings::scan_entries(),
+        }
+    }
+
+    fn create(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let label = match self {
+            Layout::Scene => "scene",
+            Layout::Targets => "targets",
+            Layout::SampleTargets => "sample targets",
+            Layout::Scan => "scan",
+            Layout::Storage(_) | Layout::Textures(_) => "oit group",
         };
-        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("oit group"), entries: &entries })
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &self.entries() })
     }
 }
 
@@ -107,6 +122,78 @@ pub struct ComputeDesc {
     pub shader: ShaderKey,
     pub entry: &'static str,
     pub groups: Vec<Layout>,
+}
+
+/// The stages a pipeline runs, and so its entry points besides its own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stages {
+    /// Scene triangles by vertex pulling (`vs_main`), then the fragment entry.
+    Geometry,
+    /// One full-screen triangle (`vs_fullscreen`), then the fragment entry.
+    Fullscreen,
+    /// The compute entry alone.
+    Compute,
+}
+
+/// One pipeline as declared once: its shader file, entry point, stages, and the layout of each
+/// bind group (0, 1, ...). Each method builds its pipelines from its table of these
+/// (`MethodInfo::pipelines`; the renderer's are `ENGINE_PIPELINES`), and tests/bindings.rs
+/// checks every entry against what its WGSL binds, by naga reflection.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PipelineSpec {
+    pub shader: &'static str,
+    pub entry: &'static str,
+    pub stages: Stages,
+    pub groups: &'static [Layout],
+}
+
+impl PipelineSpec {
+    /// A geometry pipeline of the fragment entry `entry`.
+    pub const fn geometry(shader: &'static str, entry: &'static str, groups: &'static [Layout]) -> Self {
+        Self { shader, entry, stages: Stages::Geometry, groups }
+    }
+
+    /// A full-screen pipeline of the fragment entry `entry`.
+    pub const fn fullscreen(shader: &'static str, entry: &'static str, groups: &'static [Layout]) -> Self {
+        Self { shader, entry, stages: Stages::Fullscreen, groups }
+    }
+
+    pub const fn compute(shader: &'static str, entry: &'static str, groups: &'static [Layout]) -> Self {
+        Self { shader, entry, stages: Stages::Compute, groups }
+    }
+
+    /// The entry points the pipeline runs, with their stages.
+    pub fn entry_points(&self) -> Vec<(&'static str, wgpu::ShaderStages)> {
+        match self.stages {
+            Stages::Geometry => vec![("vs_main", wgpu::ShaderStages::VERTEX), (self.entry, wgpu::ShaderStages::FRAGMENT)],
+            Stages::Fullscreen => vec![("vs_fullscreen", wgpu::ShaderStages::VERTEX), (self.entry, wgpu::ShaderStages::FRAGMENT)],
+            Stages::Compute => vec![(self.entry, wgpu::ShaderStages::COMPUTE)],
+        }
+    }
+
+    /// The render pipeline of this spec with the shader constants `consts`.
+    pub fn render(&self, consts: &[Const], draw: Draw, targets: Vec<Option<wgpu::ColorTargetState>>) -> RenderDesc {
+        let stages = match draw {
+            Draw::Geometry { .. } => Stages::Geometry,
+            Draw::Fullscreen => Stages::Fullscreen,
+        };
+        assert_eq!(stages, self.stages, "{} {}: drawn as another kind of pipeline than declared", self.shader, self.entry);
+        RenderDesc { shader: ShaderKey::new(self.shader, consts), entry: self.entry, groups: self.groups.to_vec(), draw, targets }
+    }
+
+    /// The compute pipeline of this spec with the shader constants `consts`.
+    pub fn compute_desc(&self, consts: &[Const]) -> ComputeDesc {
+        assert_eq!(self.stages, Stages::Compute, "{} {}: not declared a compute pipeline", self.shader, self.entry);
+        ComputeDesc { shader: ShaderKey::new(self.shader, consts), entry: self.entry, groups: self.groups.to_vec() }
+    }
+}
+
+/// The pipeline of `entry` in `table` (a method's declared pipelines).
+pub fn spec(table: &'static [PipelineSpec], entry: &str) -> &'static PipelineSpec {
+    table.iter().find(|p| p.entry == entry).unwrap_or_else(|| {
+        let shader = table.first().map_or("an empty table", |p| p.shader);
+        panic!("{shader}: no pipeline of entry {entry} is declared in its table")
+    })
 }
 
 /// Modules, layouts and pipelines of one device, each built at its first use.
@@ -176,3 +263,19 @@ pub fn resolve_targets(bound: bool) -> Vec<Option<wgpu::ColorTargetState>> {
     }
     t
 }
+
+/// The renderer's own pipelines (renderer/execute.rs, renderer/into.rs) and the prefix sum's
+/// (scan.rs), listed in `ENGINE_PIPELINES`; the methods' are in their `MethodInfo::pipelines`.
+pub const OPAQUE: PipelineSpec = PipelineSpec::geometry("opaque.wgsl", "fs_opaque", &[Layout::Scene]);
+/// The census by blending into the count target.
+pub const CENSUS_BLEND: PipelineSpec = PipelineSpec::geometry("census.wgsl", "fs_count", &[Layout::Scene]);
+/// The census with an atomic a fragment into the counts buffer.
+pub const CENSUS_ATOMIC: PipelineSpec =
+    PipelineSpec::geometry("census.wgsl", "fs_census", &[Layout::Scene, Layout::Targets, Layout::Storage(1)]);
+/// The census of a coverage-mask frame, at each sample's coverage.
+pub const CENSUS_SAMPLES: PipelineSpec =
+    PipelineSpec::geometry("census_samples.wgsl", "fs_census", &[Layout::Scene, Layout::SampleTargets, Layout::Storage(1)]);
+pub const BLIT: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit", &[Layout::Textures(&[0])]);
+pub const SCAN_BLOCKS: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_scan_blocks", &[Layout::Scan]);
+pub const SCAN_ADD: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_add_blocks", &[Layout::Scan]);
+pub const ENGINE_PIPELINES: &[PipelineSpec] = &[OPAQUE, CENSUS_BLEND, CENSUS_ATOMIC, CENSUS_SAMPLES, BLIT, SCAN_BLOCKS, SCAN_ADD];

@@ -62,11 +62,10 @@ impl Counter {
 }
 
 /// Storage buffers bound together as one group (bindings 0..n in order, then the counters'),
-/// reallocated only when their sizes change.
+/// reallocated only when their sizes change. Its layout, `Layout::Storage` of them all, is
+/// the one the method's pipeline table declares at group 2.
 pub struct StorageGroup {
     sizes: Vec<u64>,
-    /// Bindings of the group: the buffers, then the counters.
-    bindings: u32,
     pub buffers: Vec<wgpu::Buffer>,
     pub group: wgpu::BindGroup,
 }
@@ -92,14 +91,9 @@ impl StorageGroup {
                 all.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
             let group =
                 d.create_bind_group(&wgpu::BindGroupDescriptor { label: buffers.first().map(|b| b.0), layout: &layout, entries: &entries });
-            *slot = Some(StorageGroup { sizes, bindings: all.len() as u32, buffers: made, group });
+            *slot = Some(StorageGroup { sizes, buffers: made, group });
         }
         slot.as_ref().expect("made above")
-    }
-
-    /// The layout a pipeline over this group binds at group 2 (its buffers and counters).
-    pub fn layout(&self) -> Layout {
-        Layout::Storage(self.bindings)
     }
 
     /// Records zeroing every buffer of the group (not the counters).

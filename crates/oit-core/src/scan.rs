@@ -2,8 +2,8 @@
 //! blocks scanned serially, one an invocation, their totals scanned recursively, then added
 //! back.
 
+use crate::cache::{SCAN_ADD, SCAN_BLOCKS};
 use crate::context::GpuContext;
-use crate::shader;
 use crate::targets::storage_buffer;
 
 const BLOCK: u64 = 256;
@@ -37,21 +37,8 @@ impl Scan {
     /// A scan of the first `n` words of `data`.
     pub fn new(gpu: &GpuContext, data: &wgpu::Buffer, n: u64) -> Self {
         let d = &gpu.device;
-        let module = shader::module(d, "scan.wgsl", &[]);
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        };
-        let storage = wgpu::BufferBindingType::Storage { read_only: false };
-        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scan"),
-            entries: &[entry(0, storage), entry(1, storage), entry(2, wgpu::BufferBindingType::Uniform)],
-        });
-        let pl = crate::pipeline::layout(d, &[&layout]);
-        let pipeline = |entry: &str| crate::pipeline::compute(d, &pl, &module, entry);
-        let (scan, add) = (pipeline("cs_scan_blocks"), pipeline("cs_add_blocks"));
+        let layout = gpu.cache.layout(d, SCAN_BLOCKS.groups[0]);
+        let (scan, add) = (gpu.cache.compute(d, &SCAN_BLOCKS.compute_desc(&[])), gpu.cache.compute(d, &SCAN_ADD.compute_desc(&[])));
         let mut buffers = Vec::new();
         let mut levels = Vec::new();
         let mut bytes = 0;

@@ -61,6 +61,25 @@ impl SceneVariant {
     }
 }
 
+/// Scene variants besides the defaults' that tests validate every shader in: unlit, lit
+/// without textures, and the shading-cost knob on an unlit scene.
+pub const VALIDATION_VARIANTS: [SceneVariant; 3] = [
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0 },
+    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0 },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3 },
+];
+
+/// `DEFAULT_CONSTS` with `variant`'s constants in place of the defaults of the same names.
+pub fn variant_consts(variant: SceneVariant) -> Vec<Const> {
+    let own = variant.consts();
+    let name = |c: &Const| match *c {
+        Const::U32(n, _) | Const::F32(n, _) => n,
+    };
+    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !own.iter().any(|o| name(o) == name(c))).collect();
+    consts.extend(own);
+    consts
+}
+
 fn source(path: &str) -> &'static str {
     SOURCES.iter().find(|(p, _)| *p == path).map(|(_, s)| *s).unwrap_or_else(|| panic!("shader '{path}' is not in shader::SOURCES"))
 }

@@ -2,7 +2,7 @@
 //! with Rust have the sizes naga computes.
 
 use oit_core::gpu_types::{Alloc, CompactNode, CoverageNode, FrameUniform, GpuLight, PallBlock, PoolNode, PrimNode, PrimShading};
-use oit_core::shader::{compose, entry_files, Const, SceneVariant, DEFAULT_CONSTS};
+use oit_core::shader::{compose, entry_files, variant_consts, Const, SceneVariant, DEFAULT_CONSTS, VALIDATION_VARIANTS};
 
 fn validate(path: &str) -> naga::Module {
     validate_with(path, DEFAULT_CONSTS)
@@ -30,33 +30,16 @@ fn every_shader_validates() {
 /// shading-cost knob on an unlit scene) validates too: the `//!if` blocks leave whole shaders.
 #[test]
 fn every_shader_validates_in_every_scene_variant() {
-    let variants = [
-        SceneVariant::default(),
-        SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0 },
-        SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3 },
-    ];
-    for v in variants {
-        // The variant's constants replace the defaults of the same names.
-        let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !v.consts().iter().any(|o| name(o) == name(c))).collect();
-        consts.extend(v.consts());
+    for v in VALIDATION_VARIANTS {
         for f in entry_files() {
-            validate_with(f, &consts);
+            validate_with(f, &variant_consts(v));
         }
-    }
-}
-
-fn name(c: &Const) -> &'static str {
-    match c {
-        Const::U32(n, _) | Const::F32(n, _) => n,
     }
 }
 
 #[test]
 fn an_unlit_variant_has_no_shading_varyings() {
-    let mut consts: Vec<Const> =
-        DEFAULT_CONSTS.iter().copied().filter(|c| !SceneVariant::default().consts().iter().any(|o| name(o) == name(c))).collect();
-    consts.extend(SceneVariant::default().consts());
-    let unlit = compose("blend.wgsl", &consts);
+    let unlit = compose("blend.wgsl", &variant_consts(SceneVariant::default()));
     let lit = compose("blend.wgsl", DEFAULT_CONSTS);
     for varying in ["normal: vec3<f32>", "uv: vec2<f32>", "material: u32", "fn texture_sample"] {
         assert!(!unlit.contains(varying), "the unlit blend shader still has `{varying}`");

@@ -3,10 +3,15 @@
 
 use super::frame::{FrameCtx, Limits, Method, MethodReport};
 use super::info::{AntialiasMode, ErrorBound, Memory, MethodInfo, Order, Tiling};
+use super::list_pipelines::{swept, FRAME, SAMPLES};
 use super::lists::{state_words, Aux, ListLayout, ListMethod, PIXEL_BYTES, STATE_WORDS};
+use crate::cache::PipelineSpec;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::gpu_types::{CoverageNode, PoolNode};
+
+const PIPELINES: &[PipelineSpec] = &swept("abuffer.wgsl", FRAME);
+const COVERAGE: &[PipelineSpec] = &swept("abuffer_coverage.wgsl", SAMPLES);
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "abuffer",
@@ -23,6 +28,7 @@ pub const INFO: MethodInfo = MethodInfo {
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
     census: true,
     main: None,
+    pipelines: &[PIPELINES, COVERAGE],
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 
@@ -38,7 +44,7 @@ impl ABuffer {
             gpu,
             limits,
             ListLayout {
-                shader: "abuffer.wgsl",
+                pipelines: PIPELINES,
                 node_bytes: std::mem::size_of::<PoolNode>() as u64,
                 state_words: STATE_WORDS,
                 samples: 1,
@@ -59,7 +65,7 @@ impl Method for ABuffer {
                         cx.gpu,
                         &cx.limits,
                         ListLayout {
-                            shader: "abuffer_coverage.wgsl",
+                            pipelines: COVERAGE,
                             node_bytes: std::mem::size_of::<CoverageNode>() as u64,
                             state_words: state_words(c.samples),
                             samples: c.samples,

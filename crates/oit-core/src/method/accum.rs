@@ -28,7 +28,7 @@ pub(crate) enum Aux {
     Reveal,
 }
 
-/// The two color targets of the accumulation pass.
+/// The two color targets of the accumulation pass (`Accum` of shaders/common/accum_targets.wgsl).
 pub(crate) fn accumulation_targets(aux: Aux) -> Vec<Option<wgpu::ColorTargetState>> {
     let aux_blend = if aux == Aux::Reveal { REVEAL } else { ADD };
     vec![

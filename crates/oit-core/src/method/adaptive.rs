@@ -5,11 +5,15 @@
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::list_pipelines::{single, FRAME};
 use super::lists::{check_replay_budget, Aux, ListLayout, ListMethod};
 use super::params::{ParamInfo, ParamKind};
+use crate::cache::PipelineSpec;
 use crate::error::Result;
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;
+
+const PIPELINES: &[PipelineSpec] = &single("adaptive.wgsl", FRAME);
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "adaptive",
@@ -30,12 +34,13 @@ pub const INFO: MethodInfo = MethodInfo {
     tiling: Tiling::Storage { per_pixel: 4, per_fragment: 32, per_triangle: 0 },
     census: true,
     main: Some("nodes"),
+    pipelines: &[PIPELINES],
     create: |gpu, limits| {
         Box::new(Adaptive(ListMethod::new(
             gpu,
             limits,
             ListLayout {
-                shader: "adaptive.wgsl",
+                pipelines: PIPELINES,
                 node_bytes: std::mem::size_of::<PrimNode>() as u64,
                 state_words: 0,
                 samples: 1,

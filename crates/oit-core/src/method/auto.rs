@@ -12,12 +12,16 @@ use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::ktab::{self, KTab, Slots};
 use super::params::{ParamInfo, ParamKind, Params};
-use crate::cache::ShaderKey;
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::consts::{self, ALPHA_8BIT_ERROR, ROUNDING_TERM as ROUNDING};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::resources::{Readback, StorageGroup};
 use crate::targets::read_region;
+
+/// The estimate pass, into its sums (group 2); the frame itself is the k-TAB engine's.
+const PIPELINES: &[PipelineSpec] =
+    &[PipelineSpec::geometry("auto_estimate.wgsl", "fs_estimate", &[Layout::Scene, Layout::Targets, Layout::Storage(1)])];
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "auto",
@@ -45,6 +49,7 @@ pub const INFO: MethodInfo = MethodInfo {
     tiling: Tiling::Storage { per_pixel: 96, per_fragment: 24, per_triangle: 0 },
     census: true,
     main: None,
+    pipelines: &[PIPELINES, ktab::PIPELINES],
     create: |gpu, limits| Box::new(Auto::new(gpu, limits)),
 };
 
@@ -79,7 +84,7 @@ impl Auto {
             self.readback = Some((bytes, Readback::new(cx.gpu, "auto estimate readback", bytes)));
         }
         let (_, readback) = self.readback.as_ref().expect("made above");
-        let pipeline = cx.capture_pipeline(&ShaderKey::new("auto_estimate.wgsl", &[]), "fs_estimate", b.layout());
+        let pipeline = cx.capture_pipeline(spec(PIPELINES, "fs_estimate"), &[]);
         let mut enc = cx.encoder();
         b.clear(&mut enc);
         cx.capture(&mut enc, "estimate", &pipeline, &b.group);

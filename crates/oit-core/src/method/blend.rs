@@ -4,7 +4,7 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use crate::bindings::COLOR_FORMAT;
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::passes;
 use crate::pipeline;
@@ -24,6 +24,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     tiling: Tiling::Formula,
     census: false,
     main: None,
+    pipelines: &[PIPELINES],
     create: |_, _| Box::new(Blend { kind: Kind::Unsorted }),
 };
 
@@ -89,6 +90,11 @@ impl Kind {
     }
 }
 
+const PIPELINES: &[PipelineSpec] = &[
+    PipelineSpec::geometry("blend.wgsl", "fs_blend", &[Layout::Scene]),
+    PipelineSpec::geometry("blend.wgsl", "fs_filter", &[Layout::Scene]),
+];
+
 struct Blend {
     kind: Kind,
 }
@@ -96,8 +102,7 @@ struct Blend {
 impl Method for Blend {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let target = wgpu::ColorTargetState { format: COLOR_FORMAT, blend: Some(self.kind.blend()), write_mask: wgpu::ColorWrites::ALL };
-        let shader = ShaderKey::new("blend.wgsl", &[]);
-        let pipeline = cx.draw_pipeline(&shader, self.kind.entry(), vec![Layout::Scene], vec![Some(target)], pipeline::depth_test_only());
+        let pipeline = cx.draw_pipeline(spec(PIPELINES, self.kind.entry()), &[], vec![Some(target)], pipeline::depth_test_only());
         let geo = &cx.scene.transparent;
         let mut order: Vec<usize> = (0..geo.meshes.len()).collect();
         if self.kind == Kind::Sorted {

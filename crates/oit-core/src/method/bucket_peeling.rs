@@ -5,7 +5,7 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::ShaderKey;
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -25,6 +25,7 @@ pub const INFO: MethodInfo = MethodInfo {
     tiling: Tiling::Formula,
     census: false,
     main: Some("buckets"),
+    pipelines: &[PIPELINES],
     create: |_, _| Box::new(Buckets { buffers: None, dropped: None }),
 };
 
@@ -32,6 +33,16 @@ pub const INFO: MethodInfo = MethodInfo {
 pub fn memory_bytes(pixels: u64, buckets: u64) -> u64 {
     pixels * (8 + buckets * (8 + 16)) + 4
 }
+
+const SHADER: &str = "bucket_peeling.wgsl";
+/// Group 2: bounds, keys, bucket colors, then the dropped counter.
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(4)];
+const PIPELINES: &[PipelineSpec] = &[
+    PipelineSpec::geometry(SHADER, "fs_bounds", GROUPS),
+    PipelineSpec::geometry(SHADER, "fs_keys", GROUPS),
+    PipelineSpec::geometry(SHADER, "fs_shade", GROUPS),
+    PipelineSpec::fullscreen(SHADER, "fs_resolve", GROUPS),
+];
 
 struct Buckets {
     buffers: Option<StorageGroup>,
@@ -47,15 +58,14 @@ impl Method for Buckets {
         let sizes =
             [("bucket bounds", pixels * 8), ("bucket keys", pixels * buckets as u64 * 8), ("bucket colors", pixels * buckets as u64 * 16)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[dropped]);
-        let shader = ShaderKey::new("bucket_peeling.wgsl", &[Const::U32("BUCKETS", buckets)]);
-        let own = b.layout();
+        let consts = [Const::U32("BUCKETS", buckets)];
         let mut enc = cx.encoder();
         b.clear(&mut enc);
         dropped.clear(&mut enc);
         for (fs, label) in [("fs_bounds", "bounds"), ("fs_keys", "keys"), ("fs_shade", "colors")] {
-            cx.capture(&mut enc, label, &cx.capture_pipeline(&shader, fs, own), &b.group);
+            cx.capture(&mut enc, label, &cx.capture_pipeline(spec(PIPELINES, fs), &consts), &b.group);
         }
-        cx.resolve(&mut enc, "resolve", &cx.resolve_pipeline(&shader, "fs_resolve", own, false), &b.group, false);
+        cx.resolve(&mut enc, "resolve", &cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, false), &b.group, false);
         dropped.copy(&mut enc);
         cx.submit(enc);
         let dropped = dropped.read(cx.gpu)?;

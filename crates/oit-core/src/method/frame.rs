@@ -3,13 +3,13 @@
 //! reports back (`MethodReport`); the `Method` trait.
 
 use super::params::Params;
-use crate::cache::{resolve_targets, ComputeDesc, Draw, Layout, RenderDesc, ShaderKey};
+use crate::cache::{resolve_targets, Draw, Layout, PipelineSpec, RenderDesc};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::passes;
 use crate::pipeline;
 use crate::scene::Camera;
-use crate::shader::SceneVariant;
+use crate::shader::{Const, SceneVariant};
 use crate::targets::{SampleTargets, Targets};
 use crate::tiles::Tile;
 use crate::timer::PassTimer;
@@ -82,53 +82,52 @@ impl<'a> FrameCtx<'a> {
         }
     }
 
-    /// `shader` compiled for this frame's scene variant.
-    fn specialized(&self, shader: &ShaderKey) -> ShaderKey {
-        shader.with(&self.variant.consts())
+    /// Refuses a pipeline declared with other targets at group 1 than this frame binds.
+    fn check_targets(&self, spec: &PipelineSpec) {
+        assert_eq!(spec.groups[1], self.targets_key(), "{} {}: declared for other targets than this frame's", spec.shader, spec.entry);
     }
 
-    /// A geometry pipeline of `shader`'s fragment entry `fs` that writes storage only (group 2:
-    /// `own`), tested against the opaque depth; in a coverage-mask frame, multisampled.
-    pub fn capture_pipeline(&self, shader: &ShaderKey, fs: &'static str, own: Layout) -> wgpu::RenderPipeline {
+    /// `desc` compiled for this frame's scene variant, from the cache.
+    fn render_pipeline(&self, mut desc: RenderDesc) -> wgpu::RenderPipeline {
+        desc.shader = desc.shader.with(&self.variant.consts());
+        self.gpu.cache.render(&self.gpu.device, &desc)
+    }
+
+    /// A geometry pipeline of `spec` (shader constants `consts`) that writes storage only,
+    /// tested against the opaque depth; in a coverage-mask frame, multisampled.
+    pub fn capture_pipeline(&self, spec: &PipelineSpec, consts: &[Const]) -> wgpu::RenderPipeline {
         let draw = match self.coverage {
             Some(c) => Draw::Geometry { depth: pipeline::raster_only(), samples: c.samples },
             None => Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
         };
-        let groups = vec![Layout::Scene, self.targets_key(), own];
-        self.gpu.cache.render(&self.gpu.device, &RenderDesc { shader: self.specialized(shader), entry: fs, groups, draw, targets: vec![] })
+        self.check_targets(spec);
+        self.render_pipeline(spec.render(consts, draw, vec![]))
     }
 
-    /// A geometry pipeline of `fs` with its own groups, color targets and depth state.
+    /// A geometry pipeline of `spec` with its color targets and depth state.
     pub fn draw_pipeline(
         &self,
-        shader: &ShaderKey,
-        fs: &'static str,
-        groups: Vec<Layout>,
+        spec: &PipelineSpec,
+        consts: &[Const],
         targets: Vec<Option<wgpu::ColorTargetState>>,
         depth: Option<wgpu::DepthStencilState>,
     ) -> wgpu::RenderPipeline {
-        let draw = Draw::Geometry { depth, samples: 1 };
-        self.gpu.cache.render(&self.gpu.device, &RenderDesc { shader: self.specialized(shader), entry: fs, groups, draw, targets })
+        self.render_pipeline(spec.render(consts, Draw::Geometry { depth, samples: 1 }, targets))
     }
 
-    /// A full-screen resolve of `fs` into the output (and the error bound, with `bound`).
-    pub fn resolve_pipeline(&self, shader: &ShaderKey, fs: &'static str, own: Layout, bound: bool) -> wgpu::RenderPipeline {
-        self.resolve_pipeline_groups(shader, fs, &[own], bound)
+    /// A full-screen resolve of `spec` into the output (and the error bound, with `bound`); the
+    /// method's groups are at 2, 3, ...
+    pub fn resolve_pipeline(&self, spec: &PipelineSpec, consts: &[Const], bound: bool) -> wgpu::RenderPipeline {
+        self.check_targets(spec);
+        self.render_pipeline(spec.render(consts, Draw::Fullscreen, resolve_targets(bound)))
     }
 
-    /// A full-screen resolve with the method's groups `own` at 2, 3, ...
-    pub fn resolve_pipeline_groups(&self, shader: &ShaderKey, fs: &'static str, own: &[Layout], bound: bool) -> wgpu::RenderPipeline {
-        let mut groups = vec![Layout::Scene, self.targets_key()];
-        groups.extend_from_slice(own);
-        let desc =
-            RenderDesc { shader: self.specialized(shader), entry: fs, groups, draw: Draw::Fullscreen, targets: resolve_targets(bound) };
-        self.gpu.cache.render(&self.gpu.device, &desc)
-    }
-
-    /// A compute pipeline of `entry` over the shared groups and `own`.
-    pub fn compute_pipeline(&self, shader: &ShaderKey, entry: &'static str, own: Layout) -> wgpu::ComputePipeline {
-        let groups = vec![Layout::Scene, self.targets_key(), own];
-        self.gpu.cache.compute(&self.gpu.device, &ComputeDesc { shader: self.specialized(shader), entry, groups })
+    /// A compute pipeline of `spec` over the shared groups and the method's.
+    pub fn compute_pipeline(&self, spec: &PipelineSpec, consts: &[Const]) -> wgpu::ComputePipeline {
+        self.check_targets(spec);
+        let mut desc = spec.compute_desc(consts);
+        desc.shader = desc.shader.with(&self.variant.consts());
+        self.gpu.cache.compute(&self.gpu.device, &desc)
     }
 
     /// A bind group of `layout` over `resources` at bindings 0, 1, ... (or the layout's own).

@@ -35,6 +35,7 @@ pub const HYBRID: MethodInfo = MethodInfo {
     tiling: Tiling::Formula,
     census: false,
     main: Some("k"),
+    pipelines: &[super::ktab::PIPELINES],
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
 };
 

@@ -7,7 +7,7 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::ShaderKey;
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -31,8 +31,14 @@ pub const INFO: MethodInfo = MethodInfo {
     tiling: Tiling::Formula,
     census: false,
     main: Some("k"),
+    pipelines: &[PIPELINES],
     create: |_, _| Box::new(Hybrid64 { buffers: None, tail: None }),
 };
+
+/// Group 2: the k-TAB words, the tail accumulators, then the tail counter.
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(3)];
+const PIPELINES: &[PipelineSpec] =
+    &[PipelineSpec::geometry("hybrid64.wgsl", "fs_insert", GROUPS), PipelineSpec::fullscreen("hybrid64.wgsl", "fs_resolve", GROUPS)];
 
 /// Words per pixel of the tail accumulators.
 pub const ACCUM_WORDS: u64 = crate::consts::HYBRID64_ACCUM_WORDS as u64;
@@ -55,10 +61,9 @@ impl Method for Hybrid64 {
         let tail = self.tail.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid64 tail count"));
         let sizes = [("hybrid64 k-TAB", pixels * k as u64 * 8), ("hybrid64 tail", pixels * ACCUM_WORDS * 4)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[tail]);
-        let shader = ShaderKey::new("hybrid64.wgsl", &[Const::U32("K", k)]);
-        let own = b.layout();
-        let insert = cx.capture_pipeline(&shader, "fs_insert", own);
-        let resolve = cx.resolve_pipeline(&shader, "fs_resolve", own, true);
+        let consts = [Const::U32("K", k)];
+        let insert = cx.capture_pipeline(spec(PIPELINES, "fs_insert"), &consts);
+        let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, true);
         let mut enc = cx.encoder();
         b.clear(&mut enc);
         tail.clear(&mut enc);

@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 
 use super::frame::{Limits, Method};
 use super::params::{check, did_you_mean, ParamInfo, ParamKind, ParamValue, Params};
+use crate::cache::PipelineSpec;
 use crate::context::GpuContext;
 use crate::error::{invalid, Result};
 
@@ -38,6 +39,9 @@ pub struct MethodInfo {
     /// The integer parameter the method's speed-accuracy trade moves along (k, nodes, layers,
     /// samples, buckets): what `oit compare` sweeps; None where there is none.
     pub main: Option<&'static str>,
+    /// The pipelines it builds, a table per shader file: what it creates them from, and what
+    /// tests/bindings.rs checks against each shader's bindings.
+    pub pipelines: &'static [&'static [PipelineSpec]],
     pub(crate) create: fn(&GpuContext, &Limits) -> Box<dyn Method>,
 }
 

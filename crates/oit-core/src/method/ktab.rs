@@ -5,7 +5,7 @@
 
 use super::accum::{FloatTargets, ADD};
 use super::frame::{FrameCtx, MethodReport};
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::{OitError, Result};
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -35,6 +35,25 @@ pub(crate) enum Slots<'s> {
 
 /// Binding of the per-pixel slot offsets in the group (shaders/hybrid.wgsl).
 const OFFSETS: usize = 3;
+
+const SHADER: &str = "hybrid.wgsl";
+/// Group 2: k-TAB, core visibility, accumulators, slot offsets, then the overflow counter.
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(5)];
+
+/// The k-TAB engine's pipelines (hybrid, ktab, auto).
+pub(crate) const PIPELINES: &[PipelineSpec] = &[
+    PipelineSpec::geometry(SHADER, "fs_store", GROUPS),
+    PipelineSpec::compute(SHADER, "cs_visibility", GROUPS),
+    PipelineSpec::geometry(SHADER, "fs_shade", GROUPS),
+    PipelineSpec::fullscreen(SHADER, "fs_final", GROUPS),
+    PipelineSpec::geometry(SHADER, "fs_shade_blend", GROUPS),
+    // The blended sums at group 3.
+    PipelineSpec::fullscreen(
+        SHADER,
+        "fs_final_blend",
+        &[Layout::Scene, Layout::Targets, Layout::Storage(5), Layout::Textures(BLEND_BINDINGS)],
+    ),
+];
 
 /// How the second geometry pass sums the core and the tail.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -143,25 +162,23 @@ impl KTab {
             Slots::PerPixel(_) => 1,
         };
         let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", per_pixel as u32), Const::U32("TAIL", self.tail as u32)];
-        let shader = ShaderKey::new("hybrid.wgsl", &consts);
-        let own = b.layout();
         let mut enc = cx.encoder();
         enc.clear_buffer(&b.buffers[0], 0, None);
         enc.clear_buffer(&b.buffers[2], 0, None);
         overflow.clear(&mut enc);
-        cx.capture(&mut enc, "store", &cx.capture_pipeline(&shader, "fs_store", own), &b.group);
-        cx.dispatch(&mut enc, "visibility", &cx.compute_pipeline(&shader, "cs_visibility", own), &b.group);
+        cx.capture(&mut enc, "store", &cx.capture_pipeline(spec(PIPELINES, "fs_store"), &consts), &b.group);
+        cx.dispatch(&mut enc, "visibility", &cx.compute_pipeline(spec(PIPELINES, "cs_visibility"), &consts), &b.group);
         match sums {
             Sums::Exact => {
-                cx.capture(&mut enc, "shade", &cx.capture_pipeline(&shader, "fs_shade", own), &b.group);
-                cx.resolve(&mut enc, "final", &cx.resolve_pipeline(&shader, "fs_final", own, true), &b.group, true);
+                cx.capture(&mut enc, "shade", &cx.capture_pipeline(spec(PIPELINES, "fs_shade"), &consts), &b.group);
+                cx.resolve(&mut enc, "final", &cx.resolve_pipeline(spec(PIPELINES, "fs_final"), &consts, true), &b.group, true);
             }
             Sums::Blend => {
                 let targets = FloatTargets::ensure(&mut self.blend, cx, &BLEND_FORMATS, BLEND_BINDINGS);
-                let groups = vec![Layout::Scene, Layout::Targets, own];
-                let shade = cx.draw_pipeline(&shader, "fs_shade_blend", groups, blend_targets(), crate::pipeline::depth_test_only());
+                let shade_blend = spec(PIPELINES, "fs_shade_blend");
+                let shade = cx.draw_pipeline(shade_blend, &consts, blend_targets(), crate::pipeline::depth_test_only());
                 cx.capture_into(&mut enc, "shade", &shade, &b.group, &targets.attachments(&[wgpu::Color::TRANSPARENT; 4]));
-                let fin = cx.resolve_pipeline_groups(&shader, "fs_final_blend", &[own, Layout::Textures(BLEND_BINDINGS)], true);
+                let fin = cx.resolve_pipeline(spec(PIPELINES, "fs_final_blend"), &consts, true);
                 cx.resolve_groups(&mut enc, "final", &fin, &[&b.group, &targets.group], true);
             }
         }

@@ -4,7 +4,8 @@
 //! rendered again when the atomic counter says the pool overflowed (docs/methods.md).
 
 use super::frame::{Dispatch, FrameCtx, Limits, MethodReport};
-use crate::cache::{Layout, ShaderKey};
+use super::list_pipelines::{POOL_LAYOUT, SWEEPS};
+use crate::cache::{spec, PipelineSpec};
 use crate::consts::{SWEEP_COMPOSITE_STEPS, SWEEP_LINK_STEPS, SWEEP_LOAD_STEPS, SWEEP_MERGE_STEPS};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
@@ -32,9 +33,6 @@ pub const BLOCK: u64 = 8;
 pub fn run_length(n: u64) -> u32 {
     (n.next_power_of_two() as u32).clamp(BLOCK as u32, RUN)
 }
-
-/// The pool's group: heads, allocator, the pool bindings, sweep state and binding 7.
-const POOL_LAYOUT: Layout = Layout::Storage(4 + POOL_BINDINGS as u32);
 
 const ALLOC_BYTES: u64 = std::mem::size_of::<Alloc>() as u64;
 /// The indirect dispatch arguments (x, y, z workgroups) of the sorted resolve's first pass,
@@ -219,7 +217,7 @@ impl NodePool {
 
 /// A capture-then-resolve method over a node pool.
 pub(crate) struct ListMethod {
-    shader: &'static str,
+    pipelines: &'static [PipelineSpec],
     consts: Vec<Const>,
     pool: NodePool,
     /// Whether the resolve runs `cs_sweep` dispatches before the full-screen pass, and the
@@ -243,7 +241,8 @@ struct Pipelines {
 
 /// The storage layout of a list method.
 pub(crate) struct ListLayout {
-    pub shader: &'static str,
+    /// The pipelines of its shader (list_pipelines.rs).
+    pub pipelines: &'static [PipelineSpec],
     /// Bytes of one node.
     pub node_bytes: u64,
     /// Per-pixel words carried between resolve sweeps; 0 for a single-pass resolve.
@@ -270,7 +269,7 @@ pub fn loop_limited(gpu: &GpuContext) -> bool {
 impl ListMethod {
     pub fn new(gpu: &GpuContext, limits: &Limits, layout: ListLayout) -> Self {
         Self {
-            shader: layout.shader,
+            pipelines: layout.pipelines,
             consts: Vec::new(),
             pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.aux),
             sweeps: (layout.state_words > 0).then_some(layout.samples),
@@ -303,14 +302,14 @@ impl ListMethod {
         consts.push(Const::U32("FRAG_STEPS", costs.frag as u32));
         consts.push(Const::U32("KEYED", costs.keyed() as u32));
         consts.extend(self.consts.iter().copied());
-        let shader = ShaderKey::new(self.shader, &consts);
-        let compute = |entry| cx.compute_pipeline(&shader, entry, POOL_LAYOUT);
+        let at = |entry| spec(self.pipelines, entry);
+        let compute = |entry| cx.compute_pipeline(at(entry), &consts);
         Pipelines {
             allocate: matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate")),
-            count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(&shader, "fs_count", POOL_LAYOUT)),
-            capture: cx.capture_pipeline(&shader, "fs_capture", POOL_LAYOUT),
-            sweep: self.sweeps.map(|_| ["cs_active", "cs_groups", "cs_sort", "cs_runs", "cs_merge", "cs_composite"].map(compute)),
-            resolve: cx.resolve_pipeline(&shader, "fs_resolve", POOL_LAYOUT, false),
+            count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(at("fs_count"), &consts)),
+            capture: cx.capture_pipeline(at("fs_capture"), &consts),
+            sweep: self.sweeps.map(|_| SWEEPS.map(compute)),
+            resolve: cx.resolve_pipeline(at("fs_resolve"), &consts, false),
         }
     }
 
@@ -343,7 +342,7 @@ impl ListMethod {
         let tile = cx.tile;
         let pixels = cx.pixels();
         cx.check_per_pixel(
-            &format!("{} (its per-pixel heads and sweep state)", self.shader.trim_end_matches(".wgsl")),
+            &format!("{} (its per-pixel heads and sweep state)", self.pipelines[0].shader.trim_end_matches(".wgsl")),
             4 * self.pool.state_len().max(1),
         )?;
         // A tile of a larger frame gets a pool of its counted fragments, so that tiles planned

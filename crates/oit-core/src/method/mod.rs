@@ -13,6 +13,7 @@ mod hybrid;
 mod hybrid64;
 mod info;
 mod ktab;
+mod list_pipelines;
 pub(crate) mod lists;
 mod mlab;
 mod pall;

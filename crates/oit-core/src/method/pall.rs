@@ -5,10 +5,14 @@
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::list_pipelines::{swept_after, FRAME};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{PIXEL_BYTES, STATE_WORDS};
+use crate::cache::PipelineSpec;
 use crate::error::Result;
 use crate::gpu_types::{PallBlock, PoolNode};
+
+const PIPELINES: &[PipelineSpec] = &swept_after(PipelineSpec::compute("pall.wgsl", "cs_allocate", FRAME));
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "pall",
@@ -25,12 +29,13 @@ pub const INFO: MethodInfo = MethodInfo {
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 16 },
     census: true,
     main: None,
+    pipelines: &[PIPELINES],
     create: |gpu, limits| {
         Box::new(Pall(ListMethod::new(
             gpu,
             limits,
             ListLayout {
-                shader: "pall.wgsl",
+                pipelines: PIPELINES,
                 node_bytes: std::mem::size_of::<PoolNode>() as u64,
                 state_words: STATE_WORDS,
                 samples: 1,

@@ -6,7 +6,7 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::ShaderKey;
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
@@ -32,6 +32,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     tiling: Tiling::Formula,
     census: true,
     main: Some("layers"),
+    pipelines: &[PIPELINES],
     create: |_, _| Box::new(Peel { dual: false, buffers: None, peeled: None }),
 };
 
@@ -42,6 +43,16 @@ pub const DUAL_DEPTH_PEELING: MethodInfo = MethodInfo {
     create: |_, _| Box::new(Peel { dual: true, buffers: None, peeled: None }),
     ..DEPTH_PEELING
 };
+
+const SHADER: &str = "peel.wgsl";
+/// Group 2: keys, layer colors, accumulators, then the peeled counter.
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(4)];
+const PIPELINES: &[PipelineSpec] = &[
+    PipelineSpec::compute(SHADER, "cs_init", GROUPS),
+    PipelineSpec::geometry(SHADER, "fs_peel", GROUPS),
+    PipelineSpec::compute(SHADER, "cs_composite", GROUPS),
+    PipelineSpec::fullscreen(SHADER, "fs_resolve", GROUPS),
+];
 
 /// Words of per-pixel accumulation.
 pub const PEEL_WORDS: u64 = crate::consts::PEEL_WORDS as u64;
@@ -73,10 +84,10 @@ impl Method for Peel {
         let layers = if limit == 0 { n } else { limit.min(n) };
         // The first pass only finds; each later pass shades one layer (two when dual).
         let passes = if self.dual { layers.div_ceil(2) } else { layers } + 1;
-        let shader = ShaderKey::new("peel.wgsl", &[Const::U32("DUAL", self.dual as u32)]);
-        let own = b.layout();
-        let (init, composite) = (cx.compute_pipeline(&shader, "cs_init", own), cx.compute_pipeline(&shader, "cs_composite", own));
-        let peel = cx.capture_pipeline(&shader, "fs_peel", own);
+        let consts = [Const::U32("DUAL", self.dual as u32)];
+        let init = cx.compute_pipeline(spec(PIPELINES, "cs_init"), &consts);
+        let composite = cx.compute_pipeline(spec(PIPELINES, "cs_composite"), &consts);
+        let peel = cx.capture_pipeline(spec(PIPELINES, "fs_peel"), &consts);
         let mut enc = cx.encoder();
         peeled.clear(&mut enc);
         // One timed span from the first dispatch to the last composite, around every pass.
@@ -91,7 +102,7 @@ impl Method for Peel {
             cx.capture_untimed(&mut enc, "peel", &peel, &b.group);
             compute(cx, &mut enc, &composite, false, i + 1 == passes);
         }
-        cx.resolve(&mut enc, "resolve", &cx.resolve_pipeline(&shader, "fs_resolve", own, false), &b.group, false);
+        cx.resolve(&mut enc, "resolve", &cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, false), &b.group, false);
         peeled.copy(&mut enc);
         cx.submit(enc);
         let peeled = peeled.read(cx.gpu)?;

@@ -5,7 +5,7 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::passes;
 use crate::pipeline;
@@ -26,6 +26,7 @@ pub const INFO: MethodInfo = MethodInfo {
     tiling: Tiling::Formula,
     census: false,
     main: None,
+    pipelines: &[PIPELINES],
     create: |_, _| Box::new(ScreenDoor { depth: None }),
 };
 
@@ -33,6 +34,8 @@ pub const INFO: MethodInfo = MethodInfo {
 pub fn memory_bytes(pixels: u64) -> u64 {
     pixels * 4
 }
+
+const PIPELINES: &[PipelineSpec] = &[PipelineSpec::geometry("screen_door.wgsl", "fs_door", &[Layout::Scene])];
 
 struct ScreenDoor {
     depth: Option<((u32, u32), wgpu::Texture, wgpu::TextureView)>,
@@ -42,8 +45,7 @@ impl Method for ScreenDoor {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let d = &cx.gpu.device;
         let t = cx.targets;
-        let shader = ShaderKey::new("screen_door.wgsl", &[]);
-        let pipeline = cx.draw_pipeline(&shader, "fs_door", vec![Layout::Scene], vec![Some(COLOR_FORMAT.into())], pipeline::depth_write());
+        let pipeline = cx.draw_pipeline(spec(PIPELINES, "fs_door"), &[], vec![Some(COLOR_FORMAT.into())], pipeline::depth_write());
         let size = (t.width, t.height);
         if self.depth.as_ref().is_none_or(|(s, _, _)| *s != size) {
             let tex = texture(

@@ -6,7 +6,7 @@ use super::accum::{accumulation_targets, Aux, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::gpu_types::FrameUniform;
 use crate::pipeline;
@@ -39,8 +39,20 @@ pub const INFO: MethodInfo = MethodInfo {
     tiling: Tiling::Formula,
     census: false,
     main: Some("samples"),
+    pipelines: &[PIPELINES],
     create: |_, _| Box::new(Stochastic { samples: None, targets: None }),
 };
+
+const SHADER: &str = "stochastic.wgsl";
+/// Group 2 of the geometry passes: the per-pixel depth samples.
+const SAMPLES: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(1)];
+/// The bindings the resolve reads the accumulation targets at (group 2).
+const TEXTURES: &[u32] = &[1, 2];
+const PIPELINES: &[PipelineSpec] = &[
+    PipelineSpec::geometry(SHADER, "fs_depth", SAMPLES),
+    PipelineSpec::geometry(SHADER, "fs_accum", SAMPLES),
+    PipelineSpec::fullscreen(SHADER, "fs_resolve", &[Layout::Scene, Layout::Targets, Layout::Textures(TEXTURES)]),
+];
 
 /// Bytes stochastic allocates: `samples` depth words per pixel and two float targets.
 pub fn memory_bytes(pixels: u64, samples: u64) -> u64 {
@@ -59,14 +71,13 @@ impl Method for Stochastic {
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("stochastic with {samples} samples"), 4 * samples as u64)?;
         let b = StorageGroup::ensure(&mut self.samples, cx.gpu, &[("stochastic samples", pixels * samples as u64 * 4)], &[]);
-        // The accumulation targets are read only by the resolve, at bindings 1 and 2 of its group.
-        let w = FloatTargets::accumulation(&mut self.targets, cx, &[1, 2]);
-        let shader = ShaderKey::new("stochastic.wgsl", &[Const::U32("SAMPLES", samples)]);
-        let own = b.layout();
-        let depth = cx.capture_pipeline(&shader, "fs_depth", own);
-        let groups = vec![Layout::Scene, Layout::Targets, own];
-        let accumulate = cx.draw_pipeline(&shader, "fs_accum", groups, accumulation_targets(Aux::Reveal), pipeline::depth_test_only());
-        let resolve = cx.resolve_pipeline(&shader, "fs_resolve", Layout::Textures(&[1, 2]), false);
+        // The accumulation targets are read only by the resolve.
+        let w = FloatTargets::accumulation(&mut self.targets, cx, TEXTURES);
+        let consts = [Const::U32("SAMPLES", samples)];
+        let depth = cx.capture_pipeline(spec(PIPELINES, "fs_depth"), &consts);
+        let accumulate =
+            cx.draw_pipeline(spec(PIPELINES, "fs_accum"), &consts, accumulation_targets(Aux::Reveal), pipeline::depth_test_only());
+        let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, false);
         let offset = std::mem::offset_of!(FrameUniform, seed) as u64;
         cx.gpu.queue.write_buffer(cx.frame_uniform, offset, bytemuck::bytes_of(&seed));
         let mut enc = cx.encoder();

@@ -5,10 +5,22 @@ use super::accum::{accumulation_targets, memory_bytes, Aux, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::{Layout, ShaderKey};
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::pipeline;
 use crate::shader::Const;
+
+const SHADER: &str = "weighted.wgsl";
+/// The bindings the resolves read the two targets at (group 2).
+const TEXTURES: &[u32] = &[0, 1];
+const RESOLVE: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Textures(TEXTURES)];
+const PIPELINES: &[PipelineSpec] = &[
+    PipelineSpec::geometry(SHADER, "fs_sum", &[Layout::Scene]),
+    PipelineSpec::geometry(SHADER, "fs_wboit", &[Layout::Scene]),
+    PipelineSpec::fullscreen(SHADER, "fs_resolve_wsum", RESOLVE),
+    PipelineSpec::fullscreen(SHADER, "fs_resolve_wavg", RESOLVE),
+    PipelineSpec::fullscreen(SHADER, "fs_resolve_wboit", RESOLVE),
+];
 
 #[derive(Clone, Copy, PartialEq)]
 enum Kind {
@@ -32,6 +44,7 @@ pub const WSUM: MethodInfo = MethodInfo {
     tiling: Tiling::Formula,
     census: false,
     main: None,
+    pipelines: &[PIPELINES],
     create: |_, _| Box::new(Weighted::new(Kind::Sum)),
 };
 
@@ -75,16 +88,15 @@ impl Method for Weighted {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let weight = if self.kind == Kind::Blended { cx.params.choice("weight") } else { "eq10" };
         let eq = weight.trim_start_matches("eq").parse::<u32>().expect("choices are eqN");
-        let shader = ShaderKey::new("weighted.wgsl", &[Const::U32("WEIGHT", eq)]);
+        let consts = [Const::U32("WEIGHT", eq)];
         let (fs, resolve_fs, aux) = match self.kind {
             Kind::Sum => ("fs_sum", "fs_resolve_wsum", Aux::Sum),
             Kind::Average => ("fs_sum", "fs_resolve_wavg", Aux::Sum),
             Kind::Blended => ("fs_wboit", "fs_resolve_wboit", Aux::Reveal),
         };
-        const TEXTURES: Layout = Layout::Textures(&[0, 1]);
-        let accumulate = cx.draw_pipeline(&shader, fs, vec![Layout::Scene], accumulation_targets(aux), pipeline::depth_test_only());
-        let resolve = cx.resolve_pipeline(&shader, resolve_fs, TEXTURES, false);
-        let w = FloatTargets::accumulation(&mut self.targets, cx, &[0, 1]); // TEXTURES' bindings
+        let accumulate = cx.draw_pipeline(spec(PIPELINES, fs), &consts, accumulation_targets(aux), pipeline::depth_test_only());
+        let resolve = cx.resolve_pipeline(spec(PIPELINES, resolve_fs), &consts, false);
+        let w = FloatTargets::accumulation(&mut self.targets, cx, TEXTURES);
         let mut enc = cx.encoder();
         w.accumulate(cx, &mut enc, aux, &accumulate, &[]);
         cx.resolve(&mut enc, "resolve", &resolve, &w.group, false);

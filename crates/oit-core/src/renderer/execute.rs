@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::{Frame, Renderer, COVERAGE_SAMPLES};
 use crate::antialias;
 use crate::bindings::{COLOR_FORMAT, COUNT_FORMAT};
-use crate::cache::{Draw, Layout, RenderDesc, ShaderKey};
+use crate::cache::{Draw, Layout, CENSUS_ATOMIC, CENSUS_BLEND, CENSUS_SAMPLES, OPAQUE};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::{FrameUniform, GpuLight};
@@ -25,13 +25,8 @@ use crate::upload::GpuScene;
 
 /// The opaque pass's pipeline for `variant`: straight color, writes depth.
 fn opaque_pipeline(gpu: &GpuContext, variant: SceneVariant) -> wgpu::RenderPipeline {
-    let desc = RenderDesc {
-        shader: ShaderKey::new("opaque.wgsl", &variant.consts()),
-        entry: "fs_opaque",
-        groups: vec![Layout::Scene],
-        draw: Draw::Geometry { depth: pipeline::depth_write(), samples: 1 },
-        targets: vec![Some(COLOR_FORMAT.into())],
-    };
+    let desc =
+        OPAQUE.render(&variant.consts(), Draw::Geometry { depth: pipeline::depth_write(), samples: 1 }, vec![Some(COLOR_FORMAT.into())]);
     gpu.cache.render(&gpu.device, &desc)
 }
 
@@ -56,31 +51,19 @@ fn census_pipeline(gpu: &GpuContext, kind: CensusKind, shaded: bool) -> wgpu::Re
         operation: wgpu::BlendOperation::Add,
     };
     let desc = match kind {
-        CensusKind::Blend => RenderDesc {
-            shader: ShaderKey::new("census.wgsl", &variant),
-            entry: "fs_count",
-            groups: vec![Layout::Scene],
-            draw: Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
-            targets: vec![Some(wgpu::ColorTargetState {
+        CensusKind::Blend => CENSUS_BLEND.render(
+            &variant,
+            Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
+            vec![Some(wgpu::ColorTargetState {
                 format: COUNT_FORMAT,
                 blend: Some(wgpu::BlendState { color: add, alpha: add }),
                 write_mask: wgpu::ColorWrites::RED,
             })],
-        },
-        CensusKind::Atomic => RenderDesc {
-            shader: ShaderKey::new("census.wgsl", &variant),
-            entry: "fs_census",
-            groups: vec![Layout::Scene, Layout::Targets, Layout::Storage(1)],
-            draw: Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
-            targets: vec![],
-        },
-        CensusKind::Samples => RenderDesc {
-            shader: ShaderKey::new("census_samples.wgsl", &variant),
-            entry: "fs_census",
-            groups: vec![Layout::Scene, Layout::SampleTargets, Layout::Storage(1)],
-            draw: Draw::Geometry { depth: pipeline::raster_only(), samples: COVERAGE_SAMPLES },
-            targets: vec![],
-        },
+        ),
+        CensusKind::Atomic => CENSUS_ATOMIC.render(&variant, Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 }, vec![]),
+        CensusKind::Samples => {
+            CENSUS_SAMPLES.render(&variant, Draw::Geometry { depth: pipeline::raster_only(), samples: COVERAGE_SAMPLES }, vec![])
+        }
     };
     gpu.cache.render(&gpu.device, &desc)
 }

@@ -4,7 +4,7 @@
 
 use super::Renderer;
 use crate::bindings::DEPTH_FORMAT;
-use crate::cache::{Draw, Layout, RenderDesc, ShaderKey};
+use crate::cache::{Draw, BLIT};
 use crate::error::{invalid, Result};
 use crate::method::ParamValue;
 use crate::scene::{Camera, Scene};
@@ -81,15 +81,8 @@ impl Renderer {
     /// Draws `source` into `target` pixel for pixel (`shaders/blit.wgsl`).
     pub(super) fn blit(&self, enc: &mut wgpu::CommandEncoder, source: &wgpu::TextureView, target: &wgpu::Texture) {
         let d = &self.gpu.device;
-        let desc = RenderDesc {
-            shader: ShaderKey::new("blit.wgsl", &[]),
-            entry: "fs_blit",
-            groups: vec![Layout::Textures(&[0])],
-            draw: Draw::Fullscreen,
-            targets: vec![Some(target.format().into())],
-        };
-        let pipeline = self.gpu.cache.render(d, &desc);
-        let layout = self.gpu.cache.layout(d, Layout::Textures(&[0]));
+        let pipeline = self.gpu.cache.render(d, &BLIT.render(&[], Draw::Fullscreen, vec![Some(target.format().into())]));
+        let layout = self.gpu.cache.layout(d, BLIT.groups[0]);
         let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("blit"),
             layout: &layout,
