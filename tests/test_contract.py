@@ -210,3 +210,14 @@ def test_a_frame_has_the_schemas_keys(renderer, method):
     assert frame.stats["adapter"] == r.adapter_info["name"]
     if frame.error_bound is not None:
         assert frame.stats["error_bound_max"] == pytest.approx(float(frame.error_bound.max()))
+
+
+@pytest.mark.parametrize("method", [m["name"] for m in oit.methods()])
+def test_every_extra_a_method_reports_has_a_declared_merge_rule(renderer, method):
+    """Tiles and antialiasing samples merge a method's extras by rules declared once in the core."""
+    if method not in oit.Renderer(1, 1).adapter_info["methods"]:
+        pytest.skip(f"the adapter cannot run {method}")
+    rules = dict(oit._oit.extra_merge_rules())
+    assert set(rules.values()) <= {"sum", "max", "mean"}
+    frame = renderer(16, 16).render(build_scene([layer(0.3, (1.0, 0.0, 0.0, 0.5)), layer(0.6, (0.0, 0.0, 1.0, 0.5))]), IDENTITY, method=method)
+    assert set(frame.stats["extra"]) <= set(rules), set(frame.stats["extra"]) - set(rules)

@@ -164,6 +164,9 @@ def memory_bytes(method: str, width: int, height: int, params: dict[str, _ParamV
     """GPU bytes `method` allocates at `width` x `height` with `params` (its memory formula), or
     None when that grows with the scene; `slots` is auto's k-TAB slots in all."""
 
+def extra_merge_rules() -> list[tuple[str, str]]:
+    """Every extra number a method reports and how tiles and samples merge it: sum, max or mean."""
+
 def stats_schema() -> list[tuple[str, str, str]]:
     """The keys of a frame's stats: (name, Python type, meaning), in order (crates/oit-core/src/stats.rs)."""
 

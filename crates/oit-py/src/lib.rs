@@ -446,6 +446,19 @@ fn stats_schema() -> Vec<(&'static str, &'static str, &'static str)> {
     oit_core::stats::SCHEMA.iter().map(|k| (k.name, k.ty, k.doc)).collect()
 }
 
+/// Every extra number a method reports, with how tiles and samples merge it ('sum', 'max',
+/// 'mean'; crates/oit-core/src/stats.rs, EXTRAS).
+#[pyfunction]
+fn extra_merge_rules() -> Vec<(&'static str, &'static str)> {
+    use oit_core::stats::Merge;
+    let name = |m: Merge| match m {
+        Merge::Sum => "sum",
+        Merge::Max => "max",
+        Merge::Mean => "mean",
+    };
+    oit_core::stats::EXTRAS.iter().map(|(n, m)| (*n, name(*m))).collect()
+}
+
 /// The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs).
 #[pyfunction]
 fn constants<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -501,6 +514,7 @@ fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(memory_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(constants, m)?)?;
     m.add_function(wrap_pyfunction!(stats_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(extra_merge_rules, m)?)?;
     m.add_function(wrap_pyfunction!(load::load_file, m)?)?;
     Ok(())
 }
