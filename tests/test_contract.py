@@ -219,5 +219,6 @@ def test_every_extra_a_method_reports_has_a_declared_merge_rule(renderer, method
         pytest.skip(f"the adapter cannot run {method}")
     rules = dict(oit._oit.extra_merge_rules())
     assert set(rules.values()) <= {"sum", "max", "mean"}
-    frame = renderer(16, 16).render(build_scene([layer(0.3, (1.0, 0.0, 0.0, 0.5)), layer(0.6, (0.0, 0.0, 1.0, 0.5))]), IDENTITY, method=method)
+    scene = build_scene([layer(0.3, (1.0, 0.0, 0.0, 0.5)), layer(0.6, (0.0, 0.0, 1.0, 0.5))])
+    frame = renderer(16, 16).render(scene, IDENTITY, method=method)
     assert set(frame.stats["extra"]) <= set(rules), set(frame.stats["extra"]) - set(rules)
