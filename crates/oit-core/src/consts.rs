@@ -42,7 +42,7 @@ pub const QUANT_SCALE: f32 = 16_777_216.0;
 /// What one unit of the sorted resolve costs on llvmpipe's loop limiter, which ends an
 /// invocation's loops after 65,535 iterations and counts every `switch` as one
 /// (shaders/common/sweep.wgsl adds what turning a node into a fragment costs, FRAG_STEPS;
-/// oit_core::method::lists::StepCosts plans dispatches from the same numbers): a node loaded
+/// oit_core::method::sweep_costs::StepCosts plans dispatches from the same numbers): a node loaded
 /// into a run (its loop, the pool's switch), a node relinked (the loop, append's switch), a
 /// merge step (its switch, two fragments, the link, the append), a fragment composited from
 /// the list (before its samples).

@@ -5,8 +5,9 @@
 
 use super::frame::{Dispatch, FrameCtx, Limits, MethodReport};
 use super::list_pipelines::{POOL_LAYOUT, SWEEPS};
+pub(crate) use super::sweep_costs::{pixel_bytes, state_words, PIXEL_BYTES, STATE_WORDS};
+pub use super::sweep_costs::{resolve_dispatches, step_budget, StepCosts};
 use crate::cache::{spec, PipelineSpec};
-use crate::consts::{SWEEP_COMPOSITE_STEPS, SWEEP_LINK_STEPS, SWEEP_LOAD_STEPS, SWEEP_MERGE_STEPS};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::Alloc;
@@ -450,131 +451,6 @@ impl ListMethod {
     }
 }
 
-/// Words of per-pixel sweep state at one sample a pixel (STATE_WORDS in
-/// shaders/common/sweep.wgsl: 12 + 4 per sample).
-pub(crate) const STATE_WORDS: u64 = state_words(1);
-
-pub(crate) const fn state_words(samples: u32) -> u64 {
-    12 + 4 * samples as u64
-}
-
-/// Bytes a pixel of a sorted-resolve method keeps besides its pool: its head, its sweep state
-/// and its entries of the two pixel lists.
-pub(crate) const fn pixel_bytes(samples: u32) -> u64 {
-    4 + 4 * (state_words(samples) + 2)
-}
-
-pub(crate) const PIXEL_BYTES: u64 = pixel_bytes(1);
-
-/// What one step of the sorted resolve costs on llvmpipe's loop limiter (the constants of
-/// shaders/common/sweep.wgsl, which this mirrors): `frag` is what turning a node into a
-/// fragment adds (compact_abuffer shades it there: its lights and the shading-cost loop);
-/// `run` the fragments a run holds in this frame (RUN, or the deepest list when shorter).
-/// The array a run is sorted in is [`run_length`] of the deepest list.
-#[derive(Clone, Copy, Debug)]
-pub struct StepCosts {
-    pub samples: u64,
-    pub frag: u64,
-    pub run: u64,
-}
-
-impl StepCosts {
-    fn load(self) -> u64 {
-        SWEEP_LOAD_STEPS as u64 + self.frag
-    }
-    const LINK: u64 = SWEEP_LINK_STEPS as u64;
-    fn merge(self) -> u64 {
-        SWEEP_MERGE_STEPS as u64 + 2 * self.frag
-    }
-    fn composite(self) -> u64 {
-        SWEEP_COMPOSITE_STEPS as u64 + self.samples + self.frag
-    }
-
-    /// Whether runs hold sort keys, not whole fragments (sweep.wgsl's KEYED): where turning a
-    /// node into a fragment costs nothing beyond its load.
-    fn keyed(self) -> bool {
-        self.frag == 0
-    }
-
-    /// Steps of sweep.wgsl's `sort_keys` on n entries: the blocks' insertion sorts (at most
-    /// (BLOCK - 1)(BLOCK + 2) / 2 a block), then each merge level (a step a pair, an entry
-    /// and the level) and the copy back when the levels end in the upper half.
-    fn sort_keys(n: u64) -> u64 {
-        let blocks = n.div_ceil(BLOCK);
-        let full = (BLOCK - 1) * (BLOCK + 2) / 2;
-        let mut steps = blocks * (1 + full);
-        let (mut width, mut levels) = (BLOCK, 0);
-        while width < n {
-            steps += n + n.div_ceil(2 * width) + 1;
-            width *= 2;
-            levels += 1;
-        }
-        steps + if levels % 2 == 1 { n } else { 0 }
-    }
-
-    /// A run loaded, sorted and relinked or composited: the largest unit of work between two
-    /// checks of the budget. A run of one block is sorted by insertion in frag_less's order
-    /// (keyed: two nodes loaded at each comparison of equal depths); a longer one by its keys,
-    /// then keyed runs order equal depths by insertion, at worst every entry of the run at one
-    /// depth, a node loaded each comparison. Keyed runs load each node again to composite it.
-    fn run(self) -> u64 {
-        let run = self.run;
-        let compares = run.saturating_sub(1) * (run + 2) / 2;
-        let keyed = self.keyed() as u64;
-        let sort = if run <= BLOCK {
-            compares * (1 + keyed * 2 * self.load())
-        } else {
-            Self::sort_keys(run) + keyed * (run.saturating_sub(1) * self.load() + compares * (1 + self.load()))
-        };
-        self.load() * (run + 1) + sort + run * (Self::LINK.max(2 + self.samples) + keyed * self.load())
-    }
-
-    fn largest_unit(self) -> u64 {
-        self.run().max(self.merge()).max(self.composite())
-    }
-}
-
-/// Steps one invocation of the sorted resolve takes before it pauses until the next dispatch:
-/// on llvmpipe, whose loop limiter counts them, its limit less the largest unit of work; large
-/// elsewhere. The image does not depend on it.
-pub fn step_budget(gpu: &GpuContext, costs: StepCosts) -> Result<u64> {
-    if !loop_limited(gpu) {
-        return Ok(1 << 22);
-    }
-    // The first dispatch does one unit; a deeper frame's dispatches need room for several.
-    let unit = costs.largest_unit();
-    let room = if costs.run < RUN as u64 { LLVMPIPE_LOOP_LIMIT } else { LLVMPIPE_LOOP_LIMIT / 2 };
-    if unit > room {
-        return Err(OitError::Unsupported(format!(
-            "the exact resolve needs {unit} loop iterations for one unit of work here (a fragment shaded at resolve with \
-             {} iterations), and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: lower shading_cost or use \
-             abuffer, which shades at capture",
-            costs.frag
-        )));
-    }
-    Ok(LLVMPIPE_LOOP_LIMIT - unit)
-}
-
-/// Steps of each phase of the sorted resolve after its first dispatch, on a pixel of n
-/// fragments, at most: the further runs of RUN; ceil(log2(runs)) merge passes of two steps a
-/// node and two a pair; the composite walk. Zero for a list of one run, which the first
-/// dispatch composites.
-pub fn resolve_steps(n: u64, costs: StepCosts) -> [u64; 3] {
-    let run = run_length(n) as u64;
-    if n <= run {
-        return [0; 3];
-    }
-    let runs = n.div_ceil(run);
-    let passes = runs.next_power_of_two().ilog2() as u64;
-    [(runs - 1) * costs.run(), passes * costs.merge() * (2 * n + 2 * runs), (n + 1) * costs.composite()]
-}
-
-/// Dispatches of each phase after `cs_sort` (runs, merge, composite) that finish a frame
-/// whose deepest pixel has n fragments.
-pub fn resolve_dispatches(n: u64, costs: StepCosts, budget: u64) -> [u32; 3] {
-    resolve_steps(n, costs).map(|steps| steps.div_ceil(budget) as u32)
-}
-
 /// Refuses a frame whose deepest pixel the one-invocation replay of a submission-order
 /// method (adaptive, mlab) could not finish on llvmpipe: (n / BATCH + 1) heap sweeps of the
 /// list, then `per_fragment` loop iterations for each fragment.
@@ -589,76 +465,4 @@ pub(crate) fn check_replay_budget(cx: &FrameCtx<'_>, method: &str, param: &str, 
         )));
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    const PLAIN: StepCosts = StepCosts { samples: 1, frag: 0, run: RUN as u64 };
-
-    #[test]
-    fn a_list_of_one_run_needs_no_dispatch_after_the_first() {
-        assert_eq!(resolve_steps(RUN as u64, PLAIN), [0; 3]);
-        assert_eq!(resolve_dispatches(1, PLAIN, 1000), [0; 3]);
-    }
-
-    #[test]
-    fn deeper_lists_take_the_runs_merges_and_composite_the_shader_counts() {
-        // 300 fragments: 3 runs of 128 (2 after the first), 2 merge passes, 301 composite steps.
-        let n = 300;
-        let [runs, merge, composite] = resolve_steps(n, PLAIN);
-        assert_eq!(runs, 2 * PLAIN.run());
-        assert_eq!(merge, 2 * (SWEEP_MERGE_STEPS as u64) * (2 * n + 2 * 3));
-        assert_eq!(composite, (n + 1) * (SWEEP_COMPOSITE_STEPS as u64 + 1));
-        let budget = 1000;
-        assert_eq!(resolve_dispatches(n, PLAIN, budget), [runs, merge, composite].map(|s| s.div_ceil(budget) as u32));
-    }
-
-    #[test]
-    fn the_local_sort_counts_its_blocks_levels_and_copy() {
-        // 8 entries: one block of at most 35 shifts, no merge.
-        assert_eq!(StepCosts::sort_keys(8), 36);
-        // 20 entries: 3 blocks, then levels of width 8 (2 pairs) and 16 (1 pair), ending in
-        // the lower half (no copy).
-        assert_eq!(StepCosts::sort_keys(20), 3 * 36 + (20 + 2 + 1) + (20 + 1 + 1));
-        // 128 entries: 16 blocks, 4 levels (8, 16, 32, 64), no copy.
-        assert_eq!(StepCosts::sort_keys(128), 16 * 36 + (128 + 8 + 1) + (128 + 4 + 1) + (128 + 2 + 1) + (128 + 1 + 1));
-        // 64: 3 levels, so the result is copied back.
-        assert_eq!(StepCosts::sort_keys(64), 8 * 36 + (64 + 4 + 1) + (64 + 2 + 1) + (64 + 1 + 1) + 64);
-    }
-
-    #[test]
-    fn a_keyed_run_counts_its_worst_ties() {
-        // Every entry at one depth: the tie pass is a whole insertion sort, a node loaded each
-        // comparison, besides the entry's own load; and each node loaded again to composite it.
-        let load = SWEEP_LOAD_STEPS as u64;
-        let n = RUN as u64;
-        let compares = (n - 1) * (n + 2) / 2;
-        let ties = (n - 1) * load + compares * (1 + load);
-        assert_eq!(PLAIN.run(), load * (n + 1) + StepCosts::sort_keys(n) + ties + n * ((SWEEP_LINK_STEPS as u64).max(2 + 1) + load));
-        // A run of one block: one insertion sort, each comparison with the tie's two loads.
-        let short = StepCosts { run: BLOCK, ..PLAIN };
-        let compares = (BLOCK - 1) * (BLOCK + 2) / 2;
-        assert_eq!(short.run(), load * (BLOCK + 1) + compares * (1 + 2 * load) + BLOCK * (3 + load));
-        // The worst unit still leaves llvmpipe's limit room for more than one a dispatch.
-        assert!(PLAIN.largest_unit() < LLVMPIPE_LOOP_LIMIT / 2);
-    }
-
-    #[test]
-    fn runs_that_shade_at_resolve_keep_whole_fragments_and_cost_no_reloads() {
-        let shaded = StepCosts { samples: 1, frag: 12, run: RUN as u64 };
-        assert!(PLAIN.keyed() && !shaded.keyed());
-        let n = RUN as u64;
-        assert_eq!(shaded.run(), (SWEEP_LOAD_STEPS as u64 + 12) * (n + 1) + StepCosts::sort_keys(n) + n * 3);
-    }
-
-    #[test]
-    fn the_array_is_the_smallest_power_of_two_that_holds_the_deepest_list() {
-        assert_eq!(run_length(1), BLOCK as u32);
-        assert_eq!(run_length(9), 16);
-        assert_eq!(run_length(46), 64);
-        assert_eq!(run_length(128), 128);
-        assert_eq!(run_length(388), RUN);
-    }
 }

@@ -22,6 +22,7 @@ mod peel;
 mod sbuffer;
 mod screen_door;
 mod stochastic;
+mod sweep_costs;
 mod weighted;
 
 pub use frame::MethodReport;

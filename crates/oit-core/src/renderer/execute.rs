@@ -76,22 +76,29 @@ pub(super) struct Coverage {
 }
 
 /// The frame's pixels as the tiles stream them in: the image, and the error bound where the
-/// method derives one.
+/// method derives one (empty for a frame into a caller's texture).
 struct FrameArrays {
     width: u32,
+    height: u32,
     image: Vec<f32>,
     bound: Option<Vec<f32>>,
 }
 
 impl FrameArrays {
-    /// Arrays for a `width` x `height` frame (none for a frame into a caller's texture).
-    fn new(width: u32, height: u32, read: bool) -> Self {
-        let pixels = if read { width as usize * height as usize } else { 0 };
-        Self { width, image: vec![0.0; pixels * 4], bound: None }
+    fn new(width: u32, height: u32) -> Self {
+        Self { width, height, image: Vec::new(), bound: None }
     }
 
-    /// Copies `values` (`tile`'s pixels row-major, `channels` a pixel) into `frame` at the tile.
-    fn place(frame: &mut [f32], width: u32, tile: Tile, values: &[f32], channels: usize) {
+    /// Puts `values` (`tile`'s pixels row-major, `channels` a pixel) into `frame` at the tile: a
+    /// whole frame's values become the array as they are.
+    fn place(frame: &mut Vec<f32>, (width, height): (u32, u32), tile: Tile, values: Vec<f32>, channels: usize) {
+        if tile.is_whole() {
+            *frame = values;
+            return;
+        }
+        if frame.is_empty() {
+            *frame = vec![0.0; width as usize * height as usize * channels];
+        }
         let line = tile.width as usize * channels;
         for (r, row) in values.chunks(line).enumerate() {
             let at = ((tile.y as usize + r) * width as usize + tile.x as usize) * channels;
@@ -218,7 +225,7 @@ impl Renderer {
             let mut report = MethodReport::default();
             let mut extra = ExtraMerge::default();
             let mut pass_times: Option<Vec<(&'static str, f64)>> = None;
-            let mut arrays = FrameArrays::new(w, h, self.into.is_none());
+            let mut arrays = FrameArrays::new(w, h);
             for tile in &tiles {
                 let tile_counts: std::borrow::Cow<[u32]> = match tiles.len() {
                     _ if counts.is_empty() => (&[] as &[u32]).into(),
@@ -323,12 +330,12 @@ impl Renderer {
         if self.into.is_some() {
             return Ok(());
         }
+        let size = (arrays.width, arrays.height);
         let image = read_region(&self.gpu, &t.out_texture, &t.image_readback, 16, tile.local())?;
-        FrameArrays::place(&mut arrays.image, arrays.width, tile, &image, 4);
+        FrameArrays::place(&mut arrays.image, size, tile, image, 4);
         if bound {
             let values = read_region(&self.gpu, &t.bound_texture, &t.bound_readback, 4, tile.local())?;
-            let pixels = arrays.image.len() / 4;
-            FrameArrays::place(arrays.bound.get_or_insert_with(|| vec![0.0; pixels]), arrays.width, tile, &values, 1);
+            FrameArrays::place(arrays.bound.get_or_insert_with(Vec::new), size, tile, values, 1);
         }
         Ok(())
     }
