@@ -27,7 +27,9 @@ fn main() {
     for f in &files {
         let rel = f.to_str().expect("UTF-8 shader path").replace('\\', "/");
         println!("cargo::rerun-if-changed={}", root.join(f).display());
-        code.push_str(&format!("    ({rel:?}, include_str!({:?})),\n", root.join(f).display().to_string()));
+        // Relative to the crate being compiled, not this run's absolute path: clones that share
+        // a target directory share this file, and each must embed its own shaders.
+        code.push_str(&format!("    ({rel:?}, include_str!(concat!(env!(\"CARGO_MANIFEST_DIR\"), \"/../../shaders/{rel}\"))),\n"));
     }
     code.push_str("];\n");
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo")).join("shader_sources.rs");

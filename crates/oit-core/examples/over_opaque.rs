@@ -29,8 +29,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     scene.add_mesh(layer(0.8, [0.1, 0.1, 1.0, 0.6]));
     let camera = Camera::from_rows([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])?;
     let mut renderer = Renderer::new(gpu.clone(), size.0, size.1)?;
-    let stats =
-        renderer.render_into(&scene, &camera, "abuffer", &[], [0.0; 3], Target { color: &picture.color, depth: Some(&picture.depth) })?;
+    let stats = renderer.render_into(
+        &scene,
+        &camera,
+        "abuffer",
+        &[],
+        [0.0; 3],
+        Target { color: &picture.color, depth: Some(&picture.depth), encode_srgb: false },
+    )?;
     println!("{}: {} fragments, {:.1} ms on the GPU", stats.method, stats.fragments, stats.gpu_time_ms.unwrap_or(0.0));
     let pixels = caller::read_texture(&gpu, &picture.color, 4);
     if let Some(dir) = std::path::Path::new(&path).parent() {

@@ -276,6 +276,8 @@ pub const CENSUS_ATOMIC: PipelineSpec =
 pub const CENSUS_SAMPLES: PipelineSpec =
     PipelineSpec::geometry("census_samples.wgsl", "fs_census", &[Layout::Scene, Layout::SampleTargets, Layout::Storage(1)]);
 pub const BLIT: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit", &[Layout::Textures(&[0])]);
+pub const BLIT_SRGB: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit_srgb", &[Layout::Textures(&[0])]);
 pub const SCAN_BLOCKS: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_scan_blocks", &[Layout::Scan]);
 pub const SCAN_ADD: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_add_blocks", &[Layout::Scan]);
-pub const ENGINE_PIPELINES: &[PipelineSpec] = &[OPAQUE, CENSUS_BLEND, CENSUS_ATOMIC, CENSUS_SAMPLES, BLIT, SCAN_BLOCKS, SCAN_ADD];
+pub const ENGINE_PIPELINES: &[PipelineSpec] =
+    &[OPAQUE, CENSUS_BLEND, CENSUS_ATOMIC, CENSUS_SAMPLES, BLIT, BLIT_SRGB, SCAN_BLOCKS, SCAN_ADD];

@@ -33,7 +33,14 @@ fn the_transparent_pass_over_a_callers_picture_equals_the_frame_with_its_opaque_
     let mut r = Renderer::new(gpu.clone(), size.0, size.1).unwrap();
     for method in ["abuffer", "unsorted", "hybrid"] {
         let stats = r
-            .render_into(&transparent(), &identity(), method, &[], [0.0; 3], Target { color: &picture.color, depth: Some(&picture.depth) })
+            .render_into(
+                &transparent(),
+                &identity(),
+                method,
+                &[],
+                [0.0; 3],
+                Target { color: &picture.color, depth: Some(&picture.depth), encode_srgb: false },
+            )
             .unwrap();
         assert_eq!(stats.method, method);
         let got: Vec<f32> = bytemuck::pod_collect_to_vec(&caller::read_texture(&gpu, &picture.color, 16));
@@ -63,13 +70,27 @@ fn a_target_of_another_size_or_a_wrong_depth_is_refused_by_name() {
     let picture = caller::draw_opaque(&gpu, (32, 16), wgpu::TextureFormat::Rgba8Unorm, 0.5, [1.0; 3], 1.0, [0.0; 3]);
     let mut r = Renderer::new(gpu.clone(), 64, 48).unwrap();
     let e = r
-        .render_into(&transparent(), &identity(), "abuffer", &[], [0.0; 3], Target { color: &picture.color, depth: None })
+        .render_into(
+            &transparent(),
+            &identity(),
+            "abuffer",
+            &[],
+            [0.0; 3],
+            Target { color: &picture.color, depth: None, encode_srgb: false },
+        )
         .unwrap_err()
         .to_string();
     assert!(e.contains("make them the same size"), "{e}");
     let mut r = Renderer::new(gpu.clone(), 32, 16).unwrap();
     let e = r
-        .render_into(&transparent(), &identity(), "abuffer", &[], [0.0; 3], Target { color: &picture.color, depth: Some(&picture.color) })
+        .render_into(
+            &transparent(),
+            &identity(),
+            "abuffer",
+            &[],
+            [0.0; 3],
+            Target { color: &picture.color, depth: Some(&picture.color), encode_srgb: false },
+        )
         .unwrap_err()
         .to_string();
     assert!(e.contains("must be Depth32Float"), "{e}");

@@ -5,10 +5,11 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use eframe::egui::{self, Color32, ColorImage, Rect, TextureHandle, TextureOptions};
+use eframe::egui::{self, Color32, ColorImage, Rect, TextureHandle, TextureId, TextureOptions};
 use oit_core::{AntialiasMode, Camera, Frame, GpuContext, Mesh, ParamValue, Renderer, Scene};
 
 use crate::heatmap::{self, ErrorMap};
+use crate::native::Native;
 use crate::orbit::ViewCamera;
 use crate::scenefile::SceneData;
 use crate::state::{Action, Compare, MeshControl, Settings, ViewMode, EXACT};
@@ -25,6 +26,8 @@ struct RenderKey {
     size: [u32; 2],
     camera: [[f64; 4]; 4],
     scene: u64,
+    /// Rendered straight into the texture egui paints (`native.rs`), not read back.
+    direct: bool,
 }
 
 /// Everything the picture on screen depends on, beyond the frames.
@@ -80,6 +83,9 @@ pub struct ViewerApp {
     /// Engine renders so far (the method's and the exact one's).
     pub renders: u64,
     texture: Option<TextureHandle>,
+    /// The texture on eframe's device the plain image view is rendered into (None: another
+    /// integration, or the tests' app, which read every frame back).
+    native: Option<Native>,
     shown: Option<ShowKey>,
     /// Where the picture was last painted, in points.
     pub view_rect: Rect,
@@ -90,7 +96,9 @@ pub struct ViewerApp {
 impl ViewerApp {
     /// The app on eframe's device (`cc.wgpu_render_state`).
     pub fn new(cc: &eframe::CreationContext<'_>, data: SceneData, settings: Settings, title: String) -> Self {
-        Self::with_gpu(gpu::context(cc.wgpu_render_state.as_ref()), data, settings, title)
+        let mut app = Self::with_gpu(gpu::context(cc.wgpu_render_state.as_ref()), data, settings, title);
+        app.native = cc.wgpu_render_state.clone().map(Native::new);
+        app
     }
 
     /// The app on a given engine context (tests build it on their own egui-wgpu device).
@@ -121,6 +129,7 @@ impl ViewerApp {
             render_error: None,
             renders: 0,
             texture: None,
+            native: None,
             shown: None,
             view_rect: Rect::NOTHING,
             screenshot: None,
@@ -188,9 +197,13 @@ impl ViewerApp {
             size,
             camera: rows,
             scene: self.scene_rev,
+            direct: self.native.is_some()
+                && self.settings.view == ViewMode::Image
+                && !self.settings.needs_exact()
+                && self.settings.antialias <= 1,
         };
         // The exact frame at the same samples, as sample frames (exact at every sample).
-        let exact_key = RenderKey { method: EXACT.into(), params: vec![], mode: AntialiasMode::Frames, ..key.clone() };
+        let exact_key = RenderKey { method: EXACT.into(), params: vec![], mode: AntialiasMode::Frames, direct: false, ..key.clone() };
         let want_exact = self.settings.needs_exact() && self.settings.method != EXACT;
         let stale = self.key.as_ref() != Some(&key);
         let exact_stale = want_exact && self.exact_key.as_ref() != Some(&exact_key);
@@ -220,8 +233,11 @@ impl ViewerApp {
                 return false;
             }
         };
-        let mut run =
-            |k: &RenderKey| renderer.render_antialiased(&self.scene, &camera, &k.method, &k.params, k.background, k.antialias, k.mode);
+        let (scene, native) = (&self.scene, &mut self.native);
+        let mut run = |k: &RenderKey| match native.as_mut().filter(|_| k.direct) {
+            Some(n) => n.render(renderer, scene, &camera, &k.method, &k.params, k.background),
+            None => renderer.render_antialiased(scene, &camera, &k.method, &k.params, k.background, k.antialias, k.mode),
+        };
         if stale {
             self.key = Some(key.clone());
             self.renders += 1;
@@ -282,8 +298,12 @@ impl ViewerApp {
         })
     }
 
-    /// Uploads the picture when it changed; returns the texture to paint.
-    pub fn texture(&mut self, ctx: &egui::Context) -> Option<&TextureHandle> {
+    /// The texture to paint: the one the frame was rendered into, or the picture uploaded when
+    /// it changed.
+    pub fn texture(&mut self, ctx: &egui::Context) -> Option<TextureId> {
+        if self.key.as_ref().is_some_and(|k| k.direct) && self.frame.is_some() {
+            return self.native.as_ref().and_then(Native::texture_id);
+        }
         let s = &self.settings;
         let key = ShowKey {
             renders: self.renders,
@@ -303,7 +323,7 @@ impl ViewerApp {
                 None => self.texture = None,
             }
         }
-        self.texture.as_ref()
+        self.texture.as_ref().map(TextureHandle::id)
     }
 
     /// Saves the window picture of a finished screenshot request.
@@ -437,7 +457,7 @@ impl ViewerApp {
             ui.ctx().request_repaint(); // the side panel shows the new stats next frame
         }
         self.view_rect = layout.image;
-        let texture = self.texture(ui.ctx()).map(TextureHandle::id);
+        let texture = self.texture(ui.ctx());
         let overlay = view::Overlay {
             settings: &self.settings,
             frame: self.frame.as_ref(),

@@ -6,6 +6,7 @@ pub mod args;
 pub mod gpu;
 pub mod heatmap;
 pub mod load;
+pub mod native;
 pub mod orbit;
 pub mod panels;
 pub mod scenefile;

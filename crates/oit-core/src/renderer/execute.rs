@@ -159,7 +159,7 @@ impl Renderer {
         let (tiles, report, pass_times, arrays) = result?;
         if let (Some(into), Some(t)) = (&self.into, &self.targets) {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
-            self.blit(&mut enc, &t.out, &into.color);
+            self.blit(&mut enc, &t.out, &into.color, wgpu::ColorWrites::COLOR, into.encode_srgb);
             gpu.queue.submit([enc.finish()]);
         }
         let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
@@ -397,7 +397,7 @@ impl Renderer {
             Some((picture, caller_depth)) => {
                 let t = self.targets.as_ref().expect("made by ensure_targets");
                 enc.copy_texture_to_texture(caller_depth.as_image_copy(), t.depth_texture.as_image_copy(), caller_depth.size());
-                self.blit(enc, &picture.create_view(&Default::default()), &t.base_texture);
+                self.blit(enc, &picture.create_view(&Default::default()), &t.base_texture, wgpu::ColorWrites::ALL, false);
                 (wgpu::LoadOp::Load, wgpu::LoadOp::Load)
             }
             None => {

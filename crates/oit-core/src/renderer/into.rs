@@ -4,7 +4,7 @@
 
 use super::Renderer;
 use crate::bindings::DEPTH_FORMAT;
-use crate::cache::{Draw, BLIT};
+use crate::cache::{Draw, BLIT, BLIT_SRGB};
 use crate::error::{invalid, Result};
 use crate::method::ParamValue;
 use crate::scene::{Camera, Scene};
@@ -12,21 +12,26 @@ use crate::stats::Stats;
 
 /// A caller's texture to render into, on the renderer's device, at the renderer's size.
 pub struct Target<'a> {
-    /// Receives the composite (any color format the device renders to; needs RENDER_ATTACHMENT,
-    /// and TEXTURE_BINDING where `depth` is given: its contents are then the opaque picture the
-    /// transparent geometry is drawn over).
+    /// Receives the composite's RGB; its alpha channel is left as it is (any color format the
+    /// device renders to; needs RENDER_ATTACHMENT, and TEXTURE_BINDING where `depth` is given:
+    /// its contents are then the opaque picture the transparent geometry is drawn over).
     pub color: &'a wgpu::Texture,
     /// The caller's opaque depth (Depth32Float with COPY_SRC, cleared to 1 and drawn with the
     /// camera's projection): it hides transparent fragments behind it. None: the picture under
     /// the transparent geometry is the scene's own opaque meshes over the background, as in
     /// `Renderer::render`.
     pub depth: Option<&'a wgpu::Texture>,
+    /// Writes sRGB-encoded RGB into a `color` whose format does not encode (an egui native
+    /// texture of Rgba8Unorm, which egui samples as encoded bytes); false for an sRGB or a float
+    /// format, which take linear values.
+    pub encode_srgb: bool,
 }
 
 /// The caller's textures while a frame renders into them.
 pub(super) struct IntoTarget {
     pub color: wgpu::Texture,
     pub depth: Option<wgpu::Texture>,
+    pub encode_srgb: bool,
 }
 
 impl Renderer {
@@ -70,7 +75,7 @@ impl Renderer {
             }
         }
         let (info, params) = self.prepare(scene, method_name, params, background)?;
-        self.into = Some(IntoTarget { color: target.color.clone(), depth: target.depth.cloned() });
+        self.into = Some(IntoTarget { color: target.color.clone(), depth: target.depth.cloned(), encode_srgb: target.encode_srgb });
         let frame = self.render_sample(camera, info, &params, background, false);
         self.into = None;
         let mut stats = frame?.stats;
@@ -78,10 +83,20 @@ impl Renderer {
         Ok(stats)
     }
 
-    /// Draws `source` into `target` pixel for pixel (`shaders/blit.wgsl`).
-    pub(super) fn blit(&self, enc: &mut wgpu::CommandEncoder, source: &wgpu::TextureView, target: &wgpu::Texture) {
+    /// Draws `source` into the channels `mask` of `target`, pixel for pixel, sRGB-encoded with
+    /// `encode_srgb` (`shaders/blit.wgsl`).
+    pub(super) fn blit(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        source: &wgpu::TextureView,
+        target: &wgpu::Texture,
+        mask: wgpu::ColorWrites,
+        encode_srgb: bool,
+    ) {
         let d = &self.gpu.device;
-        let pipeline = self.gpu.cache.render(d, &BLIT.render(&[], Draw::Fullscreen, vec![Some(target.format().into())]));
+        let color = wgpu::ColorTargetState { format: target.format(), blend: None, write_mask: mask };
+        let spec = if encode_srgb { &BLIT_SRGB } else { &BLIT };
+        let pipeline = self.gpu.cache.render(d, &spec.render(&[], Draw::Fullscreen, vec![Some(color)]));
         let layout = self.gpu.cache.layout(d, BLIT.groups[0]);
         let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("blit"),
