@@ -64,34 +64,18 @@ fn the_transparent_pass_over_a_callers_picture_equals_the_frame_with_its_opaque_
     }
 }
 
+/// The error `render_into` refuses `target` with, at the renderer's `size`.
+fn refusal(gpu: &std::sync::Arc<oit_core::GpuContext>, size: (u32, u32), target: Target<'_>) -> String {
+    let mut r = Renderer::new(gpu.clone(), size.0, size.1).unwrap();
+    r.render_into(&transparent(), &identity(), "abuffer", &[], [0.0; 3], target).unwrap_err().to_string()
+}
+
 #[test]
 fn a_target_of_another_size_or_a_wrong_depth_is_refused_by_name() {
     let gpu = shared_context(None).expect("a GPU adapter (lavapipe in CI)");
     let picture = caller::draw_opaque(&gpu, (32, 16), wgpu::TextureFormat::Rgba8Unorm, 0.5, [1.0; 3], 1.0, [0.0; 3]);
-    let mut r = Renderer::new(gpu.clone(), 64, 48).unwrap();
-    let e = r
-        .render_into(
-            &transparent(),
-            &identity(),
-            "abuffer",
-            &[],
-            [0.0; 3],
-            Target { color: &picture.color, depth: None, encode_srgb: false },
-        )
-        .unwrap_err()
-        .to_string();
+    let e = refusal(&gpu, (64, 48), Target { color: &picture.color, depth: None, encode_srgb: false });
     assert!(e.contains("make them the same size"), "{e}");
-    let mut r = Renderer::new(gpu.clone(), 32, 16).unwrap();
-    let e = r
-        .render_into(
-            &transparent(),
-            &identity(),
-            "abuffer",
-            &[],
-            [0.0; 3],
-            Target { color: &picture.color, depth: Some(&picture.color), encode_srgb: false },
-        )
-        .unwrap_err()
-        .to_string();
+    let e = refusal(&gpu, (32, 16), Target { color: &picture.color, depth: Some(&picture.color), encode_srgb: false });
     assert!(e.contains("must be Depth32Float"), "{e}");
 }
