@@ -114,6 +114,25 @@ def test_a_budget_below_the_frame_targets_tiles_them_too(hair_scene, name):
         assert (np.abs(tiled.image[..., :3] - exact[..., :3]) <= tiled.error_bound + 1e-6).all()
 
 
+def test_every_method_at_256_squared_stays_within_4_mib(hair_scene):
+    """The issue's case: at 256 x 256 the frame's targets alone (4.7 MB) pass a 4 MiB budget, so
+    every method renders in tiles of tile-sized targets, within the budget, with the same
+    coverage and, for the exact methods, within float32 rounding of the untiled frame."""
+    scene, camera = hair_scene
+    budget = 4 * 2 ** 20
+    for name in METHODS:
+        if name not in oit.Renderer(1, 1).adapter_info["methods"]:
+            continue
+        untiled = oit.Renderer(256, 256).render(scene, camera, name)
+        tiled = oit.Renderer(256, 256, memory_budget=budget).render(scene, camera, name)
+        assert tiled.stats["tiles"] > 1 and tiled.stats["peak_memory_bytes"] <= budget, name
+        if untiled.depth_complexity is not None:
+            assert np.array_equal(tiled.depth_complexity, untiled.depth_complexity), name
+        if INFO[name]["error_bound"] == "exact":
+            n = max(int(untiled.depth_complexity.max()), 1)
+            assert np.abs(tiled.image - untiled.image).max() <= (n + 2) * 2.0 ** -21, name
+
+
 @pytest.mark.parametrize("name", ["abuffer", "hybrid"])
 def test_tiles_under_perspective_with_opaque_occluders(name):
     scene = build_scene(random_meshes(5, transparent=30, opaque=3, triangles=6, space="world", spread=1.0))
