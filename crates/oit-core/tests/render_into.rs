@@ -78,4 +78,19 @@ fn a_target_of_another_size_or_a_wrong_depth_is_refused_by_name() {
     assert!(e.contains("make them the same size"), "{e}");
     let e = refusal(&gpu, (32, 16), Target { color: &picture.color, depth: Some(&picture.color), encode_srgb: false });
     assert!(e.contains("must be Depth32Float"), "{e}");
+    // A budget below the frame's targets, which render_into keeps frame-sized, before any work.
+    let mut r = Renderer::new(gpu.clone(), 32, 16).unwrap();
+    r.set_memory_budget(Some(4096)).unwrap();
+    let e = r
+        .render_into(
+            &transparent(),
+            &identity(),
+            "abuffer",
+            &[],
+            [0.0; 3],
+            Target { color: &picture.color, depth: Some(&picture.depth), encode_srgb: false },
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("render_into draws into frame-sized targets"), "{e}");
 }

@@ -207,16 +207,12 @@ impl Renderer {
     ) -> Result<(Vec<Tile>, MethodReport, Option<Vec<(&'static str, f64)>>, FrameArrays)> {
         let gpu = self.gpu.clone();
         let (w, h) = (self.width, self.height);
+        let frame_max_depth_complexity = counts.iter().copied().max().unwrap_or(0);
         let mut squeeze = 1.0f64;
         loop {
             let plan = self.plan_tiles(info, params, counts, coverage, squeeze)?;
             if self.into.is_some() && plan.targets != (w, h) {
-                return Err(OitError::OutOfMemory(format!(
-                    "render_into draws into frame-sized targets ({} bytes at {w} x {h}), which the memory_budget of {} bytes \
-                     cannot hold beside the method: raise memory_budget, or render() in tiles",
-                    Self::target_bytes(w, h, coverage),
-                    self.memory_budget.unwrap_or(0)
-                )));
+                return Err(self.target_refused());
             }
             let tiles = plan.tiles;
             if self.ensure_targets(plan.targets.0, plan.targets.1, coverage)? {
@@ -249,7 +245,7 @@ impl Renderer {
                     params,
                     tile: *tile,
                     max_depth_complexity: tile_counts.iter().copied().max().unwrap_or(0),
-                    frame_max_depth_complexity: counts.iter().copied().max().unwrap_or(0),
+                    frame_max_depth_complexity,
                     fragments: tile_counts.iter().map(|&c| c as u64).sum(),
                     depth_complexity: &tile_counts,
                     frame_uniform: &self.shared.uniform,

@@ -74,6 +74,10 @@ impl Renderer {
                 ));
             }
         }
+        // Refused before any work: the census would otherwise draw into tile-sized targets.
+        if !self.frame_targets(false) {
+            return Err(self.target_refused());
+        }
         let (info, params) = self.prepare(scene, method_name, params, background)?;
         self.into = Some(IntoTarget { color: target.color.clone(), depth: target.depth.cloned(), encode_srgb: target.encode_srgb });
         let frame = self.render_sample(camera, info, &params, background, false);

@@ -26,7 +26,7 @@ impl Renderer {
     /// interpolated exactly as in the untiled frame. Tile-sized targets rasterize with the
     /// viewport moved by the tile's origin: coverage is the same, interpolated depth and color
     /// may differ by float32 rounding (docs/methods.md, "Tiles").
-    fn frame_targets(&self, coverage: bool) -> bool {
+    pub(super) fn frame_targets(&self, coverage: bool) -> bool {
         self.memory_budget.is_none_or(|b| Self::target_bytes(self.width, self.height, coverage) < b)
     }
 
@@ -45,6 +45,19 @@ impl Renderer {
             rows -= 1;
         }
         Ok(rows)
+    }
+
+    /// Why a frame into a caller's texture cannot render: its targets must be the frame's (the
+    /// caller's depth and picture are copied whole), and the budget cannot hold them beside the
+    /// method.
+    pub(super) fn target_refused(&self) -> OitError {
+        let (w, h) = (self.width, self.height);
+        OitError::OutOfMemory(format!(
+            "render_into draws into frame-sized targets ({} bytes at {w} x {h}), which the memory_budget of {} bytes \
+             cannot hold beside the method: raise memory_budget, or render() in tiles",
+            Self::target_bytes(w, h, false),
+            self.memory_budget.unwrap_or(0)
+        ))
     }
 
     fn row_refused(&self, budget: u64, row: u64) -> OitError {
