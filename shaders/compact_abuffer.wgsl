@@ -28,22 +28,25 @@ struct PrimShading {
 
 @compute @workgroup_size(64)
 fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let t = triangle_of(gid); // within the chunk
-    if t >= chunk.triangles {
+    let d = triangle_of(gid); // drawn, within the chunk
+    if d >= chunk.drawn {
         return;
     }
+    let t = drawn_triangle(d);
     var s: PrimShading;
     for (var k = 0u; k < 3u; k++) {
+        let v = indices[3u * t.t + k];
         s.clip[k] = clip_vertex(t, k);
-        s.color[k] = colors[indices[3u * t + k]];
+        s.color[k] = placed_color(v, t.inst);
         s.normal[k] = vec4<f32>(0.0);
         s.uv[k] = vec2<f32>(0.0);
         if SHADED != 0u {
-            s.normal[k] = attributes[2u * indices[3u * t + k]];
-            s.uv[k] = attributes[2u * indices[3u * t + k] + 1u].xy;
+            let a = attributes[2u * v];
+            s.normal[k] = vec4<f32>(placed_normal(a.xyz, t.inst), a.w);
+            s.uv[k] = attributes[2u * v + 1u].xy;
         }
     }
-    shading[chunk.first_triangle + t] = s;
+    shading[t.prim] = s;
 }
 
 @fragment @early_depth_test(force)

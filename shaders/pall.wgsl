@@ -24,10 +24,11 @@ struct Block {
 
 @compute @workgroup_size(64)
 fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let t = triangle_of(gid); // within the chunk
-    if t >= chunk.triangles {
+    let d = triangle_of(gid); // drawn, within the chunk
+    if d >= chunk.drawn {
         return;
     }
+    let t = drawn_triangle(d);
     let b = pixel_box(clip_vertex(t, 0u), clip_vertex(t, 1u), clip_vertex(t, 2u));
     var extent = vec2<u32>(0u);
     if all(b.hi >= b.lo) {
@@ -35,7 +36,7 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let start = atomicAdd(&alloc.count, extent.x * extent.y);
     let lo = vec2<u32>(max(b.lo, vec2<i32>(0)));
-    blocks[chunk.first_triangle + t] = Block(start, lo.x | (lo.y << 16u), extent.x | (extent.y << 16u), 0u);
+    blocks[t.prim] = Block(start, lo.x | (lo.y << 16u), extent.x | (extent.y << 16u), 0u);
 }
 
 @fragment @early_depth_test(force)

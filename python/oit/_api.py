@@ -30,8 +30,12 @@ class Scene:
     def add_mesh(self, positions: Any, indices: Any, colors: Any, opaque: bool = False, *, normals: Any = None,
                  uvs: Any = None, texture: Any = None, shading: str | None = None, specular: float = 0.0,
                  shininess: float = 32.0, opacity: float = 1.0, two_sided: bool = True,
-                 cull_back_faces: bool = False) -> int:
+                 cull_back_faces: bool = False, transform: Any = None) -> int:
         """Adds a triangle mesh and returns its index.
+
+        `transform` (4, 4), affine, places it (world = transform @ [x, y, z, 1]; normals by its
+        inverse transpose); without one it is drawn where its vertices are. `add_instances`
+        and `set_instances` draw the same vertices again under other transforms.
 
         positions: (n, 3) float; indices: (m, 3) non-negative integers below n (converted to
         uint32 after range checks); colors: (n, 4) per vertex or (4,) for the whole mesh,
@@ -76,7 +80,41 @@ class Scene:
             raise TypeError(f"opaque must be a bool, got {type(opaque).__name__}")
         surface = _surface(len(pos), normals, uvs, texture, shading, specular, shininess, opacity, two_sided,
                            cull_back_faces)
+        if transform is not None:
+            if np.shape(transform) != (4, 4):
+                raise ValueError(f"transform must have shape (4, 4), got {np.shape(transform)}: "
+                                 "add_instances places a mesh more than once")
+            surface["transform"] = _transforms(transform, "transform")[0]
         return self._native.add_mesh(pos, idx, col, bool(opaque), **surface)
+
+    def add_instances(self, mesh: int, transforms: Any, colors: Any = None) -> int:
+        """Draws mesh `mesh` (the index add_mesh returned) once more under each of `transforms`
+        ((n, 4, 4) or (4, 4), affine), from the same uploaded vertices; `colors` ((n, 4) or (4,),
+        in [0, 1]) multiplies each instance's vertex RGBA. Returns the first new instance's index.
+        A mirroring transform (negative determinant) keeps the mesh's outside outside: its front
+        faces are clockwise, as glTF has it. Submission order: a mesh's instances in order, each
+        with all its triangles."""
+        index = self._mesh_index(mesh)
+        t = _transforms(transforms, "transforms")
+        return self._native.add_instances(index, t, _instance_colors(colors, len(t)))
+
+    def set_instances(self, mesh: int, transforms: Any, colors: Any = None) -> None:
+        """Replaces the instances of mesh `mesh` (its add_mesh placement included) with
+        `transforms` and `colors`, as `add_instances` takes them; with none (shape (0, 4, 4))
+        the mesh stays in the scene but is not drawn."""
+        index = self._mesh_index(mesh)
+        t = _transforms(transforms, "transforms")
+        self._native.set_instances(index, t, _instance_colors(colors, len(t)))
+
+    def instances(self, mesh: int) -> tuple[np.ndarray, np.ndarray]:
+        """(transforms (n, 4, 4), colors (n, 4)) of mesh `mesh`'s instances."""
+        return self._native.instances(self._mesh_index(mesh))
+
+    def _mesh_index(self, mesh: Any) -> int:
+        index = _int(mesh, "mesh", "an int (the index add_mesh returned)")
+        if not 0 <= index < self.mesh_count:
+            raise ValueError(f"mesh index {index} is out of range: the scene has {self.mesh_count} meshes")
+        return index
 
     def add_light(self, direction: Sequence[float], color: Sequence[float] = (1.0, 1.0, 1.0), intensity: float = 1.0) -> int:
         """Adds a directional light travelling along `direction` (world space: L is
@@ -132,11 +170,23 @@ class Scene:
 
     @property
     def triangle_count(self) -> int:
+        """Triangles drawn: each mesh's times its instances."""
         return self._native.triangle_count
 
     @property
+    def unique_triangle_count(self) -> int:
+        """Triangles uploaded: each mesh's once, however many instances draw it."""
+        return self._native.unique_triangle_count
+
+    @property
+    def instance_count(self) -> int:
+        """Instances drawn over every mesh (a mesh added once counts one)."""
+        return self._native.instance_count
+
+    @property
     def bounds(self) -> tuple[np.ndarray, np.ndarray] | None:
-        """The (lo, hi) corners of the box around every vertex; None for an empty scene."""
+        """The (lo, hi) corners of the box around every drawn vertex (instances placed); None
+        when nothing is drawn."""
         b = self._native.bounds()
         return None if b is None else (np.array(b[0], dtype=np.float64), np.array(b[1], dtype=np.float64))
 
@@ -201,6 +251,29 @@ class Scene:
             self.add_mesh(t.positions, t.faces, colors, opaque=opaque or t.opaque,
                           normals=t.normals if shading == "smooth" else None, uvs=t.uvs, texture=t.texture,
                           shading=shading, specular=specular, shininess=shininess, two_sided=two_sided)
+
+
+def _transforms(value: Any, name: str) -> np.ndarray:
+    """(n, 4, 4) float64 from (n, 4, 4) or (4, 4); affinity and finiteness are the core's checks."""
+    a = np.asarray(value)
+    if a.dtype == object or a.dtype == bool or not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)):
+        raise TypeError(f"{name} must be a float array of 4 x 4 matrices, got dtype {a.dtype}")
+    if a.shape == (4, 4):
+        a = a.reshape(1, 4, 4)
+    if a.ndim != 3 or a.shape[1:] != (4, 4):
+        raise ValueError(f"{name} must have shape (n, 4, 4) or (4, 4), got {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _instance_colors(value: Any, n: int) -> np.ndarray | None:
+    if value is None:
+        return None
+    c = _float_array(value, "colors")
+    if c.shape == (4,):
+        c = np.tile(c, (n, 1))
+    if c.shape != (n, 4):
+        raise ValueError(f"colors must have shape ({n}, 4) (one RGBA factor an instance) or (4,), got {c.shape}")
+    return np.ascontiguousarray(c)
 
 
 class Camera:
@@ -362,7 +435,7 @@ class Stats(TypedDict, total=False):
     max_depth_complexity: int | None  # the most transparent fragments of a pixel; None without a census
     memory_bytes: int  # what the method allocated (oit.memory_bytes gives its formula)
     target_bytes: int  # the frame's targets and readbacks as allocated (tile-sized under a small budget)
-    scene_bytes: int  # the scene's GPU buffers, apart from the frame's
+    scene_bytes: int  # the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's
     gpu_time_ms: float | None  # the passes' GPU time; None where the adapter has no timestamp queries
     pass_times_ms: dict[str, float]  # GPU time per pass; a pass run more than once adds up
     overflow_fragments: int  # fragments a bounded structure could not hold
@@ -371,6 +444,7 @@ class Stats(TypedDict, total=False):
     antialias_mode: str  # 'frames' or 'coverage'
     tiles: int  # screen tiles the frame was rendered in (1: untiled), summed over antialiasing samples
     geometry_chunks: int  # chunks the transparent geometry was uploaded in (1 unless it passes a binding)
+    instances: int  # instances drawn, over every mesh (a mesh added once counts one)
     peak_memory_bytes: int  # memory_bytes + target_bytes: all the frame allocated at once, within memory_budget
     adapter: str  # the adapter's name
     extra: dict[str, float]  # method-specific (the schema lists them)

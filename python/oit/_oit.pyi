@@ -59,6 +59,7 @@ class _Stats(TypedDict, total=False):
     antialias_mode: str
     tiles: int
     geometry_chunks: int
+    instances: int
     peak_memory_bytes: int
     adapter: str
     extra: dict[str, float]
@@ -101,10 +102,23 @@ class Scene:
         opacity: float = 1.0,
         two_sided: bool = True,
         cull_back_faces: bool = False,
+        transform: npt.NDArray[np.float64] | None = None,
     ) -> int:
         """positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
         surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
-        shading "unlit", "flat" or "smooth"."""
+        shading "unlit", "flat" or "smooth". `transform` (4, 4) float64 places it (else it is
+        drawn where its vertices are)."""
+    def add_instances(
+        self, mesh: int, transforms: npt.NDArray[np.float64], colors: npt.NDArray[np.float32] | None = None
+    ) -> int:
+        """Appends instances to mesh `mesh`: transforms (n, 4, 4) float64, colors (n, 4) float32
+        factors or None; returns the first new instance's index."""
+    def set_instances(
+        self, mesh: int, transforms: npt.NDArray[np.float64], colors: npt.NDArray[np.float32] | None = None
+    ) -> None:
+        """Replaces the instances of mesh `mesh` (none: it stays uploaded but is not drawn)."""
+    def instances(self, mesh: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float32]]:
+        """Transforms (n, 4, 4) row-major and color factors (n, 4) of mesh `mesh`'s instances."""
     def add_light(self, direction: tuple[float, float, float], color: tuple[float, float, float], intensity: float) -> int:
         """A directional light travelling along `direction` (world space); returns its index."""
     def clear_lights(self) -> None: ...
@@ -120,11 +134,18 @@ class Scene:
     @property
     def mesh_count(self) -> int: ...
     @property
-    def triangle_count(self) -> int: ...
+    def triangle_count(self) -> int:
+        """Triangles drawn, instances included."""
+    @property
+    def unique_triangle_count(self) -> int:
+        """Triangles uploaded: each mesh's once."""
+    @property
+    def instance_count(self) -> int: ...
     def mesh_materials(self) -> list[dict[str, Any]]:
         """Per mesh: what its material and colors are (tests and `Scene.materials`)."""
     def bounds(self) -> tuple[list[float], list[float]] | None:
-        """The smallest and largest corner of every vertex's box; None for an empty scene."""
+        """The smallest and largest corner of every drawn vertex's box (instances placed); None
+        when nothing is drawn."""
     def mesh_summary(self) -> list[tuple[int, int, bool]]:
         """(triangles, vertices, opaque) per mesh."""
 

@@ -33,24 +33,41 @@ struct Light {
 @group(0) @binding(1) var<storage, read> positions: array<f32>;
 @group(0) @binding(2) var<storage, read> colors: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> indices: array<u32>;
-// Geometry is uploaded in chunks that each fit a binding: this chunk's first triangle in the
-// submission order of the whole scene, and its triangle count. Indices are local to the chunk.
+// Geometry is uploaded in chunks that each fit a binding: this chunk's first uploaded triangle
+// in the scene's order, its uploaded triangle count, its segments (common/setup.wgsl) and the
+// triangles drawn from it, instances included. Indices are local to the chunk.
 struct Chunk {
     first_triangle: u32,
     triangles: u32,
-    pad0: u32,
-    pad1: u32,
+    segments: u32,
+    drawn: u32,
 }
 @group(0) @binding(4) var<uniform> chunk: Chunk;
 // Two vec4 a vertex where the scene is shaded: (unit normal, material index bits), (u, v, 0, 0).
 @group(0) @binding(5) var<storage, read> attributes: array<vec4<f32>>;
 // The material table, then every texture's texels (common/shading.wgsl); the same in every chunk.
 @group(0) @binding(6) var<storage, read> surfaces: array<vec4<f32>>;
+//!if INSTANCED
+// A mesh drawn other than once in place: each instance's transform, the inverse transpose of
+// its linear part (normals), an RGBA factor of the vertex colors, what turns an uploaded
+// triangle's index into its drawn one (the drawn order: every triangle of instance 0, then of
+// instance 1, mesh after mesh), and whether it mirrors. Mirrors oit_core::gpu_types::GpuInstance.
+struct Instance {
+    model: mat4x4<f32>,
+    normal: mat3x3<f32>,
+    color: vec4<f32>,
+    prim_offset: u32,
+    mirror: u32,
+    pad0: u32,
+    pad1: u32,
+}
+@group(0) @binding(7) var<storage, read> instances: array<Instance>;
+//!endif
 
 struct VsOut {
     @builtin(position) @invariant clip: vec4<f32>,
     @location(0) color: vec4<f32>,
-    // Global triangle index in submission order (the chunk's first, plus vertex_index / 3).
+    // The triangle's index in the drawn order (instances included): what passes key it by.
     @location(1) @interpolate(flat) prim: u32,
     // Clip w, interpolated: the view distance under a perspective camera (1 for orthographic).
     @location(2) view_w: f32,
@@ -65,20 +82,27 @@ struct VsOut {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+fn vs_main(
+    @builtin(vertex_index) vi: u32,
+//!if INSTANCED
+    @builtin(instance_index) ii: u32,
+//!endif
+) -> VsOut {
+//!if !INSTANCED
+    let ii = 0u;
+//!endif
     let v = indices[vi];
-    let p = scene_position(v);
     var out: VsOut;
-    out.clip = frame.view_proj * vec4<f32>(p, 1.0);
-    out.color = colors[v];
-    out.prim = chunk.first_triangle + vi / 3u;
+    out.clip = frame.view_proj * placed(v, ii);
+    out.color = placed_color(v, ii);
+    out.prim = drawn_prim(vi / 3u, ii);
     out.view_w = out.clip.w;
 //!if SHADED
     let a = attributes[2u * v];
     out.material = bitcast<u32>(a.w);
-    out.normal = a.xyz;
+    out.normal = placed_normal(a.xyz, ii);
     out.uv = attributes[2u * v + 1u].xy;
-    if (bitcast<u32>(surfaces[2u * out.material].w) & CULL_BACK) != 0u && !faces_front(vi) {
+    if (bitcast<u32>(surfaces[2u * out.material].w) & CULL_BACK) != 0u && !faces_front(vi, ii) {
         // A culled back face: all three corners behind the near plane, so nothing is drawn.
         out.clip = vec4<f32>(0.0, 0.0, -1.0, 1.0);
     }
@@ -86,17 +110,64 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     return out;
 }
 
-// Whether the triangle of vertex `vi` is counter-clockwise on screen (wgpu's front face): the
-// sign of det[x y w] of its clip corners, right for corners behind the eye too (Olano and
-// Greer, "Triangle scan conversion using 2D homogeneous coordinates"). Every corner computes
-// the same value, so a triangle is kept or dropped whole; the reference's test is the same.
-fn faces_front(vi: u32) -> bool {
+// Whether the triangle of vertex `vi` is counter-clockwise on screen (wgpu's front face), or
+// clockwise under a mirroring instance: the sign of det[x y w] of its clip corners, right for
+// corners behind the eye too (Olano and Greer, "Triangle scan conversion using 2D homogeneous
+// coordinates"). Every corner computes the same value, so a triangle is kept or dropped whole;
+// the reference's test is the same.
+fn faces_front(vi: u32, ii: u32) -> bool {
     let first = vi - vi % 3u;
-    let a = frame.view_proj * vec4<f32>(scene_position(indices[first]), 1.0);
-    let b = frame.view_proj * vec4<f32>(scene_position(indices[first + 1u]), 1.0);
-    let c = frame.view_proj * vec4<f32>(scene_position(indices[first + 2u]), 1.0);
-    return determinant(mat3x3<f32>(a.xyw, b.xyw, c.xyw)) > 0.0;
+    let a = frame.view_proj * placed(indices[first], ii);
+    let b = frame.view_proj * placed(indices[first + 1u], ii);
+    let c = frame.view_proj * placed(indices[first + 2u], ii);
+    return (determinant(mat3x3<f32>(a.xyw, b.xyw, c.xyw)) > 0.0) != mirrors(ii);
 }
+
+// Vertex `v` of the chunk placed by instance `ii` (world space, w = 1); its color times the
+// instance's; a shading normal carried by the instance (renormalized; zero stays zero); the
+// drawn index of the chunk's local triangle `t` under it; whether it mirrors.
+//!if INSTANCED
+fn placed(v: u32, ii: u32) -> vec4<f32> {
+    return instances[ii].model * vec4<f32>(scene_position(v), 1.0);
+}
+
+fn placed_color(v: u32, ii: u32) -> vec4<f32> {
+    return colors[v] * instances[ii].color;
+}
+
+fn placed_normal(n: vec3<f32>, ii: u32) -> vec3<f32> {
+    let m = instances[ii].normal * n;
+    return select(vec3<f32>(0.0), normalize(m), dot(m, m) > 0.0);
+}
+
+fn drawn_prim(t: u32, ii: u32) -> u32 {
+    return instances[ii].prim_offset + chunk.first_triangle + t;
+}
+
+fn mirrors(ii: u32) -> bool {
+    return instances[ii].mirror != 0u;
+}
+//!else
+fn placed(v: u32, ii: u32) -> vec4<f32> {
+    return vec4<f32>(scene_position(v), 1.0);
+}
+
+fn placed_color(v: u32, ii: u32) -> vec4<f32> {
+    return colors[v];
+}
+
+fn placed_normal(n: vec3<f32>, ii: u32) -> vec3<f32> {
+    return n;
+}
+
+fn drawn_prim(t: u32, ii: u32) -> u32 {
+    return chunk.first_triangle + t;
+}
+
+fn mirrors(ii: u32) -> bool {
+    return false;
+}
+//!endif
 
 fn scene_position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);

@@ -1,15 +1,60 @@
-// Triangle setup in compute passes over the transparent triangles (one invocation each):
-// clip-space vertices by vertex pulling, and the pixel-center bounding box.
+// Triangle setup in compute passes over the transparent triangles as drawn (one invocation
+// each, instances included): clip-space vertices by vertex pulling, and the pixel-center
+// bounding box.
 
-// Triangle of an invocation: dispatches over more than 65,535 groups of 64 use y as well.
+// Drawn triangle of an invocation, within the chunk: dispatches over more than 65,535 groups
+// of 64 use y as well.
 fn triangle_of(gid: vec3<u32>) -> u32 {
     return gid.y * (65535u * 64u) + gid.x;
 }
 
-fn clip_vertex(t: u32, corner: u32) -> vec4<f32> {
-    let v = indices[3u * t + corner];
-    let p = vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
-    return frame.view_proj * vec4<f32>(p, 1.0);
+// A drawn triangle: its local uploaded triangle in the chunk, its instance and its drawn index.
+struct Drawn {
+    t: u32,
+    inst: u32,
+    prim: u32,
+}
+
+//!if INSTANCED
+// A mesh's local triangles lo .. lo + triangles in the chunk, drawn once for each of its
+// instances from first_instance on, the chunk's drawn triangles from drawn_first on.
+// Mirrors `GpuSegment` in oit_core's upload.rs.
+struct Segment {
+    drawn_first: u32,
+    lo: u32,
+    triangles: u32,
+    first_instance: u32,
+}
+@group(0) @binding(8) var<storage, read> segments: array<Segment>;
+
+// The segment of drawn triangle `d` (d < chunk.drawn), by binary search over the chunk's
+// segments, then its instance and local triangle: instance-major, as the draws are.
+fn drawn_triangle(d: u32) -> Drawn {
+    var lo = 0u;
+    var hi = chunk.segments;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if segments[mid].drawn_first <= d {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let g = segments[lo];
+    let k = d - g.drawn_first;
+    let inst = g.first_instance + k / g.triangles;
+    let t = g.lo + k % g.triangles;
+    return Drawn(t, inst, drawn_prim(t, inst));
+}
+//!else
+fn drawn_triangle(d: u32) -> Drawn {
+    return Drawn(d, 0u, chunk.first_triangle + d);
+}
+//!endif
+
+// Corner `corner` of a drawn triangle in clip space.
+fn clip_vertex(tri: Drawn, corner: u32) -> vec4<f32> {
+    return frame.view_proj * placed(indices[3u * tri.t + corner], tri.inst);
 }
 
 // Inclusive pixel range [lo, hi] whose centers a triangle can cover, clamped to the tile; the

@@ -37,14 +37,16 @@ fn buffer_entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BufferBi
 }
 
 /// Group 0 (shaders/common/scene.wgsl): the frame uniform, positions, colors, indices, the
-/// chunk's place in the scene, the vertex attributes of shading, and the material table that
-/// fragments shade with.
+/// chunk's place in the scene, the vertex attributes of shading, the material table that
+/// fragments shade with, the instance table and the chunk's segments (compute passes over the
+/// drawn triangles).
 pub fn scene_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
     let read = wgpu::BufferBindingType::Storage { read_only: true };
     let storage = |binding| buffer_entry(binding, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE, read);
     let uniform = |binding| buffer_entry(binding, all, wgpu::BufferBindingType::Uniform);
-    vec![uniform(0), storage(1), storage(2), storage(3), uniform(4), storage(5), buffer_entry(6, all, read)]
+    let compute = |binding| buffer_entry(binding, wgpu::ShaderStages::COMPUTE, read);
+    vec![uniform(0), storage(1), storage(2), storage(3), uniform(4), storage(5), buffer_entry(6, all, read), storage(7), compute(8)]
 }
 
 /// The prefix sum's group (shaders/scan.wgsl): the data and the block sums, read-write, and

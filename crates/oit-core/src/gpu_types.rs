@@ -48,6 +48,49 @@ pub struct GpuMaterial {
     pub pad: u32,
 }
 
+/// Mirrors `Instance` in `shaders/common/scene.wgsl`: one row of the instance table.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuInstance {
+    /// The transform, columns.
+    pub model: [[f32; 4]; 4],
+    /// The normal matrix (`Instance::normal_matrix`), columns padded to vec4.
+    pub normal: [[f32; 4]; 3],
+    /// RGBA factor of the vertex colors.
+    pub color: [f32; 4],
+    /// Added to a triangle's uploaded index to give its drawn index (wrapping).
+    pub prim_offset: u32,
+    /// 1 where the transform mirrors (front faces are clockwise).
+    pub mirror: u32,
+    pub pad: [u32; 2],
+}
+
+impl GpuInstance {
+    pub fn new(inst: &crate::scene::Instance, prim_offset: u32) -> Self {
+        let n = inst.normal_matrix().as_mat3();
+        let col = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
+        Self {
+            model: inst.transform.as_mat4().to_cols_array_2d(),
+            normal: [col(n.x_axis), col(n.y_axis), col(n.z_axis)],
+            color: inst.color,
+            prim_offset,
+            mirror: inst.mirrors() as u32,
+            pad: [0; 2],
+        }
+    }
+}
+
+/// Mirrors `Segment` in shaders/common/setup.wgsl: a mesh's local triangles in a chunk and
+/// where its drawn triangles start among the chunk's.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuSegment {
+    pub drawn_first: u32,
+    pub lo: u32,
+    pub triangles: u32,
+    pub first_instance: u32,
+}
+
 /// Mirrors `Node` in `shaders/abuffer.wgsl`: depth, next index, straight RGBA.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]

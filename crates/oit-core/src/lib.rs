@@ -32,6 +32,6 @@ pub use method::{
 };
 pub use reference::{reference, reference_antialiased, ReferenceImage};
 pub use renderer::{coverage_methods, shared_context, Frame, Renderer, Target, COVERAGE_SAMPLES};
-pub use scene::{Camera, Mesh, Scene};
+pub use scene::{Camera, Instance, Mesh, Scene};
 pub use shading::{Light, Material, Shading, Texture, MAX_LIGHTS};
 pub use stats::Stats;

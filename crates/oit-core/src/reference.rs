@@ -44,6 +44,8 @@ struct Tri {
     /// frame's camera (clockwise on screen: `back_facing`).
     cull: bool,
     back: bool,
+    /// Whether the triangle's instance mirrors: its front faces are clockwise.
+    mirror: bool,
 }
 
 struct Bounds(Aabb);
@@ -148,17 +150,26 @@ pub fn reference_antialiased(
     }
     let offsets = crate::antialias::sample_offsets(antialias)?;
     let mut tris = Vec::new();
-    for (mesh, m) in scene.meshes().iter().enumerate() {
-        for ix in &m.indices {
-            let v = ix.map(|i| DVec3::from(m.positions[i as usize].map(|x| x as f64)));
-            let c = ix.map(|i| DVec4::from(m.colors[i as usize].map(|x| x as f64)));
-            let n = match m.material.shading {
-                Shading::Flat => [(v[1] - v[0]).cross(v[2] - v[0]).normalize(); 3],
-                _ if m.normals.is_empty() => [DVec3::ZERO; 3],
-                _ => ix.map(|i| DVec3::from(m.normals[i as usize].map(|x| x as f64))),
-            };
-            let uv = if m.uvs.is_empty() { [DVec2::ZERO; 3] } else { ix.map(|i| DVec2::from(m.uvs[i as usize].map(|x| x as f64))) };
-            tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull: m.material.cull_back_faces, back: false });
+    // Every instance's triangles in world space, in f64: positions by the transform, normals by
+    // its inverse transpose (renormalized), colors times the instance's.
+    for (mesh, (m, instances)) in scene.placed().enumerate() {
+        for inst in instances {
+            let nm = inst.normal_matrix();
+            let factor = DVec4::from(inst.color.map(|x| x as f64));
+            let carry = |n: DVec3| (nm * n).normalize_or_zero();
+            for ix in &m.indices {
+                let local = ix.map(|i| DVec3::from(m.positions[i as usize].map(|x| x as f64)));
+                let v = ix.map(|i| inst.apply(m.positions[i as usize]));
+                let c = ix.map(|i| DVec4::from(m.colors[i as usize].map(|x| x as f64)) * factor);
+                let n = match m.material.shading {
+                    Shading::Flat => [carry((local[1] - local[0]).cross(local[2] - local[0]).normalize()); 3],
+                    _ if m.normals.is_empty() => [DVec3::ZERO; 3],
+                    _ => ix.map(|i| carry(DVec3::from(m.normals[i as usize].map(|x| x as f64)))),
+                };
+                let uv = if m.uvs.is_empty() { [DVec2::ZERO; 3] } else { ix.map(|i| DVec2::from(m.uvs[i as usize].map(|x| x as f64))) };
+                let cull = m.material.cull_back_faces;
+                tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull, mirror: inst.mirrors(), back: false });
+            }
         }
     }
     let materials: Vec<&Material> = scene.meshes().iter().map(|m| &m.material).collect();
@@ -227,7 +238,7 @@ fn trace_frame(
             (Some(a), Some(b), Some(c)) => Some([a, b, c]),
             _ => None,
         };
-        t.back = t.cull && back_facing(&vp, &t.v);
+        t.back = t.cull && back_facing(&vp, &t.v) != t.mirror;
     }
     let tris = &*tris;
     let pixels = width as usize * height as usize;

@@ -349,13 +349,14 @@ impl Renderer {
     }
 
     /// What `scene`'s passes compile for: its surfaces, its light count (the headlight when it
-    /// has none) and the shading-cost knob.
+    /// has none), the shading-cost knob and whether it has instances.
     fn variant(&self, scene: &GpuScene) -> SceneVariant {
         SceneVariant {
             shaded: scene.shaded,
             lights: Lighting::count(&self.lights.0),
             textured: scene.textured,
             shading_cost: self.shading_cost,
+            instanced: scene.instanced,
         }
     }
 }

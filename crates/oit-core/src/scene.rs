@@ -2,7 +2,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::{DMat4, DVec4, Mat4};
+use glam::{DMat3, DMat4, DVec4, Mat4};
 
 use crate::error::{invalid, Result};
 use crate::shading::{self, Light, Lighting, Material, Shading, MAX_LIGHTS};
@@ -81,12 +81,72 @@ impl Mesh {
     }
 }
 
+/// One placement of a mesh: an affine transform (column-vector convention, `world = M @ [p, 1]`)
+/// and an RGBA factor that multiplies the mesh's vertex colors. A mesh is drawn once for each
+/// of its instances, from one copy of its vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Instance {
+    pub transform: DMat4,
+    pub color: [f32; 4],
+}
+
+impl Instance {
+    pub const IDENTITY: Instance = Instance { transform: DMat4::IDENTITY, color: [1.0; 4] };
+
+    /// `m` in row-major order (as numpy stores a 4x4 array). The transform must be affine
+    /// (last row 0, 0, 0, 1) and finite; `color` straight RGBA in [0, 1].
+    pub fn from_rows(m: [[f64; 4]; 4], color: [f32; 4]) -> Result<Self> {
+        if m.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(invalid!("transform {m:?} has NaN or Inf entries"));
+        }
+        if m[3] != [0.0, 0.0, 0.0, 1.0] {
+            return Err(invalid!("transform's last row is {:?}: instance transforms must be affine, with last row (0, 0, 0, 1)", m[3]));
+        }
+        if color.iter().any(|x| !(0.0..=1.0).contains(x)) {
+            return Err(invalid!("instance color {color:?} is outside [0, 1] (or NaN): it multiplies straight linear RGBA"));
+        }
+        Ok(Self { transform: DMat4::from_cols_array_2d(&m).transpose(), color })
+    }
+
+    pub fn is_identity(&self) -> bool {
+        *self == Self::IDENTITY
+    }
+
+    /// The matrix that carries normals: the inverse transpose of the linear part, computed as
+    /// the cofactor matrix times the determinant's sign (the same direction, and defined for a
+    /// singular transform too). Normals are renormalized after it.
+    pub fn normal_matrix(&self) -> DMat3 {
+        let a = DMat3::from_mat4(self.transform);
+        let (c0, c1, c2) = (a.x_axis, a.y_axis, a.z_axis);
+        let cof = DMat3::from_cols(c1.cross(c2), c2.cross(c0), c0.cross(c1));
+        if a.determinant() < 0.0 {
+            -cof
+        } else {
+            cof
+        }
+    }
+
+    /// Whether the transform mirrors (negative determinant): its front faces are clockwise
+    /// on screen, as glTF defines for such nodes, so back-face culling flips with it.
+    pub fn mirrors(&self) -> bool {
+        DMat3::from_mat4(self.transform).determinant() < 0.0
+    }
+
+    /// `p` carried into world space, in f64.
+    pub fn apply(&self, p: [f32; 3]) -> glam::DVec3 {
+        self.transform.transform_point3(glam::DVec3::from(p.map(|x| x as f64)))
+    }
+}
+
 static NEXT_SCENE_ID: AtomicU64 = AtomicU64::new(1);
 
-/// An ordered list of meshes. Submission order is the order of `add_mesh` calls.
+/// An ordered list of meshes, each drawn once for each of its instances. Submission order is
+/// the order of `add_mesh` calls, and within a mesh the order of its instances: every triangle
+/// of instance 0, then of instance 1, and so on.
 #[derive(Debug)]
 pub struct Scene {
     meshes: Vec<Mesh>,
+    instances: Vec<Vec<Instance>>,
     lights: Vec<Light>,
     ambient: [f32; 3],
     id: u64,
@@ -103,6 +163,7 @@ impl Clone for Scene {
     fn clone(&self) -> Self {
         Self {
             meshes: self.meshes.clone(),
+            instances: self.instances.clone(),
             lights: self.lights.clone(),
             ambient: self.ambient,
             id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed),
@@ -113,7 +174,14 @@ impl Clone for Scene {
 
 impl Scene {
     pub fn new() -> Self {
-        Self { meshes: Vec::new(), lights: Vec::new(), ambient: [0.0; 3], id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed), revision: 0 }
+        Self {
+            meshes: Vec::new(),
+            instances: Vec::new(),
+            lights: Vec::new(),
+            ambient: [0.0; 3],
+            id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed),
+            revision: 0,
+        }
     }
 
     /// Adds a directional light (at most MAX_LIGHTS); with none, a headlight shines.
@@ -158,14 +226,84 @@ impl Scene {
         Lighting::new(&self.lights, self.ambient, camera.view_direction())
     }
 
+    /// Adds a mesh drawn once, where its vertices are.
     pub fn add_mesh(&mut self, mesh: Mesh) -> usize {
+        self.add_placed(mesh, vec![Instance::IDENTITY])
+    }
+
+    /// Adds a mesh drawn once for each of `instances` (none: uploaded, not drawn).
+    pub fn add_placed(&mut self, mesh: Mesh, instances: Vec<Instance>) -> usize {
         self.meshes.push(mesh);
+        self.instances.push(instances);
         self.revision += 1;
         self.meshes.len() - 1
     }
 
+    /// Appends instances to mesh `mesh`; returns the index of the first one added.
+    pub fn add_instances(&mut self, mesh: usize, instances: &[Instance]) -> Result<usize> {
+        let list = self.instances.get_mut(mesh).ok_or_else(|| invalid!("no mesh {mesh}: add_mesh returns the index to pass"))?;
+        list.extend_from_slice(instances);
+        self.revision += 1;
+        Ok(list.len() - instances.len())
+    }
+
+    /// Replaces the instances of mesh `mesh`.
+    pub fn set_instances(&mut self, mesh: usize, instances: Vec<Instance>) -> Result<()> {
+        let list = self.instances.get_mut(mesh).ok_or_else(|| invalid!("no mesh {mesh}: add_mesh returns the index to pass"))?;
+        *list = instances;
+        self.revision += 1;
+        Ok(())
+    }
+
     pub fn meshes(&self) -> &[Mesh] {
         &self.meshes
+    }
+
+    /// The instances of mesh `mesh` (one identity instance for a mesh added by `add_mesh`).
+    pub fn instances(&self, mesh: usize) -> &[Instance] {
+        &self.instances[mesh]
+    }
+
+    /// Every mesh with its instances, in submission order.
+    pub fn placed(&self) -> impl Iterator<Item = (&Mesh, &[Instance])> {
+        self.meshes.iter().zip(self.instances.iter().map(|v| v.as_slice()))
+    }
+
+    /// Whether any mesh is drawn other than once where its vertices are (the constant
+    /// INSTANCED the geometry passes compile with: else they carry no transform).
+    pub fn instanced(&self) -> bool {
+        self.instances.iter().any(|v| v.len() != 1 || !v[0].is_identity())
+    }
+
+    /// Instances drawn, over every mesh.
+    pub fn instance_count(&self) -> usize {
+        self.instances.iter().map(|v| v.len()).sum()
+    }
+
+    /// Triangles drawn: each mesh's times its instances.
+    pub fn triangle_count(&self) -> usize {
+        self.placed().map(|(m, i)| m.triangle_count() * i.len()).sum()
+    }
+
+    /// Triangles uploaded: each mesh's once.
+    pub fn unique_triangle_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.triangle_count()).sum()
+    }
+
+    /// The box around every drawn vertex (instances included), in f64; None when nothing is drawn.
+    pub fn bounds(&self) -> Option<(glam::DVec3, glam::DVec3)> {
+        let mut lo = glam::DVec3::splat(f64::INFINITY);
+        let mut hi = -lo;
+        for (m, list) in self.placed() {
+            for inst in list {
+                for p in &m.positions {
+                    let w = inst.apply(*p);
+                    lo = lo.min(w);
+                    hi = hi.max(w);
+                }
+            }
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
     }
 
     /// Changes one mesh's alpha (all vertices), e.g. from a viewer slider.

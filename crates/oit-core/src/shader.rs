@@ -35,38 +35,44 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("LIGHTS", 2),
     Const::U32("TEXTURES", 1),
     Const::U32("SHADING_COST", 0),
+    Const::U32("INSTANCED", 1),
 ];
 
 /// What a scene's geometry passes compile for (`//!if` blocks and loop bounds in
 /// common/scene.wgsl and common/shading.wgsl): whether any mesh has a surface (normals, UVs
 /// and the material as varyings), the light count, whether any mesh is textured, and the
-/// shading-cost knob's extra light evaluations. An unlit scene's pipelines carry the vertex
-/// color alone, as they did before shading existed.
+/// shading-cost knob's extra light evaluations, and whether any mesh is drawn other than once
+/// in place (instances: the transform, color factor and drawn index from the instance table).
+/// An unlit scene's pipelines carry the vertex color alone, as they did before shading existed,
+/// and a scene without instances no transform.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct SceneVariant {
     pub shaded: bool,
     pub lights: u32,
     pub textured: bool,
     pub shading_cost: u32,
+    pub instanced: bool,
 }
 
 impl SceneVariant {
-    pub fn consts(&self) -> [Const; 4] {
+    pub fn consts(&self) -> [Const; 5] {
         [
             Const::U32("SHADED", self.shaded as u32),
             Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
             Const::U32("TEXTURES", (self.shaded && self.textured) as u32),
             Const::U32("SHADING_COST", self.shading_cost),
+            Const::U32("INSTANCED", self.instanced as u32),
         ]
     }
 }
 
 /// Scene variants besides the defaults' that tests validate every shader in: unlit, lit
-/// without textures, and the shading-cost knob on an unlit scene.
-pub const VALIDATION_VARIANTS: [SceneVariant; 3] = [
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0 },
-    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0 },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3 },
+/// without textures, the shading-cost knob on an unlit scene, and an unlit instanced scene.
+pub const VALIDATION_VARIANTS: [SceneVariant; 4] = [
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false },
+    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0, instanced: false },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3, instanced: false },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: true },
 ];
 
 /// `DEFAULT_CONSTS` with `variant`'s constants in place of the defaults of the same names.

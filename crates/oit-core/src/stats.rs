@@ -24,7 +24,8 @@ pub struct Stats {
     /// The frame's own targets and readbacks, at the tile size: base color, depth, output,
     /// error bound, census counts, and a coverage-mask frame's per-sample targets.
     pub target_bytes: u64,
-    /// The scene's buffers (vertices, indices, materials, textures), apart from the frame's.
+    /// The scene's buffers (vertices, indices, materials, textures, the instance table), apart
+    /// from the frame's.
     pub scene_bytes: u64,
     pub gpu_time_ms: Option<f64>,
     pub pass_times_ms: Vec<(&'static str, f64)>,
@@ -38,6 +39,8 @@ pub struct Stats {
     pub tiles: u32,
     /// Chunks the transparent geometry was uploaded in (1 unless it passes a binding).
     pub geometry_chunks: u32,
+    /// Instances drawn, over every mesh (a mesh added once counts one).
+    pub instances: u64,
     /// The most GPU memory the frame allocated at once: the method's largest tile and the
     /// frame's targets and readbacks (`memory_bytes + target_bytes`), within the memory budget
     /// when one is set; the scene's own buffers are `scene_bytes`.
@@ -71,7 +74,7 @@ pub const SCHEMA: &[StatKey] = &[
     key("max_depth_complexity", "int | None", "the most transparent fragments of a pixel; None without a census"),
     key("memory_bytes", "int", "what the method allocated (oit.memory_bytes gives its formula)"),
     key("target_bytes", "int", "the frame's targets and readbacks as allocated (tile-sized under a small budget)"),
-    key("scene_bytes", "int", "the scene's GPU buffers, apart from the frame's"),
+    key("scene_bytes", "int", "the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's"),
     key("gpu_time_ms", "float | None", "the passes' GPU time; None where the adapter has no timestamp queries"),
     key("pass_times_ms", "dict[str, float]", "GPU time per pass; a pass run more than once adds up"),
     key("overflow_fragments", "int", "fragments a bounded structure could not hold"),
@@ -80,6 +83,7 @@ pub const SCHEMA: &[StatKey] = &[
     key("antialias_mode", "str", "'frames' or 'coverage'"),
     key("tiles", "int", "screen tiles the frame was rendered in (1: untiled), summed over antialiasing samples"),
     key("geometry_chunks", "int", "chunks the transparent geometry was uploaded in (1 unless it passes a binding)"),
+    key("instances", "int", "instances drawn, over every mesh (a mesh added once counts one)"),
     key("peak_memory_bytes", "int", "memory_bytes + target_bytes: all the frame allocated at once, within memory_budget"),
     key("adapter", "str", "the adapter's name"),
     key(
@@ -127,6 +131,7 @@ impl Stats {
             ("antialias_mode", Str(self.antialias_mode.name())),
             ("tiles", Int(Some(self.tiles as u64))),
             ("geometry_chunks", Int(Some(self.geometry_chunks as u64))),
+            ("instances", Int(Some(self.instances))),
             ("peak_memory_bytes", Int(Some(self.peak_memory_bytes))),
             ("adapter", Str(&self.adapter)),
             ("extra", Numbers(self.extra.clone())),

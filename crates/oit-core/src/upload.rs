@@ -7,33 +7,54 @@ use glam::Vec3;
 
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
-use crate::gpu_types::GpuMaterial;
-use crate::scene::{Mesh, Scene};
+use crate::gpu_types::{GpuInstance, GpuMaterial, GpuSegment};
+use crate::scene::{Instance, Mesh, Scene};
 use crate::shading::Shading;
 use crate::targets::storage_buffer;
 
-/// A mesh's place in the concatenated geometry.
+/// One instance of a mesh, in the drawn order: its centroid in world space, its mesh (within
+/// this geometry) and its row of the instance table.
 #[derive(Clone, Copy, Debug)]
-pub struct MeshRange {
-    pub first_triangle: u32,
-    pub triangles: u32,
+pub struct Placement {
     pub centroid: Vec3,
+    pub mesh: usize,
+    pub instance: u32,
+}
+
+/// A mesh's triangles within one chunk: local triangles `lo .. hi`.
+#[derive(Clone, Copy, Debug)]
+struct Segment {
+    chunk: usize,
+    lo: u32,
+    hi: u32,
 }
 
 /// A run of triangles uploaded as one set of buffers that each fit a binding.
 pub struct Chunk {
-    /// Group 0: the frame uniform, this chunk's positions, colors and indices, and its place.
+    /// Group 0: the frame uniform, this chunk's positions, colors and indices, its place, the
+    /// instance table and the chunk's segments.
     pub group: wgpu::BindGroup,
-    pub first_triangle: u32,
+    /// The chunk's uploaded triangles.
     pub triangles: u32,
+    /// Triangles drawn from it, instances included: what a compute pass over the drawn
+    /// triangles dispatches (shaders/common/setup.wgsl).
+    pub drawn: u32,
 }
 
 /// The transparent or the opaque meshes, concatenated in submission order and split into
-/// chunks where their buffers would pass a storage binding.
+/// chunks where their buffers would pass a storage binding; each mesh is drawn once for each
+/// of its instances (upload.rs `draw_all`).
 pub struct Geometry {
     pub chunks: Vec<Chunk>,
+    /// Triangles drawn, instances included.
     pub triangles: u32,
-    pub meshes: Vec<MeshRange>,
+    pub placements: Vec<Placement>,
+    /// Per mesh of this geometry: its segments, its first instance and its instance count.
+    segments: Vec<Vec<Segment>>,
+    instances: Vec<(u32, u32)>,
+    /// Whether the passes compile with transforms (else every instance is the identity, one
+    /// a mesh, and a chunk draws in one call).
+    pub instanced: bool,
     pub bytes: u64,
 }
 
@@ -43,20 +64,39 @@ impl Geometry {
         &self.chunks[0].group
     }
 
-    /// Draws every triangle (three vertices each, pulled from storage), chunk after chunk.
+    /// Draws every triangle of every instance (three vertices each, pulled from storage) in
+    /// submission order: chunk after chunk; instanced, a mesh's instances in one draw, or
+    /// instance after instance where the mesh spans chunks.
     pub fn draw_all(&self, pass: &mut wgpu::RenderPass<'_>) {
-        self.draw_range(pass, 0, self.triangles);
+        if !self.instanced {
+            for c in &self.chunks {
+                pass.set_bind_group(0, &c.group, &[]);
+                pass.draw(0..3 * c.triangles, 0..1);
+            }
+            return;
+        }
+        for (segments, &(first, count)) in self.segments.iter().zip(&self.instances) {
+            if let [s] = segments[..] {
+                self.draw_segment(pass, s, first..first + count);
+            } else {
+                for i in first..first + count {
+                    segments.iter().for_each(|&s| self.draw_segment(pass, s, i..i + 1));
+                }
+            }
+        }
     }
 
-    /// Draws triangles `first .. first + count` of the submission order.
-    pub fn draw_range(&self, pass: &mut wgpu::RenderPass<'_>, first: u32, count: u32) {
-        for c in &self.chunks {
-            let lo = first.max(c.first_triangle);
-            let hi = (first + count).min(c.first_triangle + c.triangles);
-            if lo < hi {
-                pass.set_bind_group(0, &c.group, &[]);
-                pass.draw(3 * (lo - c.first_triangle)..3 * (hi - c.first_triangle), 0..1);
-            }
+    /// Draws one placement's triangles.
+    pub fn draw_placement(&self, pass: &mut wgpu::RenderPass<'_>, p: &Placement) {
+        for &s in &self.segments[p.mesh] {
+            self.draw_segment(pass, s, p.instance..p.instance + 1);
+        }
+    }
+
+    fn draw_segment(&self, pass: &mut wgpu::RenderPass<'_>, s: Segment, instances: std::ops::Range<u32>) {
+        if s.lo < s.hi && !instances.is_empty() {
+            pass.set_bind_group(0, &self.chunks[s.chunk].group, &[]);
+            pass.draw(3 * s.lo..3 * s.hi, instances);
         }
     }
 }
@@ -68,6 +108,10 @@ pub struct GpuScene {
     pub shaded: bool,
     /// Whether any mesh is textured.
     pub textured: bool,
+    /// Whether any mesh is drawn other than once in place (the constant INSTANCED), and the
+    /// instances drawn.
+    pub instanced: bool,
+    pub instances: u64,
 }
 
 /// Chunk contents on the host while they are gathered.
@@ -121,21 +165,26 @@ struct Shared<'a> {
     uniform: &'a wgpu::Buffer,
     surfaces: &'a wgpu::Buffer,
     shaded: bool,
+    instanced: bool,
 }
 
 fn upload<'a>(
     gpu: &GpuContext,
     label: &str,
-    meshes: impl Iterator<Item = (usize, &'a Mesh)>,
+    meshes: impl Iterator<Item = (usize, &'a Mesh, &'a [Instance])>,
     shared: &Shared<'_>,
     max_binding_bytes: u64,
 ) -> Result<Geometry> {
     let max = max_binding_bytes.max(48);
     let mut done: Vec<Gather> = Vec::new();
     let mut cur = Gather { shaded: shared.shaded, ..Default::default() };
-    let mut ranges = Vec::new();
-    let mut triangles: u64 = 0;
-    for (mesh, m) in meshes {
+    let mut placements = Vec::new();
+    let mut segments: Vec<Vec<Segment>> = Vec::new();
+    let mut instances: Vec<(u32, u32)> = Vec::new();
+    let mut table: Vec<GpuInstance> = Vec::new();
+    let mut unique: u64 = 0;
+    let mut drawn: u64 = 0;
+    for (mesh, m, list) in meshes {
         let split;
         let m = if shared.shaded && m.material.shading == Shading::Flat {
             split = flat_corners(m);
@@ -143,47 +192,82 @@ fn upload<'a>(
         } else {
             m
         };
-        if triangles + m.indices.len() as u64 > u32::MAX as u64 / 3 {
+        let tris = m.indices.len() as u64;
+        if drawn + tris * list.len() as u64 > u32::MAX as u64 / 3 {
             return Err(OitError::OutOfMemory(format!(
-                "the {label} meshes have more than {} triangles, the most one draw numbers: split the scene",
+                "the {label} meshes draw more than {} triangles (instances included), the most one frame numbers: \
+                 split the scene or draw fewer instances",
                 u32::MAX / 3
             )));
         }
+        let local = segments.len();
         let centroid = if m.positions.is_empty() {
-            Vec3::ZERO
+            glam::DVec3::ZERO
         } else {
-            m.positions.iter().map(|p| Vec3::from(*p)).sum::<Vec3>() / m.positions.len() as f32
+            m.positions.iter().map(|p| glam::DVec3::from(p.map(|x| x as f64))).sum::<glam::DVec3>() / m.positions.len() as f64
         };
-        ranges.push(MeshRange { first_triangle: triangles as u32, triangles: m.indices.len() as u32, centroid });
-        triangles += m.indices.len() as u64;
-        if cur.room(m.positions.len() as u64, m.indices.len() as u64, max) {
+        instances.push((table.len() as u32, list.len() as u32));
+        for inst in list {
+            placements.push(Placement {
+                centroid: inst.transform.transform_point3(centroid).as_vec3(),
+                mesh: local,
+                instance: table.len() as u32,
+            });
+            table.push(GpuInstance::new(inst, (drawn as u32).wrapping_sub(unique as u32)));
+            drawn += tris;
+        }
+        unique += tris;
+        let mut mine = Vec::new();
+        if cur.room(m.positions.len() as u64, tris, max) {
             // The whole mesh: its vertices in order, its indices offset.
             let base = cur.vertices() as u32;
+            mine.push(Segment { chunk: done.len(), lo: cur.triangles(), hi: cur.triangles() + tris as u32 });
             (0..m.positions.len()).for_each(|v| cur.push_vertex(m, mesh, v));
             cur.indices.extend(m.indices.iter().flatten().map(|&i| i + base));
-            continue;
-        }
-        // Triangle by triangle, each chunk with the vertices its triangles use.
-        let mut local = vec![u32::MAX; m.positions.len()];
-        let mut stamp = vec![usize::MAX; m.positions.len()];
-        for tri in &m.indices {
-            if !cur.room(3, 1, max) {
-                let next = cur.first_triangle + cur.triangles();
-                done.push(std::mem::replace(&mut cur, Gather { first_triangle: next, shaded: shared.shaded, ..Default::default() }));
-            }
-            let id = done.len();
-            for &v in tri {
-                let v = v as usize;
-                if stamp[v] != id {
-                    stamp[v] = id;
-                    local[v] = cur.vertices() as u32;
-                    cur.push_vertex(m, mesh, v);
+        } else {
+            // Triangle by triangle, each chunk with the vertices its triangles use.
+            let mut local = vec![u32::MAX; m.positions.len()];
+            let mut stamp = vec![usize::MAX; m.positions.len()];
+            mine.push(Segment { chunk: done.len(), lo: cur.triangles(), hi: cur.triangles() });
+            for tri in &m.indices {
+                if !cur.room(3, 1, max) {
+                    let next = cur.first_triangle + cur.triangles();
+                    done.push(std::mem::replace(&mut cur, Gather { first_triangle: next, shaded: shared.shaded, ..Default::default() }));
+                    mine.push(Segment { chunk: done.len(), lo: 0, hi: 0 });
                 }
-                cur.indices.push(local[v]);
+                let id = done.len();
+                for &v in tri {
+                    let v = v as usize;
+                    if stamp[v] != id {
+                        stamp[v] = id;
+                        local[v] = cur.vertices() as u32;
+                        cur.push_vertex(m, mesh, v);
+                    }
+                    cur.indices.push(local[v]);
+                }
+                mine.last_mut().expect("pushed above").hi += 1;
+            }
+        }
+        mine.retain(|s| s.lo < s.hi);
+        segments.push(mine);
+    }
+    done.push(cur);
+    // Chunks that hold no triangle are dropped (but one is kept for its group): renumber.
+    let kept: Vec<usize> = (0..done.len()).filter(|&c| done[c].triangles() > 0 || c == 0).collect();
+    let renumber = |c: usize| kept.iter().position(|&k| k == c).expect("a segment's chunk holds triangles");
+    segments.iter_mut().flatten().for_each(|s| s.chunk = renumber(s.chunk));
+    // Each chunk's segments, in drawn order, for compute passes over the drawn triangles.
+    let mut chunk_segments: Vec<Vec<GpuSegment>> = vec![Vec::new(); kept.len()];
+    let mut chunk_drawn = vec![0u32; kept.len()];
+    for (mine, &(first, count)) in segments.iter().zip(&instances) {
+        for s in mine {
+            if count > 0 {
+                let at = chunk_drawn[s.chunk];
+                chunk_segments[s.chunk].push(GpuSegment { drawn_first: at, lo: s.lo, triangles: s.hi - s.lo, first_instance: first });
+                chunk_drawn[s.chunk] = at + (s.hi - s.lo) * count;
             }
         }
     }
-    done.push(cur);
     let make = |name: &str, bytes: &[u8]| {
         let b = storage_buffer(&gpu.device, name, bytes.len() as u64, wgpu::BufferUsages::empty());
         if !bytes.is_empty() {
@@ -191,24 +275,37 @@ fn upload<'a>(
         }
         b
     };
-    let mut bytes = 0;
-    let chunks = done
+    if table.len() as u64 * std::mem::size_of::<GpuInstance>() as u64 > max {
+        return Err(OitError::OutOfMemory(format!(
+            "the {label} meshes have {} instances, whose table passes a storage binding ({max} bytes): draw fewer instances",
+            table.len()
+        )));
+    }
+    let instance_table = make("instances", bytemuck::cast_slice(&table));
+    let mut bytes = if shared.instanced { table.len() as u64 * std::mem::size_of::<GpuInstance>() as u64 } else { 0 };
+    let chunks = kept
         .iter()
-        .filter(|g| g.triangles() > 0 || done.len() == 1)
-        .map(|g| {
+        .enumerate()
+        .map(|(k, &c)| {
+            let g = &done[c];
             bytes +=
                 g.positions.len() as u64 * 4 + g.colors.len() as u64 * 16 + g.indices.len() as u64 * 4 + g.attributes.len() as u64 * 16;
+            let list = &chunk_segments[k];
+            if shared.instanced {
+                bytes += list.len() as u64 * 16;
+            }
             let info = gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("chunk"),
                 size: 16,
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
-            gpu.queue.write_buffer(&info, 0, bytemuck::cast_slice(&[g.first_triangle, g.triangles(), 0, 0]));
+            gpu.queue.write_buffer(&info, 0, bytemuck::cast_slice(&[g.first_triangle, g.triangles(), list.len() as u32, chunk_drawn[k]]));
             let pos = make("positions", bytemuck::cast_slice(&g.positions));
             let col = make("colors", bytemuck::cast_slice(&g.colors));
             let idx = make("indices", bytemuck::cast_slice(&g.indices));
             let attr = make("attributes", bytemuck::cast_slice(&g.attributes));
+            let seg = make("segments", bytemuck::cast_slice(list));
             let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(label),
                 layout: shared.layout,
@@ -220,12 +317,14 @@ fn upload<'a>(
                     wgpu::BindGroupEntry { binding: 4, resource: info.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 5, resource: attr.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 6, resource: shared.surfaces.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 7, resource: instance_table.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 8, resource: seg.as_entire_binding() },
                 ],
             });
-            Chunk { group, first_triangle: g.first_triangle, triangles: g.triangles() }
+            Chunk { group, triangles: g.triangles(), drawn: chunk_drawn[k] }
         })
         .collect();
-    Ok(Geometry { chunks, triangles: triangles as u32, meshes: ranges, bytes })
+    Ok(Geometry { chunks, triangles: drawn as u32, placements, segments, instances, instanced: shared.instanced, bytes })
 }
 
 impl GpuScene {
@@ -248,15 +347,16 @@ impl GpuScene {
         }
         let buffer = storage_buffer(&gpu.device, "surfaces", table.len() as u64 * 16, wgpu::BufferUsages::empty());
         gpu.queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&table));
-        let shared = Shared { layout, uniform, surfaces: &buffer, shaded };
-        let meshes = || scene.meshes().iter().enumerate();
-        let mut transparent = upload(gpu, "transparent", meshes().filter(|(_, m)| !m.opaque), &shared, max_binding_bytes)?;
-        let opaque = upload(gpu, "opaque", meshes().filter(|(_, m)| m.opaque), &shared, max_binding_bytes)?;
+        let instanced = scene.instanced();
+        let shared = Shared { layout, uniform, surfaces: &buffer, shaded, instanced };
+        let meshes = || scene.placed().enumerate().map(|(i, (m, list))| (i, m, list));
+        let mut transparent = upload(gpu, "transparent", meshes().filter(|(_, m, _)| !m.opaque), &shared, max_binding_bytes)?;
+        let opaque = upload(gpu, "opaque", meshes().filter(|(_, m, _)| m.opaque), &shared, max_binding_bytes)?;
         if shaded {
             transparent.bytes += table.len() as u64 * 16;
         }
         let textured = shaded && scene.meshes().iter().any(|m| m.material.texture.is_some());
-        Ok(Self { transparent, opaque, shaded, textured })
+        Ok(Self { transparent, opaque, shaded, textured, instanced, instances: scene.instance_count() as u64 })
     }
 }
 

@@ -1,7 +1,9 @@
 //! Every WGSL file parses and validates with naga (no GPU needed), and the structs shared
 //! with Rust have the sizes naga computes.
 
-use oit_core::gpu_types::{Alloc, CompactNode, CoverageNode, FrameUniform, GpuLight, PallBlock, PoolNode, PrimNode, PrimShading};
+use oit_core::gpu_types::{
+    Alloc, CompactNode, CoverageNode, FrameUniform, GpuInstance, GpuLight, GpuSegment, PallBlock, PoolNode, PrimNode, PrimShading,
+};
 use oit_core::shader::{compose, entry_files, variant_consts, Const, SceneVariant, DEFAULT_CONSTS, VALIDATION_VARIANTS};
 
 fn validate(path: &str) -> naga::Module {
@@ -67,6 +69,7 @@ fn layout_sizes() {
     assert_eq!(struct_size(&m, "Light") as usize, std::mem::size_of::<GpuLight>());
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<PoolNode>());
     assert_eq!(struct_size(&m, "Alloc") as usize, std::mem::size_of::<Alloc>());
+    assert_eq!(struct_size(&m, "Instance") as usize, std::mem::size_of::<GpuInstance>());
     let m = validate("adaptive.wgsl");
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<PrimNode>());
     let m = validate("compact_abuffer.wgsl");
@@ -76,6 +79,7 @@ fn layout_sizes() {
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<CoverageNode>());
     let m = validate("pall.wgsl");
     assert_eq!(struct_size(&m, "Block") as usize, std::mem::size_of::<PallBlock>());
+    assert_eq!(struct_size(&m, "Segment") as usize, std::mem::size_of::<GpuSegment>());
 }
 
 /// The value naga evaluates for the global constant `name` of `module`.

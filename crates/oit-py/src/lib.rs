@@ -43,10 +43,10 @@ fn rows<T: Copy + numpy::Element, const N: usize>(a: &PyReadonlyArray2<'_, T>, n
     Ok(flat.chunks_exact(N).map(|c| c.try_into().expect("chunk of N")).collect())
 }
 
-fn matrix(m: &PyReadonlyArray2<'_, f64>) -> PyResult<[[f64; 4]; 4]> {
+fn matrix(m: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<[[f64; 4]; 4]> {
     let a = m.as_array();
     if a.shape() != [4, 4] {
-        return Err(PyValueError::new_err(format!("camera matrix must be 4 x 4, got {:?}", a.shape())));
+        return Err(PyValueError::new_err(format!("{name} must be 4 x 4, got {:?}", a.shape())));
     }
     let mut out = [[0.0; 4]; 4];
     for r in 0..4 {
@@ -55,6 +55,31 @@ fn matrix(m: &PyReadonlyArray2<'_, f64>) -> PyResult<[[f64; 4]; 4]> {
         }
     }
     Ok(out)
+}
+
+/// Instances from transforms (n, 4, 4) and optional color factors (n, 4).
+fn instances(transforms: &PyReadonlyArray3<'_, f64>, colors: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<oit_core::Instance>> {
+    let t = transforms.as_array();
+    let n = t.shape()[0];
+    if t.shape()[1..] != [4, 4] {
+        return Err(PyValueError::new_err(format!("transforms must have shape (n, 4, 4), got {:?}", t.shape())));
+    }
+    let colors: Vec<[f32; 4]> = match colors {
+        Some(c) => rows(c, "instance colors")?,
+        None => vec![[1.0; 4]; n],
+    };
+    if colors.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "colors has {} rows but transforms has {n}: pass one RGBA factor an instance",
+            colors.len()
+        )));
+    }
+    (0..n)
+        .map(|i| {
+            let rows: [[f64; 4]; 4] = std::array::from_fn(|r| std::array::from_fn(|c| t[[i, r, c]]));
+            oit_core::Instance::from_rows(rows, colors[i]).map_err(|e| PyValueError::new_err(format!("instance {i}: {e}")))
+        })
+        .collect()
 }
 
 /// Meshes in submission order (validated on the way in).
@@ -73,8 +98,9 @@ impl Scene {
     /// positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
     /// surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
     /// shading "unlit", "flat" or "smooth".
+    /// `transform` (4, 4) float64 places it (else it is drawn where its vertices are).
     #[pyo3(signature = (positions, indices, colors, opaque, normals=None, uvs=None, texture=None, shading="unlit",
-                        specular=0.0, shininess=32.0, opacity=1.0, two_sided=true, cull_back_faces=false))]
+                        specular=0.0, shininess=32.0, opacity=1.0, two_sided=true, cull_back_faces=false, transform=None))]
     #[allow(clippy::too_many_arguments)]
     fn add_mesh(
         &mut self,
@@ -91,7 +117,12 @@ impl Scene {
         opacity: f32,
         two_sided: bool,
         cull_back_faces: bool,
+        transform: Option<PyReadonlyArray2<'_, f64>>,
     ) -> PyResult<usize> {
+        let placement = match transform {
+            Some(t) => oit_core::Instance::from_rows(matrix(&t, "transform")?, [1.0; 4]).map_err(Error::from)?,
+            None => oit_core::Instance::IDENTITY,
+        };
         let mesh = oit_core::Mesh::new(rows(&positions, "positions")?, rows(&indices, "indices")?, rows(&colors, "colors")?, opaque)
             .map_err(Error::from)?;
         let texture = match texture {
@@ -119,7 +150,46 @@ impl Scene {
         let normals = normals.map(|n| rows(&n, "normals")).transpose()?;
         let uvs = uvs.map(|u| rows(&u, "uvs")).transpose()?;
         let mesh = mesh.with_surface(normals, uvs, material).map_err(Error::from)?;
-        Ok(self.inner.add_mesh(mesh))
+        Ok(self.inner.add_placed(mesh, vec![placement]))
+    }
+
+    /// Appends instances to mesh `mesh`: transforms (n, 4, 4) float64, colors (n, 4) float32
+    /// factors or None; returns the first new instance's index.
+    #[pyo3(signature = (mesh, transforms, colors=None))]
+    fn add_instances(
+        &mut self,
+        mesh: usize,
+        transforms: PyReadonlyArray3<'_, f64>,
+        colors: Option<PyReadonlyArray2<'_, f32>>,
+    ) -> PyResult<usize> {
+        let list = instances(&transforms, colors.as_ref())?;
+        Ok(self.inner.add_instances(self.mesh_index(mesh)?, &list).map_err(Error::from)?)
+    }
+
+    /// Replaces the instances of mesh `mesh` (none: it stays uploaded but is not drawn).
+    #[pyo3(signature = (mesh, transforms, colors=None))]
+    fn set_instances(
+        &mut self,
+        mesh: usize,
+        transforms: PyReadonlyArray3<'_, f64>,
+        colors: Option<PyReadonlyArray2<'_, f32>>,
+    ) -> PyResult<()> {
+        let list = instances(&transforms, colors.as_ref())?;
+        Ok(self.inner.set_instances(self.mesh_index(mesh)?, list).map_err(Error::from)?)
+    }
+
+    /// Transforms (n, 4, 4) row-major and color factors (n, 4) of mesh `mesh`'s instances.
+    fn instances<'py>(
+        &self,
+        py: Python<'py>,
+        mesh: usize,
+    ) -> PyResult<(Bound<'py, numpy::PyArray3<f64>>, Bound<'py, numpy::PyArray2<f32>>)> {
+        let list = self.inner.instances(self.mesh_index(mesh)?);
+        let t: Vec<f64> = list.iter().flat_map(|i| i.transform.transpose().to_cols_array()).collect();
+        let c: Vec<f32> = list.iter().flat_map(|i| i.color).collect();
+        let t = numpy::ndarray::Array3::from_shape_vec((list.len(), 4, 4), t).expect("n x 4 x 4");
+        let c = numpy::ndarray::Array2::from_shape_vec((list.len(), 4), c).expect("n x 4");
+        Ok((t.into_pyarray(py), c.into_pyarray(py)))
     }
 
     /// A directional light travelling along `direction` (world space); returns its index.
@@ -165,9 +235,21 @@ impl Scene {
         self.inner.meshes().len()
     }
 
+    /// Triangles drawn, instances included.
     #[getter]
     fn triangle_count(&self) -> usize {
-        self.inner.meshes().iter().map(|m| m.triangle_count()).sum()
+        self.inner.triangle_count()
+    }
+
+    /// Triangles uploaded: each mesh's once.
+    #[getter]
+    fn unique_triangle_count(&self) -> usize {
+        self.inner.unique_triangle_count()
+    }
+
+    #[getter]
+    fn instance_count(&self) -> usize {
+        self.inner.instance_count()
     }
 
     /// Per mesh: what its material and colors are (tests and `Scene.materials`).
@@ -175,13 +257,18 @@ impl Scene {
         load::mesh_materials(py, &self.inner)
     }
 
-    /// The smallest and largest corner of every vertex's box; None for an empty scene.
-    fn bounds(&self) -> Option<([f32; 3], [f32; 3])> {
-        let mut points = self.inner.meshes().iter().flat_map(|m| m.positions.iter().copied());
-        let first = points.next()?;
-        Some(
-            points.fold((first, first), |(lo, hi), p| (std::array::from_fn(|i| lo[i].min(p[i])), std::array::from_fn(|i| hi[i].max(p[i])))),
-        )
+    /// The smallest and largest corner of every drawn vertex's box (instances placed); None
+    /// when nothing is drawn.
+    fn bounds(&self) -> Option<([f64; 3], [f64; 3])> {
+        self.inner.bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array()))
+    }
+
+    fn mesh_index(&self, mesh: usize) -> PyResult<usize> {
+        let count = self.inner.meshes().len();
+        if mesh >= count {
+            return Err(PyValueError::new_err(format!("mesh index {mesh} is out of range: the scene has {count} meshes")));
+        }
+        Ok(mesh)
     }
 
     /// (triangles, vertices, opaque) per mesh.
@@ -337,7 +424,7 @@ impl Renderer {
             "coverage" => oit_core::AntialiasMode::Coverage,
             other => return Err(PyValueError::new_err(format!("antialias_mode must be 'frames' or 'coverage', got '{other}'"))),
         };
-        let camera = oit_core::Camera::from_rows(matrix(&view_proj)?).map_err(Error::from)?;
+        let camera = oit_core::Camera::from_rows(matrix(&view_proj, "camera matrix")?).map_err(Error::from)?;
         let plist = param_list(&params)?;
         let inner_scene = &scene.inner;
         let bg = [background.0, background.1, background.2];
@@ -492,7 +579,7 @@ fn reference<'py>(
     if width <= 0 || height <= 0 || width > 1 << 16 || height > 1 << 16 {
         return Err(PyValueError::new_err(format!("width and height must be in [1, 65536], got {width} x {height}")));
     }
-    let camera = oit_core::Camera::from_rows(matrix(&view_proj)?).map_err(Error::from)?;
+    let camera = oit_core::Camera::from_rows(matrix(&view_proj, "camera matrix")?).map_err(Error::from)?;
     let inner_scene = &scene.inner;
     let bg = [background.0, background.1, background.2];
     let r = py

@@ -104,12 +104,12 @@ impl Method for Blend {
         let target = wgpu::ColorTargetState { format: COLOR_FORMAT, blend: Some(self.kind.blend()), write_mask: wgpu::ColorWrites::ALL };
         let pipeline = cx.draw_pipeline(spec(PIPELINES, self.kind.entry()), &[], vec![Some(target)], pipeline::depth_test_only());
         let geo = &cx.scene.transparent;
-        let mut order: Vec<usize> = (0..geo.meshes.len()).collect();
+        let mut order: Vec<usize> = (0..geo.placements.len()).collect();
         if self.kind == Kind::Sorted {
             let vp = cx.camera.matrix_f32();
-            // Far to near: larger NDC depth first; meshes behind the eye (w <= 0) go first.
+            // Far to near: larger NDC depth first; instances behind the eye (w <= 0) go first.
             let key = |i: usize| {
-                let c = vp * geo.meshes[i].centroid.extend(1.0);
+                let c = vp * geo.placements[i].centroid.extend(1.0);
                 if c.w > 0.0 {
                     c.z / c.w
                 } else {
@@ -123,9 +123,10 @@ impl Method for Blend {
         {
             let mut pass = passes::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.tile, cx.timer.render_pass("blend"));
             pass.set_pipeline(&pipeline);
-            for i in order {
-                let m = geo.meshes[i];
-                geo.draw_range(&mut pass, m.first_triangle, m.triangles);
+            if self.kind == Kind::Sorted {
+                order.iter().for_each(|&i| geo.draw_placement(&mut pass, &geo.placements[i]));
+            } else {
+                geo.draw_all(&mut pass);
             }
         }
         cx.gpu.queue.submit([enc.finish()]);

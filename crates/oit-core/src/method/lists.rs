@@ -378,10 +378,10 @@ impl ListMethod {
                 pass.set_pipeline(allocate);
                 pass.set_bind_group(1, targets_group, &[]);
                 pass.set_bind_group(2, group, &[]);
-                // One invocation a triangle, chunk after chunk (shaders/common/setup.wgsl).
+                // One invocation a drawn triangle, chunk after chunk (shaders/common/setup.wgsl).
                 for chunk in &cx.scene.transparent.chunks {
                     pass.set_bind_group(0, &chunk.group, &[]);
-                    let groups = chunk.triangles.div_ceil(64);
+                    let groups = chunk.drawn.div_ceil(64);
                     pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
                 }
             }

@@ -42,9 +42,10 @@ enum CensusKind {
 
 /// The census pipeline of `kind`. The census reads only positions: its variant is the unlit
 /// one, or for a scene with a material table (`shaded`) the shaded one without lights, whose
-/// vertex shader drops the back faces a material culls (common/scene.wgsl).
-fn census_pipeline(gpu: &GpuContext, kind: CensusKind, shaded: bool) -> wgpu::RenderPipeline {
-    let variant = SceneVariant { shaded, ..Default::default() }.consts();
+/// vertex shader drops the back faces a material culls (common/scene.wgsl); instanced where the
+/// scene is.
+fn census_pipeline(gpu: &GpuContext, kind: CensusKind, scene: &GpuScene) -> wgpu::RenderPipeline {
+    let variant = SceneVariant { shaded: scene.shaded, instanced: scene.instanced, ..Default::default() }.consts();
     let add = wgpu::BlendComponent {
         src_factor: wgpu::BlendFactor::One,
         dst_factor: wgpu::BlendFactor::One,
@@ -183,6 +184,7 @@ impl Renderer {
             antialias_mode: AntialiasMode::Frames,
             tiles: tiles.len() as u32,
             geometry_chunks: gpu_scene.transparent.chunks.len() as u32,
+            instances: gpu_scene.instances,
             peak_memory_bytes: report.memory_bytes + target_bytes,
             ..Default::default()
         };
@@ -454,7 +456,7 @@ impl Renderer {
                     };
                     let mut pass = passes::capture_into(&mut enc, "census", &t.depth, &[Some(count)], None);
                     tile.scissor(&mut pass);
-                    pass.set_pipeline(&census_pipeline(&self.gpu, CensusKind::Blend, scene.shaded));
+                    pass.set_pipeline(&census_pipeline(&self.gpu, CensusKind::Blend, scene));
                     scene.transparent.draw_all(&mut pass);
                 }
                 kind => {
@@ -466,7 +468,7 @@ impl Renderer {
                     {
                         let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
                         tile.scissor(&mut pass);
-                        pass.set_pipeline(&census_pipeline(&self.gpu, kind, scene.shaded));
+                        pass.set_pipeline(&census_pipeline(&self.gpu, kind, scene));
                         pass.set_bind_group(1, group, &[]);
                         pass.set_bind_group(2, &t.counts_group, &[]);
                         scene.transparent.draw_all(&mut pass);
