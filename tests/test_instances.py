@@ -209,3 +209,27 @@ def test_bad_instances_are_refused(transforms, colors, error, match):
     with pytest.raises(ValueError, match=r"shape \(4, 4\)"):
         scene.add_mesh(pos, idx, col, transform=np.eye(3))
     assert scene.instance_count == 1
+
+
+def test_dragons_upload_one_dragon_and_render_as_its_copies(renderer):
+    # The 22 dragons are one mesh and 22 translations. Copies translated in float32, as the
+    # vertex shader translates (1 * x + 0 * y + 0 * z + t rounds once), cover the same pixels;
+    # the shading normal is renormalized under an instance (a unit float32 vector moves by an
+    # ulp at most), so lit pixels may differ by ~1e-7.
+    from oit import scenes
+
+    built = scenes.dragons(max_triangles=600)
+    assert built.scene.unique_triangle_count * 22 == built.scene.triangle_count
+    (dragon,) = built.meshes
+    copies = []
+    for t, f in zip(dragon.transforms, dragon.instance_colors):
+        pos = dragon.positions + t[:3, 3].astype(np.float32)
+        copies.append(scenes.MeshArrays(pos, dragon.indices, dragon.colors * f, False, dict(dragon.surface)))
+    flat = scenes.from_meshes(copies, built.camera, lights=built.lights, ambient=built.ambient)
+    r = renderer(64, 64)
+    for method in EXACT:
+        a = r.render(built.scene, built.camera, method, census=True)
+        b = r.render(flat.scene, flat.camera, method, census=True)
+        np.testing.assert_array_equal(a.depth_complexity, b.depth_complexity)
+        assert np.abs(a.image - b.image).max() <= 1e-5, method
+        assert a.stats["scene_bytes"] < b.stats["scene_bytes"] / 10

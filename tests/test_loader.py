@@ -87,7 +87,9 @@ def test_alpha_makes_every_mesh_transparent(tmp_path):
 def test_textured_double_sided_multi_node_gltf(tmp_path, renderer):
     path = textured_multi_node_glb(tmp_path / "quads.glb")
     scene = oit.Scene.from_file(path)
-    assert scene.mesh_names == ["quad", "quad"] and scene.triangle_count == 4
+    # Two nodes share the quad's mesh: uploaded once, drawn as two instances.
+    assert scene.mesh_names == ["quad"] and scene.triangle_count == 4 and scene.unique_triangle_count == 2
+    assert scene.instance_count == 2
     for m in scene.materials:
         assert m["textured"] and m["has_uvs"] and m["two_sided"] and not m["cull_back_faces"] and not m["opaque"]
     lo, hi = scene.bounds

@@ -35,10 +35,13 @@ def test_scene_renders_and_its_arrays_are_the_scene(frames, name):
     built, frame = frames[name]
     assert frame.image.shape == (SIZE, SIZE, 4) and np.isfinite(frame.image).all()
     assert frame.stats["fragments"] > 0
-    # The meshes as arrays are exactly what the scene holds, so a peer can draw the same input.
-    assert sum(len(m.indices) for m in built.meshes) == built.scene.triangle_count == built.meta["triangles"]
+    # The meshes as arrays are exactly what the scene holds, so a peer can draw the same input:
+    # uploaded once each, drawn once per instance.
+    assert sum(len(m.indices) for m in built.drawn_meshes()) == built.scene.triangle_count == built.meta["triangles"]
+    assert sum(len(m.indices) for m in built.meshes) == built.scene.unique_triangle_count
     assert built.scene.mesh_count == len(built.meshes)
-    for m in built.meshes:
+    assert built.scene.instance_count == len(built.drawn_meshes())
+    for m in built.drawn_meshes():
         assert m.colors.shape == (len(m.positions), 4) and m.colors.min() >= 0 and m.colors.max() <= 1
         assert m.indices.max() < len(m.positions)
 
@@ -82,8 +85,10 @@ def test_glass_defeats_sorting(frames, renderer):
 def test_dragons_stand_in(frames):
     built, _ = frames["dragons"]
     assert built.meta["mesh"] == "stand-in blob"
-    assert [m.colors[0, 3] for m in built.meshes] == pytest.approx(scenes.DRAGON_ALPHAS)
-    assert all(len(m.indices) <= 8000 for m in built.meshes)
+    # One dragon uploaded, 22 instances with their alphas.
+    assert len(built.meshes) == 1 and built.scene.instance_count == 22
+    assert [m.colors[0, 3] for m in built.drawn_meshes()] == pytest.approx(scenes.DRAGON_ALPHAS)
+    assert len(built.meshes[0].indices) <= 8000
     assert max_depth(frames, "dragons") >= 20
 
 
@@ -91,8 +96,8 @@ def test_dragons_from_a_file(tmp_path):
     path = tmp_path / "lump.obj"
     trimesh.Trimesh(*geometry.uv_sphere(rings=8, segments=12)).export(path)
     built = scenes.dragons(path=path, max_triangles=100)
-    assert built.meta["mesh"] == "lump.obj" and len(built.meshes) == 22
-    assert all(len(m.indices) <= 100 for m in built.meshes)
+    assert built.meta["mesh"] == "lump.obj" and len(built.drawn_meshes()) == 22
+    assert len(built.meshes[0].indices) <= 100
     with pytest.raises(ValueError, match="no such mesh file"):
         scenes.dragons(path=tmp_path / "missing.obj")
 

@@ -200,7 +200,7 @@ class Scene:
     def from_file(cls, path: str | os.PathLike, alpha: float | None = None, *, shading: str = "smooth",
                   specular: float = 0.25) -> Scene:
         """A scene from a mesh file, as the file has it (docs/loading.md): OBJ with its MTL
-        (Kd, d or Tr, map_Kd, map_d), glTF/GLB (the node tree flattened to world space, every
+        (Kd, d or Tr, map_Kd, map_d), glTF/GLB (a mesh shared by nodes drawn as instances, every
         primitive, baseColorFactor and baseColorTexture, alphaMode and alphaCutoff, doubleSided:
         false culls back faces), PLY (vertex colors with alpha) or STL. `alpha` makes every mesh
         transparent at it; `shading` ("smooth" with the file's normals, "flat" or "unlit") and
@@ -218,7 +218,8 @@ class Scene:
         baseColorFactor is linear, as glTF has it); texture visuals bring their UVs and image
         (PBR baseColorTexture or the material image). glTF alphaMode is honoured: OPAQUE gives
         an opaque mesh, MASK keeps what passes alphaCutoff (alpha 0 or 1, per texel), BLEND
-        and meshes without one are transparent. `color` (RGB or RGBA) and `alpha` override
+        and meshes without one are transparent. A Scene's geometry shared by nodes is uploaded once
+        and drawn as instances under the nodes' transforms. `color` (RGB or RGBA) and `alpha` override
         the colors; `shading` ("smooth" with the mesh's vertex normals by default, "flat" or
         "unlit"), `specular`, `shininess` and `two_sided` apply to every mesh."""
         scene = cls()
@@ -233,8 +234,16 @@ class Scene:
 
         if shading not in SHADINGS:
             raise ValueError(f"shading must be one of {SHADINGS}, got {shading!r}")
-        meshes = obj.dump() if isinstance(obj, trimesh.Scene) else [obj]
-        for m in meshes:
+        # A trimesh Scene's geometry is added once and drawn under each node's transform.
+        placements: dict[str, list[np.ndarray]] = {}
+        if isinstance(obj, trimesh.Scene):
+            for node in obj.graph.nodes_geometry:
+                transform, name = obj.graph[node]
+                placements.setdefault(name, []).append(np.asarray(transform, dtype=np.float64))
+            meshes = [(obj.geometry[name], np.stack(ts)) for name, ts in placements.items()]
+        else:
+            meshes = [(obj, None)]
+        for m, transforms in meshes:
             if not isinstance(m, trimesh.Trimesh):
                 continue
             t = trimesh_arrays(m)
@@ -248,9 +257,11 @@ class Scene:
                 if not 0.0 <= float(alpha) <= 1.0:
                     raise ValueError(f"alpha must be in [0, 1], got {alpha}")
                 colors[:, 3] = float(alpha)
-            self.add_mesh(t.positions, t.faces, colors, opaque=opaque or t.opaque,
-                          normals=t.normals if shading == "smooth" else None, uvs=t.uvs, texture=t.texture,
-                          shading=shading, specular=specular, shininess=shininess, two_sided=two_sided)
+            index = self.add_mesh(t.positions, t.faces, colors, opaque=opaque or t.opaque,
+                                  normals=t.normals if shading == "smooth" else None, uvs=t.uvs, texture=t.texture,
+                                  shading=shading, specular=specular, shininess=shininess, two_sided=two_sided)
+            if transforms is not None and not (len(transforms) == 1 and np.array_equal(transforms[0], np.eye(4))):
+                self.set_instances(index, transforms)
 
 
 def _transforms(value: Any, name: str) -> np.ndarray:

@@ -125,7 +125,7 @@ class PygfxRenderer:
             scene = gfx.Scene()
             srgb = linear_to_srgb(np.asarray(background, dtype=np.float64))
             scene.add(gfx.Background.from_color(gfx.Color(*srgb)))
-            for m in built.meshes:
+            for m in built.drawn_meshes():
                 center = m.positions.astype(np.float64).mean(0)
                 alpha_mode = "solid" if m.opaque else mode
                 normals = m.surface.get("normals")
@@ -143,7 +143,7 @@ class PygfxRenderer:
                 mesh = gfx.Mesh(geometry, material)
                 mesh.local.position = center
                 scene.add(mesh)
-            if any(m.surface.get("normals") is not None for m in built.meshes):
+            if any(m.surface.get("normals") is not None for m in built.drawn_meshes()):
                 for direction, color, intensity in built.lights:
                     light = gfx.DirectionalLight(color=gfx.Color(*color), intensity=intensity)
                     light.local.position = -np.asarray(direction, dtype=np.float64)  # shines towards the origin
@@ -308,7 +308,7 @@ class VtkRenderer:
             renderer.SetMaximumNumberOfPeels(VTK_MAX_PEELS)
             renderer.SetOcclusionRatio(0.0)
             self._renderers[mode] = renderer
-        for mesh in built.meshes:
+        for mesh in built.drawn_meshes():
             rgba8 = vtk_colors(mesh)
             self._translucent |= bool((rgba8[:, 3] < 255).any())
             mapper = vtkPolyDataMapper()

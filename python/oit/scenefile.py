@@ -75,6 +75,10 @@ def save_scene(scene: SceneLike, path: str | os.PathLike, camera: Camera | LookA
         meshes = list(scene.meshes)
     else:
         meshes = list(scene)
+    # The file has no instances: a mesh drawn more than once is written once per instance.
+    names = [(names[i] if names else f"mesh {i}") + (f" #{j}" if m.transforms is not None and j else "")
+             for i, m in enumerate(meshes) for j in range(len(m.placed()))]
+    meshes = [p for m in meshes for p in m.placed()]
     lights = list(lights or [])
     ambient = tuple(float(a) for a in (ambient if ambient is not None else (0.0, 0.0, 0.0)))
     version = 2 if lights or any(ambient) or any(m.surface for m in meshes) else 1
@@ -96,7 +100,7 @@ def save_scene(scene: SceneLike, path: str | os.PathLike, camera: Camera | LookA
         idx = np.ascontiguousarray(m.indices, dtype="<u4").reshape(-1, 3)
         if len(col) != len(pos):
             raise ValueError(f"mesh {i}: {len(col)} colors for {len(pos)} vertices")
-        name = (names[i] if names else f"mesh {i}").encode()
+        name = names[i].encode()
         flags = int(bool(m.opaque)) | (2 if m.surface else 0)
         out += [struct.pack("<2I", flags, len(name)), name, struct.pack("<2I", len(pos), len(idx)),
                 pos.tobytes(), col.tobytes(), idx.tobytes()]

@@ -33,6 +33,29 @@ class MeshArrays:
     opaque: bool = False
     # The surface, as Scene.add_mesh's keywords (normals, shading, specular, ...); empty: unlit.
     surface: dict[str, Any] = field(default_factory=dict)
+    # Instances (Scene.set_instances): (n, 4, 4) transforms and (n, 4) color factors, or None
+    # for a mesh drawn once where its vertices are.
+    transforms: np.ndarray | None = None
+    instance_colors: np.ndarray | None = None
+
+    def placed(self) -> list[MeshArrays]:
+        """The mesh as drawn: one copy per instance, positions and normals carried by its
+        transform (normals by the inverse transpose) and colors times its factor, in float64
+        then float32; itself when it has no instances. For peers and files that take plain arrays."""
+        if self.transforms is None:
+            return [self]
+        factors = np.ones((len(self.transforms), 4)) if self.instance_colors is None else self.instance_colors
+        out = []
+        for t, f in zip(self.transforms, factors):
+            linear = t[:3, :3]
+            surface = dict(self.surface)
+            if surface.get("normals") is not None:
+                n = np.asarray(surface["normals"], dtype=np.float64) @ np.linalg.inv(linear)
+                surface["normals"] = (n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)).astype(np.float32)
+            pos = (self.positions.astype(np.float64) @ linear.T + t[:3, 3]).astype(np.float32)
+            idx = self.indices if np.linalg.det(linear) > 0 else np.ascontiguousarray(self.indices[:, ::-1])
+            out.append(MeshArrays(pos, idx, (self.colors * np.float32(f)).astype(np.float32), self.opaque, surface))
+        return out
 
 
 @dataclass
@@ -50,6 +73,10 @@ class BuiltScene:
         yield self.scene
         yield self.camera
 
+    def drawn_meshes(self) -> list[MeshArrays]:
+        """Every mesh as drawn, each instance a copy (`MeshArrays.placed`)."""
+        return [p for m in self.meshes for p in m.placed()]
+
 
 def from_meshes(meshes: Sequence[MeshArrays], camera: Camera, size: tuple[int, int] = (512, 512),
                 meta: dict[str, Any] | None = None, lights: Sequence[tuple[Any, Any, float]] = (),
@@ -58,7 +85,9 @@ def from_meshes(meshes: Sequence[MeshArrays], camera: Camera, size: tuple[int, i
     intensity) each; none: the headlight) and `ambient`."""
     scene = Scene()
     for m in meshes:
-        scene.add_mesh(m.positions, m.indices, m.colors, opaque=m.opaque, **m.surface)
+        index = scene.add_mesh(m.positions, m.indices, m.colors, opaque=m.opaque, **m.surface)
+        if m.transforms is not None:
+            scene.set_instances(index, m.transforms, m.instance_colors)
     lights = [(tuple(map(float, d)), tuple(map(float, c)), float(i)) for d, c, i in lights]
     for d, c, i in lights:
         scene.add_light(d, c, i)
@@ -318,20 +347,26 @@ def dragons(path: str | os.PathLike | None = "default", max_triangles: int = 800
     """The hybrid paper's 22 aligned dragons with its opacities (DRAGON_ALPHAS), one after
     another along the view, each lit by one light (two-sided, with a specular highlight). `path`:
     the mesh (anything trimesh loads); "default" uses dragon-100k.obj from shared_data_dir()
-    when present, and None or its absence gives a built-in non-convex stand-in. Each instance is
-    decimated to at most `max_triangles` (22 full 100k-triangle dragons are slow on a software
-    rasterizer). `meta["mesh"]` says which mesh was used."""
+    when present, and None or its absence gives a built-in non-convex stand-in. One dragon is
+    uploaded, decimated to at most `max_triangles` (22 full 100k-triangle dragons are slow on a
+    software rasterizer), and drawn as 22 instances, each with its hue and alpha as a color
+    factor (`built.drawn_meshes()` gives the copies). `meta["mesh"]` says which mesh was used."""
     if isinstance(path, str) and path == "default":
         path = default_dragon_path()
     p, idx, source = _dragon_mesh(path, max_triangles)
     normals = geometry.vertex_normals(p, idx).astype(np.float32)
-    meshes = []
+    # One dragon, drawn 22 times: each instance offset along the view, with its hue and alpha.
+    n = len(DRAGON_ALPHAS)
+    transforms = np.tile(np.eye(4), (n, 1, 1))
+    factors = np.ones((n, 4), dtype=np.float32)
     for i, a in enumerate(DRAGON_ALPHAS):
-        hue = i / len(DRAGON_ALPHAS)
+        hue = i / n
         base = 0.5 + 0.4 * np.cos(2 * np.pi * (hue + np.array([0.0, 1 / 3, 2 / 3])))
-        colors = np.concatenate([np.tile(np.clip(base, 0.0, 1.0), (len(p), 1)), np.full((len(p), 1), a)], 1)
-        offset = np.array([0.06 * np.sin(i * 1.3), 0.03 * np.cos(i * 0.7), -0.3 * i])
-        meshes.append(_mesh(p + offset, idx, colors, normals=normals, specular=0.35, shininess=24.0))
+        factors[i] = (*np.clip(base, 0.0, 1.0), a)
+        transforms[i, :3, 3] = (0.06 * np.sin(i * 1.3), 0.03 * np.cos(i * 0.7), -0.3 * i)
+    dragon = _mesh(p, idx, np.ones(4), normals=normals, specular=0.35, shininess=24.0)
+    dragon.transforms, dragon.instance_colors = transforms, factors
+    meshes = [dragon]
     camera = Camera.look_at(eye=(0.6, 0.5, 2.2), target=(-0.45, -0.3, -2.5), fov_y=36.0, near=1.2, far=10.0)
     return from_meshes(meshes, camera, (512, 512), {"mesh": source, "instances": len(DRAGON_ALPHAS)},
                        lights=[((-0.4, -0.8, -0.45), (1.0, 1.0, 1.0), 0.65)], ambient=(0.35, 0.35, 0.35))

@@ -275,14 +275,28 @@ fn upload<'a>(
         }
         b
     };
-    if table.len() as u64 * std::mem::size_of::<GpuInstance>() as u64 > max {
+    // Without instances the passes read neither the instance table nor the segments.
+    if !shared.instanced {
+        table.clear();
+        chunk_segments.iter_mut().for_each(Vec::clear);
+    }
+    let table_bytes = table.len() as u64 * std::mem::size_of::<GpuInstance>() as u64;
+    if table_bytes > max {
         return Err(OitError::OutOfMemory(format!(
-            "the {label} meshes have {} instances, whose table passes a storage binding ({max} bytes): draw fewer instances",
+            "the {label} meshes have {} instances, whose table ({table_bytes} bytes) passes a storage binding ({max} bytes): \
+             draw fewer instances",
             table.len()
         )));
     }
+    if let Some(list) = chunk_segments.iter().find(|l| l.len() as u64 * 16 > max) {
+        return Err(OitError::OutOfMemory(format!(
+            "a chunk of the {label} meshes holds {} instanced meshes, whose segment table passes a storage binding \
+             ({max} bytes): merge meshes",
+            list.len()
+        )));
+    }
     let instance_table = make("instances", bytemuck::cast_slice(&table));
-    let mut bytes = if shared.instanced { table.len() as u64 * std::mem::size_of::<GpuInstance>() as u64 } else { 0 };
+    let mut bytes = table_bytes;
     let chunks = kept
         .iter()
         .enumerate()
@@ -291,9 +305,7 @@ fn upload<'a>(
             bytes +=
                 g.positions.len() as u64 * 4 + g.colors.len() as u64 * 16 + g.indices.len() as u64 * 4 + g.attributes.len() as u64 * 16;
             let list = &chunk_segments[k];
-            if shared.instanced {
-                bytes += list.len() as u64 * 16;
-            }
+            bytes += list.len() as u64 * 16;
             let info = gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("chunk"),
                 size: 16,

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use eframe::egui::{self, Color32, ColorImage, Rect, TextureHandle, TextureId, TextureOptions};
-use oit_core::{AntialiasMode, Camera, Frame, GpuContext, Mesh, ParamValue, Renderer, Scene};
+use oit_core::{AntialiasMode, Camera, Frame, GpuContext, ParamValue, Renderer, Scene};
 
 use crate::heatmap::{self, ErrorMap};
 use crate::native::Native;
@@ -106,7 +106,7 @@ impl ViewerApp {
         let camera = ViewCamera::new(data.camera.as_ref(), &data.meshes);
         let mut settings = settings;
         settings.ambient = data.ambient;
-        let meshes = data.meshes.into_iter().map(|m| MeshControl::new(m.name, m.mesh)).collect();
+        let meshes = data.meshes.into_iter().map(|m| MeshControl::new(m.name, m.mesh, m.instances)).collect();
         Self {
             settings,
             meshes,
@@ -143,7 +143,7 @@ impl ViewerApp {
     }
 
     pub fn triangle_count(&self) -> usize {
-        self.scene.meshes().iter().map(Mesh::triangle_count).sum()
+        self.scene.triangle_count()
     }
 
     /// The exact frame: the method's own when the method is the exact one.
@@ -165,7 +165,7 @@ impl ViewerApp {
             if !self.settings.lit {
                 mesh.material = Default::default();
             }
-            scene.add_mesh(mesh);
+            scene.add_placed(mesh, m.instances.clone());
         }
         if !self.settings.headlight {
             for l in &self.lights {

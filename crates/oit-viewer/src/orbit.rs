@@ -33,14 +33,15 @@ pub struct ViewCamera {
     home: (Orbit, Option<DMat4>),
 }
 
-/// Center and radius of the bounding sphere of the meshes' bounding box.
+/// Center and radius of the bounding sphere of the meshes' bounding box (instances placed).
 pub fn bounds(meshes: &[NamedMesh]) -> (DVec3, f64) {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for p in meshes.iter().flat_map(|m| &m.mesh.positions) {
-        let v = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-        lo = lo.min(v);
-        hi = hi.max(v);
+    for m in meshes {
+        for v in m.instances.iter().flat_map(|i| m.mesh.positions.iter().map(|p| i.apply(*p))) {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
     }
     if !lo.is_finite() {
         return (DVec3::ZERO, 1.0);

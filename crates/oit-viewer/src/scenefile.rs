@@ -111,7 +111,7 @@ pub fn parse(data: &[u8]) -> Result<SceneData, String> {
         if flags & 2 != 0 {
             mesh = read_surface(&mut r, mesh, n).map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
         }
-        meshes.push(NamedMesh { name: if name.is_empty() { format!("mesh {i}") } else { name }, mesh });
+        meshes.push(NamedMesh::new(if name.is_empty() { format!("mesh {i}") } else { name }, mesh));
     }
     let (mut lights, mut ambient) = (Vec::new(), [0.0; 3]);
     if version == 2 {
@@ -234,7 +234,7 @@ mod tests {
     fn triangle(opaque: bool) -> NamedMesh {
         let mesh =
             Mesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]], vec![[0.5, 0.25, 1.0, 0.4]], opaque).unwrap();
-        NamedMesh { name: "tri".into(), mesh }
+        NamedMesh::new("tri".into(), mesh)
     }
 
     #[test]

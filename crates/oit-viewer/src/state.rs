@@ -104,6 +104,8 @@ impl Settings {
 pub struct MeshControl {
     pub name: String,
     pub original: Mesh,
+    /// Where the file draws it (one identity instance unless a glTF mesh is shared by nodes).
+    pub instances: Vec<oit_core::Instance>,
     pub visible: bool,
     /// The mesh's alpha when all its vertices share one, else a factor on its alphas.
     pub alpha: f32,
@@ -111,10 +113,11 @@ pub struct MeshControl {
 }
 
 impl MeshControl {
-    pub fn new(name: String, mesh: Mesh) -> Self {
+    pub fn new(name: String, mesh: Mesh, instances: Vec<oit_core::Instance>) -> Self {
         let first = mesh.colors.first().map_or(1.0, |c| c[3]);
         let uniform_alpha = mesh.colors.iter().all(|c| c[3] == first);
-        Self { name, original: mesh, visible: true, alpha: if uniform_alpha { first } else { 1.0 }, uniform_alpha }
+        let alpha = if uniform_alpha { first } else { 1.0 };
+        Self { name, original: mesh, instances, visible: true, alpha, uniform_alpha }
     }
 
     /// The mesh with the user's alpha applied.

@@ -19,7 +19,7 @@ fn quad(z: f32, offset: f32, rgba: [f32; 4], opaque: bool) -> NamedMesh {
     let s = 0.6;
     let p = |x: f32, y: f32| [x + offset, y + offset * 0.5, z];
     let mesh = Mesh::new(vec![p(-s, -s), p(s, -s), p(s, s), p(-s, s)], vec![[0, 1, 2], [0, 2, 3]], vec![rgba], opaque).unwrap();
-    NamedMesh { name: format!("quad z={z}"), mesh }
+    NamedMesh::new(format!("quad z={z}"), mesh)
 }
 
 /// Three transparent quads submitted front to back (the worst order for blending) over an

@@ -135,7 +135,7 @@ def scale(sweeps: Sequence[str] = SWEEPS, methods: Sequence[str] | None = None,
                 result.rows.append(_row(p, m, status="failed", message=f"no scene or renderer: {_first_line(e)}"))
                 progress.step(m)
             continue
-        triangles = sum(len(mesh.indices) for mesh in built.meshes)
+        triangles = built.scene.triangle_count
         exact = None
         for m in run:
             progress.show(f"{p.sweep} {p.label} {m}")

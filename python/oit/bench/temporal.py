@@ -22,7 +22,7 @@ def orbit(built: scene_lib.BuiltScene, frames: int = TEMPORAL_FRAMES, step_deg: 
     """Cameras of a slow orbit: the scene's camera turned `step_deg` a frame about the vertical
     axis through the center of the geometry's bounding box (frame 0 is the scene's camera).
     The scene is turned the other way instead of moving the eye: view_proj @ T(c) R(-a) T(-c)."""
-    points = np.concatenate([m.positions for m in built.meshes]).astype(np.float64)
+    points = np.concatenate([m.positions for m in built.drawn_meshes()]).astype(np.float64)
     center = (points.min(0) + points.max(0)) / 2
     cameras = []
     for i in range(frames):

@@ -1,6 +1,6 @@
 //! glTF 2.0 and GLB through the gltf crate's importer (buffers and images decoded): every
-//! triangle primitive of the default scene (or of every scene), placed in world space by its
-//! node's transform (a mesh shared by nodes is copied per node), with COLOR_0 times
+//! triangle primitive of the default scene (or of every scene), uploaded once and drawn as an
+//! instance under each node's world transform that uses its mesh, with COLOR_0 times
 //! baseColorFactor, baseColorTexture (sRGB) on its TEXCOORD set, normals, alphaMode
 //! (OPAQUE, the default, gives an opaque mesh; MASK alpha 0 or 1 at alphaCutoff; BLEND
 //! transparent) and doubleSided (true: lit on both sides; false: back faces culled); the
@@ -8,10 +8,11 @@
 
 use std::path::Path;
 
-use glam::{DMat3, DMat4, DVec3};
+use glam::{DMat4, DVec3};
 use gltf::material::AlphaMode;
 
 use super::{bounds, named, srgb_to_linear, FileCamera, LoadedFile, NamedMesh, Projection};
+use crate::scene::Instance;
 use crate::shading::{Material, Texture};
 
 pub fn load(path: &Path) -> Result<LoadedFile, String> {
@@ -24,6 +25,8 @@ pub fn load(path: &Path) -> Result<LoadedFile, String> {
     let mut stack: Vec<(gltf::Node, DMat4)> = roots.into_iter().rev().map(|n| (n, DMat4::IDENTITY)).collect();
     let mut out = LoadedFile::default();
     let mut cameras = Vec::new();
+    // (mesh, primitive) to its place in `out.meshes`.
+    let mut seen: std::collections::HashMap<(usize, usize), usize> = std::collections::HashMap::new();
     while let Some((node, parent)) = stack.pop() {
         let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(|x| x as f64)));
         let world = parent * local;
@@ -38,7 +41,13 @@ pub fn load(path: &Path) -> Result<LoadedFile, String> {
             }
             let label = mesh.name().or(node.name()).map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
             let name = if p > 0 { format!("{label} #{p}") } else { label };
-            if let Some(m) = primitive(&prim, &world, &buffers, &images, name)? {
+            let instance = placement(&world)?;
+            if let Some(&at) = seen.get(&(mesh.index(), p)) {
+                // A mesh another node drew already: one more instance of the same upload.
+                out.meshes[at].instances.push(instance);
+            } else if let Some(mut m) = primitive(&prim, &buffers, &images, name)? {
+                m.instances = vec![instance];
+                seen.insert((mesh.index(), p), out.meshes.len());
                 out.meshes.push(m);
             }
         }
@@ -51,24 +60,29 @@ pub fn load(path: &Path) -> Result<LoadedFile, String> {
     Ok(out)
 }
 
+/// A node's world transform as an instance (glTF transforms are affine; the last row is
+/// taken as (0, 0, 0, 1) whatever rounding left there).
+fn placement(world: &DMat4) -> Result<Instance, String> {
+    let mut rows = world.transpose().to_cols_array_2d();
+    rows[3] = [0.0, 0.0, 0.0, 1.0];
+    Instance::from_rows(rows, [1.0; 4]).map_err(|e| format!("a node's transform: {e}"))
+}
+
 fn primitive(
     prim: &gltf::Primitive<'_>,
-    world: &DMat4,
     buffers: &[gltf::buffer::Data],
     images: &[gltf::image::Data],
     name: String,
 ) -> Result<Option<NamedMesh>, String> {
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
     let Some(pos) = reader.read_positions() else { return Ok(None) };
-    let positions: Vec<[f32; 3]> =
-        pos.map(|v| world.transform_point3(DVec3::from_array(v.map(|x| x as f64))).as_vec3().to_array()).collect();
+    let positions: Vec<[f32; 3]> = pos.collect();
     let flat: Vec<u32> = match reader.read_indices() {
         Some(ix) => ix.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
     };
-    // A mirroring transform turns the winding round: swap two corners to keep the front.
-    let mirror = world.determinant() < 0.0;
-    let indices = flat.chunks_exact(3).map(|t| if mirror { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] }).collect();
+    // A mirroring node's front faces are clockwise: its instance says so (`Instance::mirrors`).
+    let indices = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
     let material = prim.material();
     let pbr = material.pbr_metallic_roughness();
     let factor = pbr.base_color_factor();
@@ -107,10 +121,9 @@ fn primitive(
     }
     let mut mesh = named(name, positions, indices, colors, mode == AlphaMode::Opaque)?;
     if let Some(normals) = reader.read_normals() {
-        // Normals by the inverse transpose; zero ones (some exporters write them) are recomputed.
-        let m = DMat3::from_mat4(*world).inverse().transpose();
+        // Zero normals (some exporters write them) are recomputed; instances carry the rest.
         let normals: Vec<[f32; 3]> =
-            normals.map(|n| (m * DVec3::from_array(n.map(|x| x as f64))).normalize_or_zero().as_vec3().to_array()).collect();
+            normals.map(|n| DVec3::from_array(n.map(|x| x as f64)).normalize_or_zero().as_vec3().to_array()).collect();
         if normals.len() == mesh.mesh.positions.len() && normals.iter().all(|n| n != &[0.0; 3]) {
             mesh.mesh.normals = normals;
         }

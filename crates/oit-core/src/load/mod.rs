@@ -13,7 +13,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use crate::error::{invalid, Result};
-use crate::scene::{Mesh, Scene};
+use crate::scene::{Instance, Mesh, Scene};
 use crate::shading::{Material, Shading, Texture};
 
 /// The alpha every mesh gets when nothing in a file is transparent (the command line and the
@@ -26,10 +26,20 @@ pub const AMBIENT: [f32; 3] = [0.1; 3];
 /// The extensions `load_file` reads, as its messages list them.
 pub const FORMATS: &str = ".obj (with .mtl), .gltf, .glb, .ply and .stl";
 
+/// A mesh of a file under its name, drawn once for each of its instances (a glTF mesh that
+/// several nodes use; one identity instance elsewhere).
 #[derive(Clone, Debug)]
 pub struct NamedMesh {
     pub name: String,
     pub mesh: Mesh,
+    pub instances: Vec<Instance>,
+}
+
+impl NamedMesh {
+    /// A mesh drawn once, where its vertices are.
+    pub fn new(name: String, mesh: Mesh) -> Self {
+        Self { name, mesh, instances: vec![Instance::IDENTITY] }
+    }
 }
 
 /// How a file camera projects; `far` is the file's or, where it gives none (glTF's infinite
@@ -145,7 +155,7 @@ impl LoadedFile {
     pub fn scene(&self) -> Scene {
         let mut scene = Scene::new();
         for m in &self.meshes {
-            scene.add_mesh(m.mesh.clone());
+            scene.add_placed(m.mesh.clone(), m.instances.clone());
         }
         scene.set_ambient(AMBIENT).expect("a valid ambient term");
         scene
@@ -170,7 +180,7 @@ pub(crate) fn named(
 ) -> std::result::Result<NamedMesh, String> {
     let colors = colors.into_iter().map(|c| c.map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) })).collect();
     let mesh = Mesh::new(positions, indices, colors, opaque).map_err(|e| format!("'{name}': {e}"))?;
-    Ok(NamedMesh { name, mesh })
+    Ok(NamedMesh::new(name, mesh))
 }
 
 /// An 8-bit image to a linear texture: RGB decoded from sRGB, alpha as it is.
@@ -183,9 +193,9 @@ fn srgb8(c: u8) -> f32 {
     srgb_to_linear(c as f32 / 255.0)
 }
 
-/// The axis-aligned bounds of every mesh (for file cameras without a far plane).
+/// The axis-aligned bounds of every mesh's instances (for file cameras without a far plane).
 pub(crate) fn bounds(meshes: &[NamedMesh]) -> (DVec3, DVec3) {
-    let points = meshes.iter().flat_map(|m| m.mesh.positions.iter()).map(|p| DVec3::from(p.map(|x| x as f64)));
+    let points = meshes.iter().flat_map(|m| m.instances.iter().flat_map(|i| m.mesh.positions.iter().map(|p| i.apply(*p))));
     points.fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), p| (lo.min(p), hi.max(p)))
 }
 
