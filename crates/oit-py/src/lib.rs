@@ -57,6 +57,9 @@ fn matrix(m: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<[[f64; 4]; 4]> 
     Ok(out)
 }
 
+/// Transforms (n, 4, 4) and color factors (n, 4), as numpy arrays.
+type InstanceArrays<'py> = (Bound<'py, numpy::PyArray3<f64>>, Bound<'py, numpy::PyArray2<f32>>);
+
 /// Instances from transforms (n, 4, 4) and optional color factors (n, 4).
 fn instances(transforms: &PyReadonlyArray3<'_, f64>, colors: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<oit_core::Instance>> {
     let t = transforms.as_array();
@@ -179,11 +182,7 @@ impl Scene {
     }
 
     /// Transforms (n, 4, 4) row-major and color factors (n, 4) of mesh `mesh`'s instances.
-    fn instances<'py>(
-        &self,
-        py: Python<'py>,
-        mesh: usize,
-    ) -> PyResult<(Bound<'py, numpy::PyArray3<f64>>, Bound<'py, numpy::PyArray2<f32>>)> {
+    fn instances<'py>(&self, py: Python<'py>, mesh: usize) -> PyResult<InstanceArrays<'py>> {
         let list = self.inner.instances(self.mesh_index(mesh)?);
         let t: Vec<f64> = list.iter().flat_map(|i| i.transform.transpose().to_cols_array()).collect();
         let c: Vec<f32> = list.iter().flat_map(|i| i.color).collect();
