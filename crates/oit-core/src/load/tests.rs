@@ -106,12 +106,15 @@ fn gltf_nodes_materials_sides_and_cameras() {
         "buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,{B64}"}]}"#;
     let f = load(&gltf_file("tri.gltf", &bin, json)).unwrap();
     let (a, b) = (&f.meshes[0].mesh, &f.meshes[1].mesh);
-    assert_eq!(a.positions[1], [1.0, 0.0, 2.0]);
+    // Vertices stay as the file has them; each node's world transform is the mesh's instance.
+    let world = |m: usize, v: usize| f.meshes[m].instances[0].apply(f.meshes[m].mesh.positions[v]).to_array();
+    assert_eq!(a.positions[1], [1.0, 0.0, 0.0]);
+    assert_eq!(world(0, 1), [1.0, 0.0, 2.0]);
     assert_eq!(a.colors[0], [1.0, 0.5, 0.0, 0.3]);
     assert!(!a.opaque && a.material.two_sided && !a.material.cull_back_faces);
     // The child composes its parent's translation with its own scale; no material is the
     // spec's default: white, OPAQUE, single-sided.
-    assert_eq!(b.positions[1], [2.0, 0.0, 2.0]);
+    assert_eq!(world(1, 1), [2.0, 0.0, 2.0]);
     assert!(b.opaque && b.colors[0] == [1.0; 4] && b.material.cull_back_faces && !b.material.two_sided);
     assert_eq!(f.cameras.len(), 1);
     let Projection::Perspective { yfov, aspect, near, far } = f.cameras[0].projection else { panic!() };
