@@ -99,7 +99,9 @@ mod tests {
         assert!(box_.opaque && box_.colors.iter().all(|c| *c == [1.0, 0.0, 0.0, 1.0]));
         assert!(box_.material.cull_back_faces && !box_.material.two_sided);
         assert!(!panel.opaque && panel.colors.iter().all(|c| *c == [0.0, 0.0, 1.0, 0.5]));
-        assert_eq!(panel.positions[0], [0.0, 0.0, -1.0]);
+        // The panel's node moves it: its instance, over the file's vertices.
+        assert_eq!(panel.positions[0], [0.0, 0.0, 0.0]);
+        assert_eq!(s.meshes[1].instances[0].apply(panel.positions[0]).to_array(), [0.0, 0.0, -1.0]);
     }
 
     #[test]
