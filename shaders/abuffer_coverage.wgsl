@@ -42,4 +42,5 @@ fn frag_mask(f: Frag) -> u32 {
     return load_node(f.id - 1u).mask;
 }
 //!include common/list_cursor.wgsl
+//!include common/stored_color.wgsl
 //!include common/sweep.wgsl

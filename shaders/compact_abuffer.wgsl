@@ -57,25 +57,74 @@ fn fs_capture(in: VsOut) {
     push_node(pixel_index(in.clip), Node(in.clip.z, 0u, in.prim));
 }
 
-// The node keeps only depth and triangle: its color is interpolated and shaded here, at the
-// pixel center (deferred shading: only the fragments the sweep composites are shaded).
+// The node keeps only depth and triangle. The sweep orders fragments by depth, then by their
+// interpolated vertex color (what an unlit scene composites), then by their triangles' records
+// (tie_key), all from the record without shading; frag_shaded shades each fragment once, when
+// it is composited, and only while the pixel can still change (the composite stops at
+// transmittance 0). docs/methods.md ("compact_abuffer").
 fn node_frag(node: Node, link: u32, px: u32) -> Frag {
     let s = shading[node.prim];
-    let at = vec2<f32>(pixel_position(px)) + 0.5;
-    let fa = frame_xy(at);
+    let b = pixel_barycentrics(s, px);
+    let color = b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2];
+    return Frag(node.depth, clamp(color, vec4<f32>(0.0), vec4<f32>(1.0)), link);
+}
+
+// Perspective-correct barycentrics of the pixel center `px` in a triangle's record.
+fn pixel_barycentrics(s: PrimShading, px: u32) -> vec3<f32> {
+    let fa = frame_xy(vec2<f32>(pixel_position(px)) + 0.5);
     let ndc = vec2<f32>(fa.x * 2.0 / f32(frame.size.x) - 1.0, 1.0 - fa.y * 2.0 / f32(frame.size.y));
-    let b = barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
-    var f: VsOut;
-    f.clip = vec4<f32>(at, node.depth, 1.0);
-    f.color = b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2];
-    f.prim = node.prim;
+    return barycentrics(s.clip[0], s.clip[1], s.clip[2], ndc);
+}
+
+// The fragment shaded (deferred shading): an unlit scene's interpolated color is already what
+// shading gives, unless the shading-cost knob asks for the work.
+fn frag_shaded(f: Frag, px: u32) -> Frag {
+    if SHADED == 0u && SHADING_COST == 0u {
+        return f;
+    }
+    let prim = load_node(f.id - 1u).prim;
+    let s = shading[prim];
+    let b = pixel_barycentrics(s, px);
+    var v: VsOut;
+    v.clip = vec4<f32>(vec2<f32>(pixel_position(px)) + 0.5, f.depth, 1.0);
+    v.color = b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2];
+    v.prim = prim;
 //!if SHADED
-    f.normal = b.x * s.normal[0].xyz + b.y * s.normal[1].xyz + b.z * s.normal[2].xyz;
-    f.uv = b.x * s.uv[0] + b.y * s.uv[1] + b.z * s.uv[2];
-    f.material = bitcast<u32>(s.normal[0].w);
+    v.normal = b.x * s.normal[0].xyz + b.y * s.normal[1].xyz + b.z * s.normal[2].xyz;
+    v.uv = b.x * s.uv[0] + b.y * s.uv[1] + b.z * s.uv[2];
+    v.material = bitcast<u32>(s.normal[0].w);
 //!endif
-    let color = clamp(shade(f), vec4<f32>(0.0), vec4<f32>(1.0));
-    return Frag(node.depth, color, link);
+    return Frag(f.depth, clamp(shade(v), vec4<f32>(0.0), vec4<f32>(1.0)), f.id);
+}
+
+// Fragments of equal depth and vertex color may still shade differently (their normals, UVs or
+// materials differ): a hash of their triangles' records (clip corners, normals with the
+// material, UVs) orders them, so the order depends on the triangles, never on their
+// submission. Unlit, the color is all there is.
+fn tie_key(f: Frag) -> u32 {
+    if SHADED == 0u {
+        return 0u;
+    }
+    let s = shading[load_node(f.id - 1u).prim];
+    var h = 2166136261u;
+    h = mix4(h, s.clip[0]);
+    h = mix4(h, s.clip[1]);
+    h = mix4(h, s.clip[2]);
+    h = mix4(h, s.normal[0]);
+    h = mix4(h, s.normal[1]);
+    h = mix4(h, s.normal[2]);
+    h = mix4(h, vec4<f32>(s.uv[0], s.uv[1]));
+    h = mix4(h, vec4<f32>(s.uv[2], 0.0, 0.0));
+    return h;
+}
+
+// FNV-1a over four words, unrolled (llvmpipe's loop limiter counts loops).
+fn mix4(h: u32, v: vec4<f32>) -> u32 {
+    let w = bitcast<vec4<u32>>(v);
+    var x = (h ^ w.x) * 16777619u;
+    x = (x ^ w.y) * 16777619u;
+    x = (x ^ w.z) * 16777619u;
+    return (x ^ w.w) * 16777619u;
 }
 
 fn frag_mask(f: Frag) -> u32 {

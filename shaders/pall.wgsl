@@ -72,4 +72,5 @@ fn frag_mask(f: Frag) -> u32 {
     return 1u;
 }
 //!include common/list_cursor.wgsl
+//!include common/stored_color.wgsl
 //!include common/sweep.wgsl

@@ -49,4 +49,5 @@ fn walk(link: u32, px: u32) -> Walked {
 fn frag_mask(f: Frag) -> u32 {
     return 1u;
 }
+//!include common/stored_color.wgsl
 //!include common/sweep.wgsl

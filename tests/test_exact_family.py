@@ -85,3 +85,33 @@ def test_peeling_separates_coplanar_fragments(renderer):
         f = r.render(build_scene(meshes), IDENTITY, method, background=(0.0, 0.0, 0.0))
         assert f.stats["overflow_fragments"] == 0
         np.testing.assert_allclose(f.image[0, 0], [0.5, 0.25, 0.125, 0.875], atol=1e-6)
+
+
+def lit_coplanar_scene(order, normals, depth: float = 0.5) -> oit.Scene:
+    """Full-screen quads at one depth, one vertex color, each with its own normal, lit from one
+    side (two_sided False): they shade differently although depth and vertex color tie."""
+    from oit import geometry
+
+    scene = oit.Scene()
+    for i in order:
+        pos, idx = geometry.quad((0.0, 0.0, depth), 2.0)
+        scene.add_mesh(pos, idx, (0.6, 0.5, 0.4, 0.5), normals=np.tile(np.float32(normals[i]), (len(pos), 1)),
+                       shading="smooth", two_sided=False, specular=0.5)
+    scene.add_light((0.3, -0.2, -1.0))
+    return scene
+
+
+@pytest.mark.parametrize("method", ["compact_abuffer", "abuffer"])
+def test_lit_coplanar_layers_equal_but_for_their_normals_keep_one_order(renderer, method):
+    # compact_abuffer sorts before it shades: the tie between equal depth and equal vertex color
+    # is broken by the triangles' records, not by submission (nor by a shaded color it does
+    # not have), so every submission order gives the same bits.
+    normals = [(0.0, 0.0, 1.0), (0.6, 0.0, 0.8), (0.0, 0.6, 0.8), (-0.48, -0.6, 0.64)]
+    r = renderer(8, 8)
+    images = [r.render(lit_coplanar_scene(p, normals), IDENTITY, method).image
+              for p in ([0, 1, 2, 3], [3, 2, 1, 0], [2, 0, 3, 1], [1, 3, 0, 2])]
+    for image in images[1:]:
+        np.testing.assert_array_equal(image, images[0])
+    # The layers do shade differently, so the order matters to the image.
+    one = [r.render(lit_coplanar_scene([i], normals), IDENTITY, method).image[0, 0] for i in range(4)]
+    assert max(np.abs(a - b).max() for a in one for b in one) > 0.05

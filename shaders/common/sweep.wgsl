@@ -20,6 +20,11 @@
 //   fn list_head(px: u32) -> u32             the link (node index + 1) of the first node, 0: none
 //   fn walk(link: u32, px: u32) -> Walked    a node's fragment and link, from one load
 //   fn frag_mask(f: Frag) -> u32             the pixel's samples it covers (bit s: sample s)
+//   fn frag_shaded(f: Frag, px: u32) -> Frag the fragment as composited (compact_abuffer shades
+//                                            it here, once; the others as stored:
+//                                            common/stored_color.wgsl)
+//   fn tie_key(f: Frag) -> u32               what orders fragments of equal depth and color
+//                                            before their links (0: nothing)
 // and declares the `state` storage binding; common/nodes.wgsl gives load_next/store_next.
 // docs/methods.md ("abuffer").
 
@@ -50,11 +55,12 @@ const MULTI: u32 = 0x100u;
 // Steps per node loaded into a run, per node relinked, per merge step and per fragment
 // composited from the list: the SWEEP_* constants (oit_core::consts, where they are explained;
 // oit_core::method::lists::StepCosts plans the dispatches from the same ones), plus FRAG_STEPS
-// (injected), what turning a node into a fragment adds (compact_abuffer shades it).
+// (injected), what turning a node into a fragment adds, and SHADE_STEPS (injected), what
+// frag_shaded adds to a composited fragment (compact_abuffer shades it there).
 const LOAD_STEPS: u32 = SWEEP_LOAD_STEPS + FRAG_STEPS;
 const LINK_STEPS: u32 = SWEEP_LINK_STEPS;
 const MERGE_STEPS: u32 = SWEEP_MERGE_STEPS + 2u * FRAG_STEPS;
-const COMPOSITE_STEPS: u32 = SWEEP_COMPOSITE_STEPS + PIXEL_SAMPLES + FRAG_STEPS;
+const COMPOSITE_STEPS: u32 = SWEEP_COMPOSITE_STEPS + PIXEL_SAMPLES + FRAG_STEPS + SHADE_STEPS;
 
 struct Frag {
     depth: f32,
@@ -67,14 +73,18 @@ struct Walked {
     next: u32,
 }
 
-// Strict total order: depth, then color, then node link. Fragments equal in depth and color
-// are interchangeable, so the composite does not depend on submission order.
+// Strict total order: depth, then color, then the includer's tie key, then node link.
+// Fragments equal in all but their links are interchangeable (the same composited color), so
+// the composite does not depend on submission order.
 fn frag_less(a: Frag, b: Frag) -> bool {
     if a.depth != b.depth { return a.depth < b.depth; }
     if a.color.r != b.color.r { return a.color.r < b.color.r; }
     if a.color.g != b.color.g { return a.color.g < b.color.g; }
     if a.color.b != b.color.b { return a.color.b < b.color.b; }
     if a.color.a != b.color.a { return a.color.a < b.color.a; }
+    let ka = tie_key(a);
+    let kb = tie_key(b);
+    if ka != kb { return ka < kb; }
     return a.id < b.id;
 }
 
@@ -130,8 +140,9 @@ fn save_acc(px: u32, c: Acc) {
 // beyond its load) an entry is a sort key, the fragment's depth bits and node link: 8 bytes,
 // not the fragment's 24. Keys are sorted by (depth, link), then equal depths, which are rare,
 // are put in frag_less's order from their nodes, loaded again; the composite loads each node
-// once more. Methods that shade at resolve (FRAG_STEPS > 0: compact_abuffer) keep whole
-// fragments (KEYED = 0), since loading one again would shade it again.
+// once more. Methods whose nodes cost more than their load to turn into fragments
+// (FRAG_STEPS > 0) keep whole fragments (KEYED = 0); compact_abuffer's cost nothing more (an
+// interpolation: it shades only in frag_shaded, at composite).
 //!if KEYED
 alias Entry = vec2<u32>;
 
@@ -549,7 +560,7 @@ fn cs_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
     var c = acc_empty();
     if run.next == 0u {
         for (var i = 0u; i < run.n; i++) {
-            if composite(&c, entry_frag(run.entries[i], px)) {
+            if composite(&c, frag_shaded(entry_frag(run.entries[i], px), px)) {
                 break;
             }
         }
@@ -623,7 +634,7 @@ fn cs_composite(@builtin(global_invocation_id) gid: vec3<u32>) {
             done = true;
         } else {
             let w = walk(link, px);
-            done = composite(&c, w.frag);
+            done = composite(&c, frag_shaded(w.frag, px));
             link = w.next;
         }
         steps += COMPOSITE_STEPS;

@@ -15,6 +15,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("RUN", 128),
     Const::U32("STEP_BUDGET", 32_768),
     Const::U32("FRAG_STEPS", 0),
+    Const::U32("SHADE_STEPS", 0),
     Const::U32("KEYED", 1),
     // Whether the device honours @early_depth_test(force) (set by `module`): validated with
     // the shaders' own opaque-depth test.

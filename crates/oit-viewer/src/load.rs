@@ -1,9 +1,11 @@
 //! Opening what the command line names: scene files (`.oitscene`) and meshes through the
 //! core's loader (`oit_core::load`: OBJ, PLY, STL, glTF/GLB), the one `oit.Scene.from_file`
-//! and `python -m oit render` use. Mesh files keep their materials; the viewer fits a camera.
+//! and `python -m oit render` use. Mesh files keep their materials and instances; the view is
+//! the file's first perspective camera, else fitted.
 
 use std::path::{Path, PathBuf};
 
+use glam::{DMat4, DVec3};
 use oit_core::load::{self as core_load, Surface, AMBIENT};
 
 use crate::scenefile::{self, SceneData};
@@ -55,7 +57,36 @@ pub fn load(path: &Path, alpha: Option<f32>) -> Result<SceneData, String> {
     if let Some(note) = core_load::viewing_alpha(&mut file.meshes, alpha).map_err(|e| e.to_string())? {
         eprintln!("oit-viewer: {}: {note}", path.display());
     }
-    Ok(SceneData { meshes: file.meshes, ambient: AMBIENT, ..Default::default() })
+    let camera = file.cameras.first().and_then(|c| file_camera(c, &file.meshes));
+    if !file.cameras.is_empty() && camera.is_none() {
+        eprintln!("oit-viewer: {}: the file's first camera is orthographic; the view is fitted instead", path.display());
+    }
+    Ok(SceneData { meshes: file.meshes, ambient: AMBIENT, camera, ..Default::default() })
+}
+
+/// A file's perspective camera as the viewer's look-at: its eye, its view direction with the
+/// orbit's pivot where that direction passes nearest the scene's center, its up, field of view
+/// and planes. (An orthographic camera has no look-at: the view is fitted.)
+fn file_camera(c: &core_load::FileCamera, meshes: &[core_load::NamedMesh]) -> Option<scenefile::CameraSpec> {
+    let core_load::Projection::Perspective { yfov, near, far, .. } = c.projection else { return None };
+    let inv = DMat4::from_cols_array_2d(&c.view).transpose().inverse();
+    let eye = inv.transform_point3(DVec3::ZERO);
+    let forward = inv.transform_vector3(DVec3::NEG_Z).normalize_or_zero();
+    let up = inv.transform_vector3(DVec3::Y).normalize_or_zero();
+    if forward == DVec3::ZERO || up == DVec3::ZERO {
+        return None;
+    }
+    let (center, _) = crate::orbit::bounds(meshes);
+    let reach = (center - eye).dot(forward).max(2.0 * near);
+    let target = eye + forward * reach;
+    Some(scenefile::CameraSpec::LookAt {
+        eye: eye.to_array(),
+        target: target.to_array(),
+        up: up.to_array(),
+        fov_y: yfov.to_degrees(),
+        near,
+        far,
+    })
 }
 
 #[cfg(test)]
@@ -102,6 +133,24 @@ mod tests {
         // The panel's node moves it: its instance, over the file's vertices.
         assert_eq!(panel.positions[0], [0.0, 0.0, 0.0]);
         assert_eq!(s.meshes[1].instances[0].apply(panel.positions[0]).to_array(), [0.0, 0.0, -1.0]);
+    }
+
+    #[test]
+    fn a_gltf_camera_is_the_view() {
+        // The triangle, and a camera 10 in front of it looking down -z.
+        let json = r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],
+            "nodes":[{"mesh":0},{"camera":0,"translation":[0.5,0,10]}],
+            "cameras":[{"type":"perspective","perspective":{"yfov":0.6,"znear":0.5,"zfar":50}}],
+            "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+            "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+            "bufferViews":[{"buffer":0,"byteLength":36}],
+            "buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]}"#;
+        let s = load(&tmp("cam.gltf", json.as_bytes()), None).unwrap();
+        let Some(scenefile::CameraSpec::LookAt { eye, target, up, fov_y, near, far }) = s.camera else { panic!("{:?}", s.camera) };
+        assert_eq!(eye, [0.5, 0.0, 10.0]);
+        assert!((target[2] - 0.0).abs() < 1e-9 && (target[0] - 0.5).abs() < 1e-9, "{target:?}");
+        assert_eq!(up, [0.0, 1.0, 0.0]);
+        assert!((fov_y - 0.6f64.to_degrees()).abs() < 1e-4 && (near - 0.5).abs() < 1e-6 && (far - 50.0).abs() < 1e-4);
     }
 
     #[test]

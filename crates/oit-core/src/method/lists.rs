@@ -288,11 +288,15 @@ impl ListMethod {
     /// This frame's pipelines, from the device's cache.
     /// What a step of the sorted resolve costs in this frame.
     fn step_costs(&self, cx: &FrameCtx<'_>) -> StepCosts {
-        // shading.wgsl's `shade`: its light loop, the shading-cost loop, and a margin for its
-        // other loops, each of which llvmpipe's limiter counts once even when skipped.
-        let frag = if self.shades_at_resolve { 4 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64 } else { 0 };
+        // Shading at composite (compact_abuffer's frag_shaded): shading.wgsl's `shade` (its
+        // light loop, the shading-cost loop, and a margin for its other loops, each of which
+        // llvmpipe's limiter counts once even when skipped) and the node's load. Its tie key
+        // loads a node a fragment compared, where the scene is shaded.
+        let deferred = self.shades_at_resolve;
+        let shade = if deferred { 5 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64 } else { 0 };
+        let frag = (deferred && cx.variant.shaded) as u64;
         let run = (cx.max_depth_complexity as u64).min(RUN as u64);
-        StepCosts { samples: self.sweeps.unwrap_or(1) as u64, frag, run }
+        StepCosts { samples: self.sweeps.unwrap_or(1) as u64, frag, shade, run }
     }
 
     fn pipelines(&self, cx: &FrameCtx<'_>, run: u32, costs: StepCosts, budget: u64) -> Pipelines {
@@ -301,6 +305,7 @@ impl ListMethod {
         consts.push(Const::U32("RUN", run));
         consts.push(Const::U32("STEP_BUDGET", budget as u32));
         consts.push(Const::U32("FRAG_STEPS", costs.frag as u32));
+        consts.push(Const::U32("SHADE_STEPS", costs.shade as u32));
         consts.push(Const::U32("KEYED", costs.keyed() as u32));
         consts.extend(self.consts.iter().copied());
         let at = |entry| spec(self.pipelines, entry);

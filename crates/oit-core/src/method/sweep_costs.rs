@@ -25,13 +25,16 @@ pub(crate) const PIXEL_BYTES: u64 = pixel_bytes(1);
 
 /// What one step of the sorted resolve costs on llvmpipe's loop limiter (the constants of
 /// shaders/common/sweep.wgsl, which this mirrors): `frag` is what turning a node into a
-/// fragment adds (compact_abuffer shades it there: its lights and the shading-cost loop);
-/// `run` the fragments a run holds in this frame (RUN, or the deepest list when shorter).
+/// fragment adds (compact_abuffer's tie key, a node load, where the scene is shaded); `shade`
+/// what compositing a fragment adds (compact_abuffer shades it there: its lights, the
+/// shading-cost loop, the node's load); `run` the fragments a run holds in this frame (RUN, or
+/// the deepest list when shorter).
 /// The array a run is sorted in is [`run_length`] of the deepest list.
 #[derive(Clone, Copy, Debug)]
 pub struct StepCosts {
     pub samples: u64,
     pub frag: u64,
+    pub shade: u64,
     pub run: u64,
 }
 
@@ -44,7 +47,7 @@ impl StepCosts {
         SWEEP_MERGE_STEPS as u64 + 2 * self.frag
     }
     fn composite(self) -> u64 {
-        SWEEP_COMPOSITE_STEPS as u64 + self.samples + self.frag
+        SWEEP_COMPOSITE_STEPS as u64 + self.samples + self.frag + self.shade
     }
 
     /// Whether runs hold sort keys, not whole fragments (sweep.wgsl's KEYED): where turning a
@@ -83,7 +86,7 @@ impl StepCosts {
         } else {
             Self::sort_keys(run) + keyed * (run.saturating_sub(1) * self.load() + compares * (1 + self.load()))
         };
-        self.load() * (run + 1) + sort + run * (Self::LINK.max(2 + self.samples) + keyed * self.load())
+        self.load() * (run + 1) + sort + run * (Self::LINK.max(2 + self.samples + self.shade) + keyed * self.load())
     }
 
     fn largest_unit(self) -> u64 {
@@ -106,7 +109,7 @@ pub fn step_budget(gpu: &GpuContext, costs: StepCosts) -> Result<u64> {
             "the exact resolve needs {unit} loop iterations for one unit of work here (a fragment shaded at resolve with \
              {} iterations), and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: lower shading_cost or use \
              abuffer, which shades at capture",
-            costs.frag
+            costs.shade
         )));
     }
     Ok(LLVMPIPE_LOOP_LIMIT - unit)
@@ -136,7 +139,7 @@ pub fn resolve_dispatches(n: u64, costs: StepCosts, budget: u64) -> [u32; 3] {
 mod tests {
     use super::*;
 
-    const PLAIN: StepCosts = StepCosts { samples: 1, frag: 0, run: RUN as u64 };
+    const PLAIN: StepCosts = StepCosts { samples: 1, frag: 0, shade: 0, run: RUN as u64 };
 
     #[test]
     fn a_list_of_one_run_needs_no_dispatch_after_the_first() {
@@ -187,11 +190,18 @@ mod tests {
     }
 
     #[test]
-    fn runs_that_shade_at_resolve_keep_whole_fragments_and_cost_no_reloads() {
-        let shaded = StepCosts { samples: 1, frag: 12, run: RUN as u64 };
-        assert!(PLAIN.keyed() && !shaded.keyed());
+    fn shading_at_composite_costs_the_composite_alone() {
+        // compact_abuffer unlit: its nodes cost their load alone, so runs stay keyed, and a
+        // composited fragment adds its shading.
         let n = RUN as u64;
-        assert_eq!(shaded.run(), (SWEEP_LOAD_STEPS as u64 + 12) * (n + 1) + StepCosts::sort_keys(n) + n * 3);
+        let deferred = StepCosts { shade: 12, ..PLAIN };
+        assert!(deferred.keyed());
+        assert_eq!(deferred.composite(), PLAIN.composite() + 12);
+        assert_eq!(deferred.run(), PLAIN.run() + n * 12);
+        // Shaded: the tie key loads a node, so runs keep whole fragments (no reloads).
+        let tied = StepCosts { frag: 1, ..deferred };
+        assert!(!tied.keyed());
+        assert_eq!(tied.run(), (SWEEP_LOAD_STEPS as u64 + 1) * (n + 1) + StepCosts::sort_keys(n) + n * (2 + 1 + 12));
     }
 
     #[test]
