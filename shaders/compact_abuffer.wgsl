@@ -66,8 +66,13 @@ fn node_frag(node: Node, link: u32, px: u32) -> Frag {
     let s = shading[node.prim];
     let b = pixel_barycentrics(s, px);
     let color = b.x * s.color[0] + b.y * s.color[1] + b.z * s.color[2];
-    return Frag(node.depth, clamp(color, vec4<f32>(0.0), vec4<f32>(1.0)), link);
+    return Frag(node.depth, clamp(color, vec4<f32>(0.0), vec4<f32>(1.0)), node.prim);
 }
+
+// A fragment's id is its triangle, not its node's link (a triangle covers a pixel center
+// once, so it is unique in a pixel's list): frag_shaded and tie_key read the record with no
+// node load. The sweep takes links from its keys only where runs are KEYED.
+const_assert KEYED != 0u;
 
 // Perspective-correct barycentrics of the pixel center `px` in a triangle's record.
 fn pixel_barycentrics(s: PrimShading, px: u32) -> vec3<f32> {
@@ -82,7 +87,7 @@ fn frag_shaded(f: Frag, px: u32) -> Frag {
     if SHADED == 0u && SHADING_COST == 0u {
         return f;
     }
-    let prim = load_node(f.id - 1u).prim;
+    let prim = f.id;
     let s = shading[prim];
     let b = pixel_barycentrics(s, px);
     var v: VsOut;
@@ -98,23 +103,27 @@ fn frag_shaded(f: Frag, px: u32) -> Frag {
 }
 
 // Fragments of equal depth and vertex color may still shade differently (their normals, UVs or
-// materials differ): a hash of their triangles' records (clip corners, normals with the
-// material, UVs) orders them, so the order depends on the triangles, never on their
-// submission. Unlit, the color is all there is.
+// materials differ): a hash of what shades them (the triangle's clip corners, normals and UVs,
+// and its material's contents: not its index in the table, nor its texture's place there,
+// which follow submission) orders them, so the order depends on the triangles, never on
+// their submission. Unlit, the color is all there is.
 fn tie_key(f: Frag) -> u32 {
     if SHADED == 0u {
         return 0u;
     }
-    let s = shading[load_node(f.id - 1u).prim];
+    let s = shading[f.id];
+    let material = bitcast<u32>(s.normal[0].w);
+    let m1 = surfaces[2u * material + 1u];
     var h = 2166136261u;
     h = mix4(h, s.clip[0]);
     h = mix4(h, s.clip[1]);
     h = mix4(h, s.clip[2]);
-    h = mix4(h, s.normal[0]);
-    h = mix4(h, s.normal[1]);
-    h = mix4(h, s.normal[2]);
-    h = mix4(h, vec4<f32>(s.uv[0], s.uv[1]));
-    h = mix4(h, vec4<f32>(s.uv[2], 0.0, 0.0));
+    h = mix4(h, vec4<f32>(s.normal[0].xyz, s.normal[1].x));
+    h = mix4(h, vec4<f32>(s.normal[1].yz, s.normal[2].xy));
+    h = mix4(h, vec4<f32>(s.normal[2].z, s.uv[0].x, s.uv[0].y, s.uv[1].x));
+    h = mix4(h, vec4<f32>(s.uv[1].y, s.uv[2].x, s.uv[2].y, 0.0));
+    h = mix4(h, surfaces[2u * material]);
+    h = mix4(h, vec4<f32>(m1.y, m1.z, 0.0, 0.0));
     return h;
 }
 

@@ -62,6 +62,8 @@ const LINK_STEPS: u32 = SWEEP_LINK_STEPS;
 const MERGE_STEPS: u32 = SWEEP_MERGE_STEPS + 2u * FRAG_STEPS;
 const COMPOSITE_STEPS: u32 = SWEEP_COMPOSITE_STEPS + PIXEL_SAMPLES + FRAG_STEPS + SHADE_STEPS;
 
+// `id`: the node's link, or where runs are KEYED anything unique in the pixel the includer
+// reads back (compact_abuffer: the triangle).
 struct Frag {
     depth: f32,
     color: vec4<f32>,
@@ -141,8 +143,8 @@ fn save_acc(px: u32, c: Acc) {
 // not the fragment's 24. Keys are sorted by (depth, link), then equal depths, which are rare,
 // are put in frag_less's order from their nodes, loaded again; the composite loads each node
 // once more. Methods whose nodes cost more than their load to turn into fragments
-// (FRAG_STEPS > 0) keep whole fragments (KEYED = 0); compact_abuffer's cost nothing more (an
-// interpolation: it shades only in frag_shaded, at composite).
+// (FRAG_STEPS > 0) keep whole fragments (KEYED = 0); compact_abuffer's cost an interpolation
+// from the triangle's record (it shades only in frag_shaded, at composite).
 //!if KEYED
 alias Entry = vec2<u32>;
 

@@ -290,11 +290,10 @@ impl ListMethod {
     fn step_costs(&self, cx: &FrameCtx<'_>) -> StepCosts {
         // Shading at composite (compact_abuffer's frag_shaded): shading.wgsl's `shade` (its
         // light loop, the shading-cost loop, and a margin for its other loops, each of which
-        // llvmpipe's limiter counts once even when skipped) and the node's load. Its tie key
-        // loads a node a fragment compared, where the scene is shaded.
-        let deferred = self.shades_at_resolve;
-        let shade = if deferred { 5 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64 } else { 0 };
-        let frag = (deferred && cx.variant.shaded) as u64;
+        // llvmpipe's limiter counts once even when skipped). Its nodes' fragments and tie keys
+        // read the triangle's record, which costs no loop: runs stay keyed.
+        let shade = if self.shades_at_resolve { 4 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64 } else { 0 };
+        let frag = 0;
         let run = (cx.max_depth_complexity as u64).min(RUN as u64);
         StepCosts { samples: self.sweeps.unwrap_or(1) as u64, frag, shade, run }
     }
