@@ -262,17 +262,19 @@ impl Scene {
         self.inner.bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array()))
     }
 
+    /// (triangles, vertices, opaque) per mesh.
+    fn mesh_summary(&self) -> Vec<(usize, usize, bool)> {
+        self.inner.meshes().iter().map(|m| (m.indices.len(), m.positions.len(), m.opaque)).collect()
+    }
+}
+
+impl Scene {
     fn mesh_index(&self, mesh: usize) -> PyResult<usize> {
         let count = self.inner.meshes().len();
         if mesh >= count {
             return Err(PyValueError::new_err(format!("mesh index {mesh} is out of range: the scene has {count} meshes")));
         }
         Ok(mesh)
-    }
-
-    /// (triangles, vertices, opaque) per mesh.
-    fn mesh_summary(&self) -> Vec<(usize, usize, bool)> {
-        self.inner.meshes().iter().map(|m| (m.indices.len(), m.positions.len(), m.opaque)).collect()
     }
 }
 
