@@ -138,6 +138,20 @@ impl Instance {
     }
 }
 
+/// The box around every drawn vertex of meshes with their instances (a scene's, a loaded
+/// file's), in f64; None when nothing is drawn.
+pub fn placed_bounds<'a>(placed: impl Iterator<Item = (&'a Mesh, &'a [Instance])>) -> Option<(glam::DVec3, glam::DVec3)> {
+    let mut lo = glam::DVec3::splat(f64::INFINITY);
+    let mut hi = -lo;
+    for (m, list) in placed {
+        for w in list.iter().flat_map(|inst| m.positions.iter().map(|p| inst.apply(*p))) {
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    (lo.x <= hi.x).then_some((lo, hi))
+}
+
 static NEXT_SCENE_ID: AtomicU64 = AtomicU64::new(1);
 
 /// An ordered list of meshes, each drawn once for each of its instances. Submission order is
@@ -292,18 +306,7 @@ impl Scene {
 
     /// The box around every drawn vertex (instances included), in f64; None when nothing is drawn.
     pub fn bounds(&self) -> Option<(glam::DVec3, glam::DVec3)> {
-        let mut lo = glam::DVec3::splat(f64::INFINITY);
-        let mut hi = -lo;
-        for (m, list) in self.placed() {
-            for inst in list {
-                for p in &m.positions {
-                    let w = inst.apply(*p);
-                    lo = lo.min(w);
-                    hi = hi.max(w);
-                }
-            }
-        }
-        (lo.x <= hi.x).then_some((lo, hi))
+        placed_bounds(self.placed())
     }
 
     /// Changes one mesh's alpha (all vertices), e.g. from a viewer slider.

@@ -206,14 +206,14 @@ fn upload<'a>(
         } else {
             m.positions.iter().map(|p| glam::DVec3::from(p.map(|x| x as f64))).sum::<glam::DVec3>() / m.positions.len() as f64
         };
-        instances.push((table.len() as u32, list.len() as u32));
+        instances.push((placements.len() as u32, list.len() as u32));
         for inst in list {
-            placements.push(Placement {
-                centroid: inst.transform.transform_point3(centroid).as_vec3(),
-                mesh: local,
-                instance: table.len() as u32,
-            });
-            table.push(GpuInstance::new(inst, (drawn as u32).wrapping_sub(unique as u32)));
+            let instance = placements.len() as u32;
+            placements.push(Placement { centroid: inst.transform.transform_point3(centroid).as_vec3(), mesh: local, instance });
+            // Without instances the passes read no table: none is built.
+            if shared.instanced {
+                table.push(GpuInstance::new(inst, (drawn as u32).wrapping_sub(unique as u32)));
+            }
             drawn += tris;
         }
         unique += tris;
@@ -254,18 +254,23 @@ fn upload<'a>(
     done.push(cur);
     // Chunks that hold no triangle are dropped (but one is kept for its group): renumber.
     let kept: Vec<usize> = (0..done.len()).filter(|&c| done[c].triangles() > 0 || c == 0).collect();
-    let renumber = |c: usize| kept.iter().position(|&k| k == c).expect("a segment's chunk holds triangles");
-    segments.iter_mut().flatten().for_each(|s| s.chunk = renumber(s.chunk));
-    // Each chunk's segments, in drawn order, for compute passes over the drawn triangles.
+    let mut renumber = vec![usize::MAX; done.len()];
+    kept.iter().enumerate().for_each(|(k, &c)| renumber[c] = k);
+    segments.iter_mut().flatten().for_each(|s| s.chunk = renumber[s.chunk]);
+    // Each chunk's segments, in drawn order, for compute passes over the drawn triangles (with
+    // instances only: the passes read them with instances alone); every chunk's drawn count.
     let mut chunk_segments: Vec<Vec<GpuSegment>> = vec![Vec::new(); kept.len()];
     let mut chunk_drawn = vec![0u32; kept.len()];
     for (mine, &(first, count)) in segments.iter().zip(&instances) {
         for s in mine {
-            if count > 0 {
-                let at = chunk_drawn[s.chunk];
-                chunk_segments[s.chunk].push(GpuSegment { drawn_first: at, lo: s.lo, triangles: s.hi - s.lo, first_instance: first });
-                chunk_drawn[s.chunk] = at + (s.hi - s.lo) * count;
+            if count == 0 {
+                continue;
             }
+            let at = chunk_drawn[s.chunk];
+            if shared.instanced {
+                chunk_segments[s.chunk].push(GpuSegment { drawn_first: at, lo: s.lo, triangles: s.hi - s.lo, first_instance: first });
+            }
+            chunk_drawn[s.chunk] = at + (s.hi - s.lo) * count;
         }
     }
     let make = |name: &str, bytes: &[u8]| {
@@ -275,11 +280,6 @@ fn upload<'a>(
         }
         b
     };
-    // Without instances the passes read neither the instance table nor the segments.
-    if !shared.instanced {
-        table.clear();
-        chunk_segments.iter_mut().for_each(Vec::clear);
-    }
     let table_bytes = table.len() as u64 * std::mem::size_of::<GpuInstance>() as u64;
     if table_bytes > max {
         return Err(OitError::OutOfMemory(format!(
@@ -288,7 +288,8 @@ fn upload<'a>(
             table.len()
         )));
     }
-    if let Some(list) = chunk_segments.iter().find(|l| l.len() as u64 * 16 > max) {
+    let segment_bytes = std::mem::size_of::<GpuSegment>() as u64;
+    if let Some(list) = chunk_segments.iter().find(|l| l.len() as u64 * segment_bytes > max) {
         return Err(OitError::OutOfMemory(format!(
             "a chunk of the {label} meshes holds {} instanced meshes, whose segment table passes a storage binding \
              ({max} bytes): merge meshes",
@@ -305,7 +306,7 @@ fn upload<'a>(
             bytes +=
                 g.positions.len() as u64 * 4 + g.colors.len() as u64 * 16 + g.indices.len() as u64 * 4 + g.attributes.len() as u64 * 16;
             let list = &chunk_segments[k];
-            bytes += list.len() as u64 * 16;
+            bytes += list.len() as u64 * segment_bytes;
             let info = gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("chunk"),
                 size: 16,

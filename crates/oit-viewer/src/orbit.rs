@@ -35,17 +35,7 @@ pub struct ViewCamera {
 
 /// Center and radius of the bounding sphere of the meshes' bounding box (instances placed).
 pub fn bounds(meshes: &[NamedMesh]) -> (DVec3, f64) {
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for m in meshes {
-        for v in m.instances.iter().flat_map(|i| m.mesh.positions.iter().map(|p| i.apply(*p))) {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
-    }
-    if !lo.is_finite() {
-        return (DVec3::ZERO, 1.0);
-    }
+    let Some((lo, hi)) = oit_core::load::bounds(meshes) else { return (DVec3::ZERO, 1.0) };
     let center = (lo + hi) / 2.0;
     (center, ((hi - lo).length() / 2.0).max(1e-6))
 }

@@ -52,7 +52,8 @@ pub fn load(path: &Path) -> Result<LoadedFile, String> {
             }
         }
     }
-    let (lo, hi) = bounds(&out.meshes);
+    // A file without triangles is refused after loading; its cameras need no far plane then.
+    let (lo, hi) = bounds(&out.meshes).unwrap_or((DVec3::ZERO, DVec3::ZERO));
     for (i, (camera, world, node_name)) in cameras.into_iter().enumerate() {
         let name = camera.name().map(str::to_string).or(node_name).unwrap_or_else(|| format!("camera {i}"));
         out.cameras.push(file_camera(&camera, &world, name, lo, hi)?);

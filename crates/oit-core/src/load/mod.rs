@@ -193,10 +193,10 @@ fn srgb8(c: u8) -> f32 {
     srgb_to_linear(c as f32 / 255.0)
 }
 
-/// The axis-aligned bounds of every mesh's instances (for file cameras without a far plane).
-pub(crate) fn bounds(meshes: &[NamedMesh]) -> (DVec3, DVec3) {
-    let points = meshes.iter().flat_map(|m| m.instances.iter().flat_map(|i| m.mesh.positions.iter().map(|p| i.apply(*p))));
-    points.fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), p| (lo.min(p), hi.max(p)))
+/// The box around every mesh's instances (file cameras without a far plane, the viewer's fit);
+/// None when nothing is drawn.
+pub fn bounds(meshes: &[NamedMesh]) -> Option<(DVec3, DVec3)> {
+    crate::scene::placed_bounds(meshes.iter().map(|m| (&m.mesh, m.instances.as_slice())))
 }
 
 #[cfg(test)]
