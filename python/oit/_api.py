@@ -157,11 +157,9 @@ class Scene:
 
     def set_mesh_alpha(self, mesh: int, alpha: float) -> None:
         """Sets every vertex alpha of one mesh."""
-        index = _int(mesh, "mesh", "an int (the index add_mesh returned)")
+        index = self._mesh_index(mesh)
         if isinstance(alpha, (bool, np.bool_)) or not isinstance(alpha, (int, float, np.integer, np.floating)):
             raise TypeError(f"alpha must be a number in [0, 1], got {type(alpha).__name__}")
-        if not 0 <= index < self.mesh_count:
-            raise ValueError(f"mesh index {index} is out of range: the scene has {self.mesh_count} meshes")
         self._native.set_mesh_alpha(index, float(alpha))
 
     @property
@@ -260,8 +258,8 @@ class Scene:
             index = self.add_mesh(t.positions, t.faces, colors, opaque=opaque or t.opaque,
                                   normals=t.normals if shading == "smooth" else None, uvs=t.uvs, texture=t.texture,
                                   shading=shading, specular=specular, shininess=shininess, two_sided=two_sided)
-            if transforms is not None and not (len(transforms) == 1 and np.array_equal(transforms[0], np.eye(4))):
-                self.set_instances(index, transforms)
+            if transforms is not None:
+                self.set_instances(index, transforms)  # one identity instance leaves the scene uninstanced
 
 
 def _transforms(value: Any, name: str) -> np.ndarray:
