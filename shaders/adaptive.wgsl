@@ -1,90 +1,131 @@
-// Adaptive transparency (Salvi et al. 2011) as the paper's proof of concept: fragments are
-// captured in per-pixel lists (unbounded memory), then one full-screen pass per pixel
-//   1. inserts the fragments in submission order (primitive index) into a visibility
-//      function of at most NODES steps; on overflow it removes the node whose removal
-//      changes the area under the curve least, merging it into the node in front of it
-//      (transmittance is underestimated, as in the paper);
-//   2. composites every fragment as C * alpha * vis(z), and the background by the function's
-//      last value. Error discussion: docs/methods.md ("adaptive").
+// Adaptive transparency (Salvi et al. 2011) as the paper designs it: a visibility function of
+// at most NODES steps a pixel in bounded storage, independent of the fragment count.
+//   fs_insert   geometry pass 1: inside its pixel's critical section (common/pixel_lock.wgsl)
+//               a fragment inserts its node (depth, transmittance), multiplies the nodes
+//               behind it by 1 - alpha and, past NODES, removes the node whose removal changes
+//               the area under the visibility curve least, merging it into the node in front
+//               (transmittance is underestimated, as in the paper);
+//   fs_shade    geometry pass 2: each fragment adds C * alpha * vis(z) by additive blending;
+//   fs_resolve  full screen: the sum over the opaque scene or background at vis(infinity).
+// The update is that of adaptive_lists.wgsl (the proof of concept over captured lists) step for
+// step. Error discussion and what the critical section guarantees where: docs/methods.md.
 //!include common/scene.wgsl
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
-//!include common/submission.wgsl
+// Node i of pixel px: its depth's bits at nodes[2 (px NODES + i)], its transmittance's next.
+@group(2) @binding(0) var<storage, read_write> nodes: array<atomic<u32>>;
 
-// The visibility function: steps at depth[i] down to trans[i], sorted by depth.
+struct Incoming {
+    depth: f32,
+    alpha: f32,
+}
+//!include common/pixel_lock.wgsl
+
+@group(3) @binding(0) var accum_tex: texture_2d<f32>;
+
 var<private> depth: array<f32, NODES_PLUS_ONE>;
 var<private> trans: array<f32, NODES_PLUS_ONE>;
-var<private> count: u32;
 
-fn visit(f: Frag) {
-    let z = f.depth;
-    let a = f.color.a;
+fn node_word(px: u32, i: u32) -> u32 {
+    return 2u * (px * NODES + i);
+}
+
+fn node_depth(px: u32, i: u32) -> f32 {
+    return bitcast<f32>(atomicLoad(&nodes[node_word(px, i)]));
+}
+
+fn node_trans(px: u32, i: u32) -> f32 {
+    return bitcast<f32>(atomicLoad(&nodes[node_word(px, i) + 1u]));
+}
+
+fn critical(px: u32, count: u32, f: Incoming) -> u32 {
+    for (var i = 0u; i < count; i++) {
+        depth[i] = node_depth(px, i);
+        trans[i] = node_trans(px, i);
+    }
     // After every node at the same or a smaller depth.
     var p = count;
-    while p > 0u && depth[p - 1u] > z {
+    while p > 0u && depth[p - 1u] > f.depth {
         depth[p] = depth[p - 1u];
-        trans[p] = trans[p - 1u] * (1.0 - a);
+        trans[p] = trans[p - 1u] * (1.0 - f.alpha);
         p--;
     }
     var front = 1.0;
     if p > 0u {
         front = trans[p - 1u];
     }
-    depth[p] = z;
-    trans[p] = front * (1.0 - a);
-    count++;
-    if count <= NODES {
+    depth[p] = f.depth;
+    trans[p] = front * (1.0 - f.alpha);
+    var n = count + 1u;
+    var first = p; // the first node that changed
+    if n > NODES {
+        // Remove the node whose merge into its predecessor changes the area least.
+        var best = 1u;
+        var best_area = 3.4e38;
+        for (var i = 1u; i < n; i++) {
+            let area = (depth[i] - depth[i - 1u]) * (trans[i - 1u] - trans[i]);
+            if area < best_area {
+                best_area = area;
+                best = i;
+            }
+        }
+        trans[best - 1u] = trans[best];
+        for (var i = best; i + 1u < n; i++) {
+            depth[i] = depth[i + 1u];
+            trans[i] = trans[i + 1u];
+        }
+        n--;
+        first = min(first, best - 1u);
+    }
+    for (var i = first; i < n; i++) {
+        atomicStore(&nodes[node_word(px, i)], bitcast<u32>(depth[i]));
+        atomicStore(&nodes[node_word(px, i) + 1u], bitcast<u32>(trans[i]));
+    }
+    return n;
+}
+
+@fragment @early_depth_test(force)
+fn fs_insert(raw: VsOut) {
+    let in = shaded_alpha(raw);
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
         return;
     }
-    // Remove the node whose merge into its predecessor changes the area least.
-    var best = 1u;
-    var best_area = 3.4e38;
-    for (var i = 1u; i < count; i++) {
-        let area = (depth[i] - depth[i - 1u]) * (trans[i - 1u] - trans[i]);
-        if area < best_area {
-            best_area = area;
-            best = i;
-        }
-    }
-    trans[best - 1u] = trans[best];
-    for (var i = best; i + 1u < count; i++) {
-        depth[i] = depth[i + 1u];
-        trans[i] = trans[i + 1u];
-    }
-    count--;
+    with_pixel_lock(pixel_index(in.clip), Incoming(in.clip.z, in.color.a));
 }
 
 // Transmittance in front of depth z: the last step strictly nearer than z.
-fn vis(z: f32) -> f32 {
+fn vis(px: u32, z: f32) -> f32 {
+    let count = entries(px);
     var t = 1.0;
     for (var i = 0u; i < count; i++) {
-        if depth[i] >= z {
+        if node_depth(px, i) >= z {
             break;
         }
-        t = trans[i];
+        t = node_trans(px, i);
     }
     return t;
+}
+
+@fragment @early_depth_test(force)
+fn fs_shade(raw: VsOut) -> @location(0) vec4<f32> {
+    let in = shaded(raw);
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
+        discard;
+    }
+    let v = vis(pixel_index(in.clip), in.clip.z);
+    return vec4<f32>(in.color.rgb * in.color.a * v, 0.0);
 }
 
 @fragment
 fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let base = base_at(pos);
-    let head = atomicLoad(&heads[pixel_index(pos)]);
-    count = 0u;
-    // 1. The visibility function, in submission order.
-    visit_in_submission_order(head);
-    // 2. Composite every fragment by the approximate visibility.
-    var accum = vec3<f32>(0.0);
-    var i = head;
-    while i != NIL {
-        let n = load_node(i - 1u);
-        i = n.next;
-        accum += vec3<f32>(n.rg, n.ba.x) * n.ba.y * vis(n.depth);
-    }
+    let px = pixel_index(pos);
+    let count = entries(px);
     var t = 1.0;
     if count > 0u {
-        t = trans[count - 1u];
+        t = node_trans(px, count - 1u);
     }
-    return vec4<f32>(accum + t * base.rgb, 1.0 - t * (1.0 - base.a));
+    let c = textureLoad(accum_tex, vec2<i32>(pos.xy), 0).rgb;
+    return vec4<f32>(c + t * base.rgb, 1.0 - t * (1.0 - base.a));
 }

@@ -171,10 +171,11 @@ def hybrid_tail_count(z, alpha, k: int) -> int:
 def expected_overflow(name: str, z, alpha, **params) -> int | None:
     """What stats["overflow_fragments"] should say for one pixel's stack, or None when no
     model of it is known here. Only hybrid and ktab have a bounded structure that overflows;
-    the blends have none, and the list methods grow theirs."""
+    the blends have none, the list methods grow theirs, and adaptive and mlab merge entries
+    by design (their overflow counts fragments that gave up on a pixel lock: none here)."""
     if name in ("hybrid", "ktab"):
         return hybrid_tail_count(z, alpha, int(params["k"]))
-    if name in ("unsorted", "sorted", "wavg", "wsum", "wboit", "adaptive") or INFO[name]["exact"]:
+    if name in ("unsorted", "sorted", "wavg", "wsum", "wboit", "adaptive", "mlab") or INFO[name]["exact"]:
         return 0
     return None
 

@@ -139,11 +139,11 @@ def test_renderer_is_usable_after_a_memory_error(renderer, name):
 
 def test_renderer_is_usable_after_each_kind_of_error(renderer):
     # A bad parameter (ValueError), a pool past its bindings (MemoryError) and, on llvmpipe, a
-    # pixel past adaptive's loop budget (RuntimeError): after each, the renderer renders the
+    # pixel past adaptive_lists' loop budget (RuntimeError): after each, the renderer renders the
     # same bits as before. (A GPU-side failure once left a method's readback buffer mapped,
     # breaking every later render of that method.)
     ok = full_screen_layers([(0.5, (0.0, 1.0, 0.0, 0.5)), (0.25, (1.0, 0.0, 0.0, 0.5))])
-    name = "adaptive" if "adaptive" in NAMES else NODE_POOL[0]
+    name = "adaptive_lists"
     limited = renderer(1, 1, max_binding_bytes=1024)  # at most 168 nodes, fewer than 200 fragments
     before = limited.render(ok, IDENTITY, name).image
     with pytest.raises(ValueError, match="no_such_parameter"):
@@ -153,7 +153,7 @@ def test_renderer_is_usable_after_each_kind_of_error(renderer):
         limited.render(stacks(1, 1, 200, seed=1).scene, IDENTITY, name)
     assert np.array_equal(limited.render(ok, IDENTITY, name).image, before)
     r = renderer(1, 1)
-    if "llvmpipe" in r.adapter_info["name"] and name == "adaptive":
+    if "llvmpipe" in r.adapter_info["name"] and name == "adaptive_lists":
         with pytest.raises(RuntimeError, match="65535"):
             r.render(stacks(1, 1, 4000, seed=3).scene, IDENTITY, name)
         assert np.array_equal(r.render(ok, IDENTITY, name).image, before)

@@ -131,28 +131,41 @@ def test_exact_methods_resolve_pixels_past_the_loop_limit(renderer, layers):
 
 
 @pytest.mark.parametrize("nodes,depths", [(8, [300, 450, 500, 510, 520, 1000, 4000]), (32, [300, 330, 340])])
-def test_adaptive_is_right_or_refuses_near_its_loop_limit(renderer, nodes, depths):
-    # On llvmpipe adaptive builds a pixel's whole visibility function in one invocation; its
+def test_adaptive_lists_is_right_or_refuses_near_its_loop_limit(renderer, nodes, depths):
+    # On llvmpipe adaptive_lists builds a pixel's whole visibility function in one invocation; its
     # estimate of the loop count decides. On both sides of it, every frame must be either the
     # model's answer or a RuntimeError naming the limit: never a silently truncated loop.
-    if "adaptive" not in NAMES:
-        pytest.skip("no adaptive method")
     r = renderer(1, 1)
     outcomes = []
     for n in depths:
         s = deep(n, "faint") if n in DEPTHS else stacks(1, 1, n, seed=n, alpha=REGIMES["faint"])
-        frame = render_or_limit(r, s.scene, "adaptive", background=tuple(BG), nodes=nodes)
+        frame = render_or_limit(r, s.scene, "adaptive_lists", background=tuple(BG), nodes=nodes)
         if isinstance(frame, RuntimeError):
             assert f"{n} fragments" in str(frame) and "nodes" in str(frame)
             outcomes.append("refused")
             continue
-        want = s.expect("adaptive", nodes=nodes)[0, 0]
-        assert np.abs(frame.image[0, 0] - want).max() <= tolerance("adaptive", n, s.alpha[0].sum()), n
+        want = s.expect("adaptive_lists", nodes=nodes)[0, 0]
+        assert np.abs(frame.image[0, 0] - want).max() <= tolerance("adaptive_lists", n, s.alpha[0].sum()), n
         outcomes.append("right")
     assert outcomes[0] == "right"  # 300 fragments always fit
     if loop_limited(r):
         assert outcomes[-1] == "refused"
         assert outcomes == sorted(outcomes, key=lambda o: o == "refused")  # refused only past a threshold
+
+
+@pytest.mark.parametrize("name,param", [("adaptive", "nodes"), ("mlab", "layers")])
+@pytest.mark.parametrize("count", [8, 32])
+def test_locked_methods_have_no_loop_limit(renderer, name, param, count):
+    # The bounded adaptive and mlab update N entries a fragment (docs/methods.md, "Critical
+    # sections"): no loop grows with the pixel's depth, so 4,000 layers are the model's answer,
+    # never a refusal, and no fragment waited for or gave up on its pixel's lock.
+    r = renderer(1, 1)
+    for regime in REGIMES:
+        s = deep(4000, regime)
+        frame = r.render(s.scene, oit.Camera(np.eye(4)), name, background=tuple(BG), **{param: count})
+        want = s.expect(name, **{param: count})[0, 0]
+        assert np.abs(frame.image[0, 0] - want).max() <= tolerance(name, 4000, s.alpha[0].sum()), regime
+        assert frame.stats["extra"]["lock_failures"] == frame.stats["extra"]["lock_waits"] == 0
 
 
 def test_deferred_shading_of_deep_pixels_keeps_within_the_loop_budget(renderer):

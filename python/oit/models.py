@@ -296,3 +296,5 @@ def bucket_peeling(z, rgb, alpha, bg, bg_a=0.0, buckets=32):
 MODELS = {"abuffer": exact, "hybrid": hybrid, "hybrid64": hybrid64, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit,
           "adaptive": adaptive, "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab,
           "bucket_peeling": bucket_peeling}
+# The list versions run the same update in the same (submission) order.
+MODELS.update({"adaptive_lists": adaptive, "mlab_lists": mlab})

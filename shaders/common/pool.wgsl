@@ -1,7 +1,7 @@
 // Per-pixel linked lists over the node pool of common/nodes.wgsl. Links (heads, next) store
 // a node's index + 1, so that a zero-cleared head buffer means empty lists. The including
 // shader defines `struct Node` with a `next: u32` field (common/pool_node.wgsl,
-// adaptive.wgsl, ...). Group 2 is the pool's (oit_core::method::list_pipelines::POOL_LAYOUT):
+// adaptive_lists.wgsl, ...). Group 2 is the pool's (oit_core::method::list_pipelines::POOL_LAYOUT):
 // heads, allocator, the pool bindings, sweep state (6) and the method's binding 7.
 
 struct Alloc {

@@ -51,6 +51,11 @@ pub const SWEEP_LINK_STEPS: u32 = 2;
 pub const SWEEP_MERGE_STEPS: u32 = 6;
 pub const SWEEP_COMPOSITE_STEPS: u32 = 4;
 
+/// Attempts a fragment makes at its pixel's lock before it gives up and is counted
+/// (`lock_failures`; shaders/common/pixel_lock.wgsl): far more than one pixel's fragments can
+/// queue for in one wave, and far below llvmpipe's 65,535-iteration loop limit.
+pub const LOCK_TRIES: u32 = 4096;
+
 /// Every shared constant, in the order they are prepended (float64 ones as the float32 the
 /// shaders compute with).
 pub const SHARED: &[Const] = &[
@@ -80,4 +85,5 @@ pub const SHARED: &[Const] = &[
     Const::U32("SWEEP_LINK_STEPS", SWEEP_LINK_STEPS),
     Const::U32("SWEEP_MERGE_STEPS", SWEEP_MERGE_STEPS),
     Const::U32("SWEEP_COMPOSITE_STEPS", SWEEP_COMPOSITE_STEPS),
+    Const::U32("LOCK_TRIES", LOCK_TRIES),
 ];

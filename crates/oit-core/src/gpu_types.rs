@@ -111,7 +111,7 @@ pub struct CoverageNode {
     pub pad: u32,
 }
 
-/// Mirrors `Node` in `shaders/adaptive.wgsl`: a pool node with its primitive index.
+/// Mirrors `Node` in `shaders/adaptive_lists.wgsl`: a pool node with its primitive index.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct PrimNode {

@@ -177,6 +177,8 @@ pub const EXTRAS: &[(&str, Merge)] = &[
     ("auto_predicted_k", Merge::Max),
     ("auto_exact", Merge::Max),
     ("auto_attempts", Merge::Max),
+    ("lock_failures", Merge::Sum),
+    ("lock_waits", Merge::Sum),
 ];
 
 /// The merge rule of extra `name` (a count unless declared otherwise).

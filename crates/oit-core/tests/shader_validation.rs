@@ -70,7 +70,7 @@ fn layout_sizes() {
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<PoolNode>());
     assert_eq!(struct_size(&m, "Alloc") as usize, std::mem::size_of::<Alloc>());
     assert_eq!(struct_size(&m, "Instance") as usize, std::mem::size_of::<GpuInstance>());
-    let m = validate("adaptive.wgsl");
+    let m = validate("adaptive_lists.wgsl");
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<PrimNode>());
     let m = validate("compact_abuffer.wgsl");
     assert_eq!(struct_size(&m, "Node") as usize, std::mem::size_of::<CompactNode>());

@@ -1,7 +1,7 @@
-//! `adaptive`: adaptive transparency (Salvi et al. 2011) as the paper's proof of concept:
+//! `adaptive_lists`: adaptive transparency (Salvi et al. 2011) as the paper's proof of concept:
 //! every fragment captured in per-pixel lists (unbounded memory, as theirs), then a
 //! full-screen pass that builds a visibility function of at most `nodes` steps in submission
-//! order and composites every fragment by it (shaders/adaptive.wgsl).
+//! order and composites every fragment by it (shaders/adaptive_lists.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
@@ -13,11 +13,11 @@ use crate::error::Result;
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;
 
-const PIPELINES: &[PipelineSpec] = &single("adaptive.wgsl", FRAME);
+const PIPELINES: &[PipelineSpec] = &single("adaptive_lists.wgsl", FRAME);
 
 pub const INFO: MethodInfo = MethodInfo {
-    name: "adaptive",
-    summary: "adaptive transparency: a visibility function of at most `nodes` steps per pixel, built from captured lists",
+    name: "adaptive_lists",
+    summary: "adaptive transparency built from captured lists (unbounded memory; `adaptive` is the bounded one)",
     exact: false,
     bounded_memory: false,
     passes: &["capture (geometry)", "build visibility and composite (full screen)"],
@@ -57,7 +57,7 @@ impl Method for Adaptive {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let nodes = cx.params.int("nodes") as u32;
         // Per fragment: an insertion and a lookup of up to `nodes` steps each.
-        check_replay_budget(cx, "adaptive", "nodes", nodes, 4 * nodes as u64)?;
+        check_replay_budget(cx, "adaptive_lists", "nodes", nodes, 4 * nodes as u64)?;
         self.0.set_consts(vec![Const::U32("NODES", nodes), Const::U32("NODES_PLUS_ONE", nodes + 1)]);
         self.0.render(cx)
     }

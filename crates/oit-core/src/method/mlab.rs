@@ -1,6 +1,6 @@
-//! `mlab`: multi-layer alpha blending (Salvi & Vaidyanathan 2014), replayed in submission
-//! order over captured lists because WebGPU has no pixel synchronization; memory is that of
-//! the lists, unbounded (shaders/mlab.wgsl).
+//! `mlab_lists`: multi-layer alpha blending (Salvi & Vaidyanathan 2014), replayed in submission
+//! order over captured lists: the proof of concept beside the bounded `mlab` (locked.rs); memory is that of
+//! the lists, unbounded (shaders/mlab_lists.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
@@ -13,11 +13,11 @@ use crate::error::Result;
 use crate::gpu_types::PrimNode;
 use crate::shader::Const;
 
-const PIPELINES: &[PipelineSpec] = &single("mlab.wgsl", FRAME);
+const PIPELINES: &[PipelineSpec] = &single("mlab_lists.wgsl", FRAME);
 
 pub const INFO: MethodInfo = MethodInfo {
-    name: "mlab",
-    summary: "multi-layer alpha blending: `layers` depth-sorted blended layers, the farthest two merged on overflow",
+    name: "mlab_lists",
+    summary: "multi-layer alpha blending replayed from captured lists (unbounded memory; `mlab` is the bounded one)",
     exact: false,
     bounded_memory: false,
     passes: &["capture (geometry)", "replay in submission order and composite (full screen)"],
@@ -53,7 +53,7 @@ impl Method for Mlab {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let layers = cx.params.int("layers") as u32;
         // Per fragment: an insertion shifting up to `layers` entries.
-        check_replay_budget(cx, "mlab", "layers", layers, layers as u64 + 2)?;
+        check_replay_budget(cx, "mlab_lists", "layers", layers, layers as u64 + 2)?;
         self.0.set_consts(vec![Const::U32("LAYERS", layers), Const::U32("LAYERS_PLUS_ONE", layers + 1)]);
         self.0.render(cx)
     }

@@ -15,6 +15,7 @@ mod info;
 mod ktab;
 mod list_pipelines;
 pub(crate) mod lists;
+mod locked;
 mod mlab;
 mod pall;
 mod params;
@@ -46,6 +47,7 @@ const REGISTRY: &[MethodInfo] = &[
     weighted::WAVG,
     weighted::WSUM,
     weighted::WBOIT,
+    locked::ADAPTIVE,
     adaptive::INFO,
     pall::INFO,
     compact_abuffer::INFO,
@@ -54,6 +56,7 @@ const REGISTRY: &[MethodInfo] = &[
     peel::DUAL_DEPTH_PEELING,
     screen_door::INFO,
     stochastic::INFO,
+    locked::MLAB,
     mlab::INFO,
     bucket_peeling::INFO,
     auto::INFO,
