@@ -24,9 +24,6 @@ struct Incoming {
 
 @group(3) @binding(0) var accum_tex: texture_2d<f32>;
 
-var<private> depth: array<f32, NODES_PLUS_ONE>;
-var<private> trans: array<f32, NODES_PLUS_ONE>;
-
 fn node_word(px: u32, i: u32) -> u32 {
     return 2u * (px * NODES + i);
 }
@@ -39,48 +36,66 @@ fn node_trans(px: u32, i: u32) -> f32 {
     return bitcast<f32>(atomicLoad(&nodes[node_word(px, i) + 1u]));
 }
 
+// The update indexes its arrays only by loop counters with constant bounds, which the
+// compiler unrolls into registers: a dynamically indexed private array is a gather per lane
+// on llvmpipe and local memory on GPUs. Only the pixel's `count` nodes are loaded, and only
+// the nodes that change are stored. Step for step the arithmetic of adaptive_lists' `visit`.
 fn critical(px: u32, count: u32, f: Incoming) -> u32 {
-    for (var i = 0u; i < count; i++) {
-        depth[i] = node_depth(px, i);
-        trans[i] = node_trans(px, i);
-    }
-    // After every node at the same or a smaller depth.
-    var p = count;
-    while p > 0u && depth[p - 1u] > f.depth {
-        depth[p] = depth[p - 1u];
-        trans[p] = trans[p - 1u] * (1.0 - f.alpha);
-        p--;
-    }
+    var d: array<f32, NODES_PLUS_ONE>;
+    var t: array<f32, NODES_PLUS_ONE>;
+    // p: the nodes at the same or a smaller depth, which stay in front of the new one (the
+    // steps are sorted by depth, and transmittance never rises along them).
+    var p = 0u;
     var front = 1.0;
-    if p > 0u {
-        front = trans[p - 1u];
+    for (var i = 0u; i < NODES; i++) {
+        d[i] = 0.0;
+        t[i] = 0.0;
+        if i < count {
+            d[i] = node_depth(px, i);
+            t[i] = node_trans(px, i);
+            if d[i] <= f.depth {
+                p = i + 1u;
+                front = t[i];
+            }
+        }
     }
-    depth[p] = f.depth;
-    trans[p] = front * (1.0 - f.alpha);
+    // Insert at p: the nodes behind move one step back, attenuated by 1 - alpha.
+    let keep = 1.0 - f.alpha;
+    var nd: array<f32, NODES_PLUS_ONE>;
+    var nt: array<f32, NODES_PLUS_ONE>;
+    nd[0] = select(d[0], f.depth, p == 0u);
+    nt[0] = select(t[0], front * keep, p == 0u);
+    for (var i = 1u; i < NODES_PLUS_ONE; i++) {
+        let moved = i > p;
+        nd[i] = select(select(d[i], f.depth, i == p), d[i - 1u], moved);
+        nt[i] = select(select(t[i], front * keep, i == p), t[i - 1u] * keep, moved);
+    }
     var n = count + 1u;
     var first = p; // the first node that changed
     if n > NODES {
-        // Remove the node whose merge into its predecessor changes the area least.
+        // Remove the node whose merge into its predecessor changes the area least (the first
+        // of equal areas); its predecessor takes its transmittance.
         var best = 1u;
         var best_area = 3.4e38;
-        for (var i = 1u; i < n; i++) {
-            let area = (depth[i] - depth[i - 1u]) * (trans[i - 1u] - trans[i]);
+        for (var i = 1u; i < NODES_PLUS_ONE; i++) {
+            let area = (nd[i] - nd[i - 1u]) * (nt[i - 1u] - nt[i]);
             if area < best_area {
                 best_area = area;
                 best = i;
             }
         }
-        trans[best - 1u] = trans[best];
-        for (var i = best; i + 1u < n; i++) {
-            depth[i] = depth[i + 1u];
-            trans[i] = trans[i + 1u];
+        for (var i = 0u; i < NODES; i++) {
+            nd[i] = select(nd[i], nd[i + 1u], i >= best);
+            nt[i] = select(nt[i], nt[i + 1u], i + 1u >= best);
         }
-        n--;
+        n = NODES;
         first = min(first, best - 1u);
     }
-    for (var i = first; i < n; i++) {
-        atomicStore(&nodes[node_word(px, i)], bitcast<u32>(depth[i]));
-        atomicStore(&nodes[node_word(px, i) + 1u], bitcast<u32>(trans[i]));
+    for (var i = 0u; i < NODES; i++) {
+        if i >= first && i < n {
+            atomicStore(&nodes[node_word(px, i)], bitcast<u32>(nd[i]));
+            atomicStore(&nodes[node_word(px, i) + 1u], bitcast<u32>(nt[i]));
+        }
     }
     return n;
 }
@@ -94,15 +109,15 @@ fn fs_insert(raw: VsOut) {
     with_pixel_lock(pixel_index(in.clip), Incoming(in.clip.z, in.color.a));
 }
 
-// Transmittance in front of depth z: the last step strictly nearer than z.
+// Transmittance in front of depth z: the last step strictly nearer than z (the steps are
+// sorted by depth).
 fn vis(px: u32, z: f32) -> f32 {
     let count = entries(px);
     var t = 1.0;
-    for (var i = 0u; i < count; i++) {
-        if node_depth(px, i) >= z {
-            break;
+    for (var i = 0u; i < NODES; i++) {
+        if i < count && node_depth(px, i) < z {
+            t = node_trans(px, i);
         }
-        t = node_trans(px, i);
     }
     return t;
 }

@@ -20,10 +20,6 @@ struct Incoming {
 }
 //!include common/pixel_lock.wgsl
 
-var<private> layer_c: array<vec3<f32>, LAYERS_PLUS_ONE>;
-var<private> layer_t: array<f32, LAYERS_PLUS_ONE>;
-var<private> layer_z: array<f32, LAYERS_PLUS_ONE>;
-
 fn layer_word(px: u32, i: u32) -> u32 {
     return LAYER_WORDS * (px * LAYERS + i);
 }
@@ -36,41 +32,59 @@ fn store_word(w: u32, v: f32) {
     atomicStore(&layers[w], bitcast<u32>(v));
 }
 
+// Indexed only by loop counters with constant bounds, which the compiler unrolls into
+// registers (as adaptive.wgsl's update); loads the pixel's `count` layers and stores those that
+// change. Step for step the arithmetic of mlab_lists' `visit`.
 fn critical(px: u32, count: u32, f: Incoming) -> u32 {
-    for (var i = 0u; i < count; i++) {
-        let w = layer_word(px, i);
-        layer_c[i] = vec3<f32>(load_word(w), load_word(w + 1u), load_word(w + 2u));
-        layer_t[i] = load_word(w + 3u);
-        layer_z[i] = load_word(w + 4u);
+    var c: array<vec3<f32>, LAYERS_PLUS_ONE>;
+    var t: array<f32, LAYERS_PLUS_ONE>;
+    var z: array<f32, LAYERS_PLUS_ONE>;
+    // p: the layers at the same or a smaller depth, which stay in front of the new one.
+    var p = 0u;
+    for (var i = 0u; i < LAYERS; i++) {
+        if i < count {
+            let w = layer_word(px, i);
+            c[i] = vec3<f32>(load_word(w), load_word(w + 1u), load_word(w + 2u));
+            t[i] = load_word(w + 3u);
+            z[i] = load_word(w + 4u);
+            if z[i] <= f.depth {
+                p = i + 1u;
+            }
+        }
     }
-    // Insert behind every layer at the same or a smaller depth.
-    var p = count;
-    while p > 0u && layer_z[p - 1u] > f.depth {
-        layer_c[p] = layer_c[p - 1u];
-        layer_t[p] = layer_t[p - 1u];
-        layer_z[p] = layer_z[p - 1u];
-        p--;
+    let new_c = f.color.rgb * f.color.a;
+    let new_t = 1.0 - f.color.a;
+    var lc: array<vec3<f32>, LAYERS_PLUS_ONE>;
+    var lt: array<f32, LAYERS_PLUS_ONE>;
+    var lz: array<f32, LAYERS_PLUS_ONE>;
+    lc[0] = select(c[0], new_c, p == 0u);
+    lt[0] = select(t[0], new_t, p == 0u);
+    lz[0] = select(z[0], f.depth, p == 0u);
+    for (var i = 1u; i < LAYERS_PLUS_ONE; i++) {
+        let moved = i > p;
+        lc[i] = select(select(c[i], new_c, i == p), c[i - 1u], moved);
+        lt[i] = select(select(t[i], new_t, i == p), t[i - 1u], moved);
+        lz[i] = select(select(z[i], f.depth, i == p), z[i - 1u], moved);
     }
-    layer_c[p] = f.color.rgb * f.color.a;
-    layer_t[p] = 1.0 - f.color.a;
-    layer_z[p] = f.depth;
     var n = count + 1u;
     var first = p; // the first layer that changed
     if n > LAYERS {
         // Merge the farthest layer into the one in front of it (over operator).
         let k = LAYERS - 1u;
-        layer_c[k] += layer_t[k] * layer_c[LAYERS];
-        layer_t[k] *= layer_t[LAYERS];
+        lc[k] += lt[k] * lc[LAYERS];
+        lt[k] *= lt[LAYERS];
         n = LAYERS;
         first = min(first, k);
     }
-    for (var i = first; i < n; i++) {
-        let w = layer_word(px, i);
-        store_word(w, layer_c[i].r);
-        store_word(w + 1u, layer_c[i].g);
-        store_word(w + 2u, layer_c[i].b);
-        store_word(w + 3u, layer_t[i]);
-        store_word(w + 4u, layer_z[i]);
+    for (var i = 0u; i < LAYERS; i++) {
+        if i >= first && i < n {
+            let w = layer_word(px, i);
+            store_word(w, lc[i].r);
+            store_word(w + 1u, lc[i].g);
+            store_word(w + 2u, lc[i].b);
+            store_word(w + 3u, lt[i]);
+            store_word(w + 4u, lz[i]);
+        }
     }
     return n;
 }
