@@ -110,7 +110,7 @@ def adaptive_throughput() -> tuple[str, str]:
         built = scene_lib.SCENES[name](**QUICK_SCENE_ARGS[name])
         r = Renderer(*built.size)
         ms = median_ms(r, built, "adaptive", nodes=8)
-        frags = r.render(built.scene, built.camera, "adaptive", nodes=8).stats["fragments"]
+        frags = r.render(built.scene, built.camera, "adaptive", nodes=8, census=True).stats["fragments"]
         out.append(f"{name} {ms:.0f} ms / {frags / 1e6:.2f} M fragments = {ms / frags * 1e6:.0f} ms a M")
     return ("adaptive with 8 nodes, thinned scenes at 512² on lavapipe, GPU median of 3: " + "; ".join(out)
             + " (the slides: 1.3 to 3.2 ms a M "
