@@ -35,18 +35,18 @@ ADD_MESH_CASES = [
     (P, [[0, 1]], C, ValueError, "indices must have shape (n, 3), got (1, 2)"),
     (P, [[[0, 1, 2]]], C, ValueError, "indices must have shape (n, 3)"),
     (P, I, (1.0, 0.0, 0.0), ValueError, "colors must have shape (3, 4)"),
-    (P, I, np.full((2, 4), 0.5), ValueError, "colors must have shape (3, 4)"),
-    # values
-    (with_nan(P, (0, 2)), I, C, ValueError, "positions has a NaN or Inf"),
-    (with_nan(P, (1, 0), np.inf), I, C, ValueError, "positions has a NaN or Inf"),
+    (P, I, np.full((2, 4), 0.5), ValueError, "colors has 2 rows but positions has 3"),
+    # values: checked once, in the core
+    (with_nan(P, (0, 2)), I, C, ValueError, "positions[0] = [0.0, 0.0, NaN] is not finite"),
+    (with_nan(P, (1, 0), np.inf), I, C, ValueError, "positions[1] = [inf, 0.0, 0.5] is not finite"),
     (with_nan(P, (1, 0), 1e39), I, C, ValueError, "too large for float32"),
-    (P, I, (1.0, np.nan, 0.0, 0.5), ValueError, "colors has a NaN or Inf"),
-    (P, I, (1.0, 0.0, np.inf, 0.5), ValueError, "colors has a NaN or Inf"),
-    (P, I, (1.5, 0.0, 0.0, 0.5), ValueError, "colors must be straight linear RGBA in [0, 1]"),
-    (P, I, (1.0, 0.0, 0.0, -0.1), ValueError, "colors must be straight linear RGBA in [0, 1]"),
-    (P, I, (1.0, 0.0, 0.0, 1.01), ValueError, "(alpha included)"),
-    (P, [[0, -1, 2]], C, ValueError, "indices has a negative entry (-1)"),
-    (P, [[0, 1, 3]], C, ValueError, "indices refers to vertex 3 but positions has 3 rows"),
+    (P, I, (1.0, np.nan, 0.0, 0.5), ValueError, "colors[0] = [1.0, NaN, 0.0, 0.5] is outside [0, 1] (or NaN)"),
+    (P, I, (1.0, 0.0, np.inf, 0.5), ValueError, "colors[0] = [1.0, 0.0, inf, 0.5] is outside [0, 1]"),
+    (P, I, (1.5, 0.0, 0.0, 0.5), ValueError, "colors are straight linear RGBA in [0, 1]"),
+    (P, I, (1.0, 0.0, 0.0, -0.1), ValueError, "colors are straight linear RGBA in [0, 1]"),
+    (P, I, (1.0, 0.0, 0.0, 1.01), ValueError, "[1.0, 0.0, 0.0, 1.01] is outside [0, 1]"),
+    (P, [[0, -1, 2]], C, ValueError, "indices has an entry -1; indices must be in [0, 3)"),
+    (P, [[0, 1, 3]], C, ValueError, "indices[0] = [0, 1, 3] refers past the last vertex (3 vertices)"),
     (P, [[0, 1, 2**40]], C, ValueError, "indices must be in [0, 3)"),
 ]
 
@@ -128,7 +128,7 @@ def test_renderer_larger_than_the_adapter_allows():
 
 
 def test_renderer_binding_limit_too_small():
-    with pytest.raises(ValueError, match="max_binding_bytes must be at least 256, got 100"):
+    with pytest.raises(ValueError, match="max_binding_bytes must be at least 256 bytes, got 100"):
         oit.Renderer(8, 8, max_binding_bytes=100)
 
 
@@ -201,7 +201,7 @@ def test_method_names_are_suggested_whatever_the_case(small):
 
 @pytest.mark.parametrize("call,error,message", [
     (lambda: oit.Camera("eye"), TypeError, "view_proj must be a 4 x 4 array of numbers"),
-    (lambda: oit.Renderer(4, 4, max_binding_bytes=-5), ValueError, "max_binding_bytes must be positive"),
+    (lambda: oit.Renderer(4, 4, max_binding_bytes=-5), ValueError, "max_binding_bytes must be at least 256 bytes, got -5"),
 ])
 def test_arguments_of_the_wrong_kind_are_named(call, error, message):
     with pytest.raises(error, match=message):

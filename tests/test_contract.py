@@ -4,6 +4,8 @@ method table, adapter info, the node pool split across bindings, and empty scene
 from __future__ import annotations
 
 import ast
+import inspect
+import re
 from pathlib import Path
 
 import numpy as np
@@ -196,6 +198,13 @@ def test_the_stats_types_are_the_cores():
     assert written == schema
     assert list(_stub_class_annotations("_Stats").items()) == schema
     assert all(doc for _, _, doc in oit._oit.stats_schema())
+
+
+def test_the_stats_comments_are_the_schemas_meanings():
+    """Each key's comment in `oit.Stats` is the meaning the core's schema gives it, word for word."""
+    source = inspect.getsource(oit.Stats)
+    comments = dict(re.findall(r"^ +(\w+): [^#\n]+# (.+)$", source, re.M))
+    assert comments == {name: doc for name, _, doc in oit._oit.stats_schema()}
 
 
 @pytest.mark.parametrize("method", ["hybrid", "abuffer"])

@@ -140,8 +140,9 @@ def bad_add_mesh(draw):
     if how == "dtype":
         return (pos, idx, draw(st.sampled_from(["red", np.array(["1", "0", "0", "1"]), None]))), TypeError, which
     if how == "shape":
+        # (Not (1, 4): one row is one RGBA for the whole mesh, like (4,).)
         return (pos, idx, draw(st.sampled_from([(1.0, 0.0, 0.0), np.full((2, 4), 0.5), np.full((3, 3), 0.5),
-                                                  np.full((1, 4), 0.5), np.full((3, 4, 1), 0.5)]))), ValueError, which
+                                                  np.full((3, 4, 1), 0.5)]))), ValueError, which
     bad = col.astype(np.float64)
     bad[draw(index), draw(st.integers(0, 3))] = draw(st.one_of(
         st.floats(1.0, 1e30, exclude_min=True), st.floats(-1e30, 0.0, exclude_max=True),

@@ -194,7 +194,7 @@ def test_zero_instances_draw_nothing(renderer):
         (np.full((1, 4, 4), np.nan), None, ValueError, "NaN or Inf"),
         (np.ones((1, 4, 4)), None, ValueError, "affine"),
         (np.eye(4)[None], np.float32([[1, 1, 1, 2]]), ValueError, r"outside \[0, 1\]"),
-        (np.eye(4)[None].repeat(2, 0), np.ones((3, 4)), ValueError, r"shape \(2, 4\)"),
+        (np.eye(4)[None].repeat(2, 0), np.ones((3, 4)), ValueError, r"colors has 3 rows but transforms has 2"),
         (np.array([[["a"] * 4] * 4]), None, TypeError, "float array"),
     ],
 )

@@ -247,16 +247,16 @@ def test_the_default_shading_is_smooth_with_normals_and_unlit_without(renderer):
 
 
 BAD = [
-    (dict(normals=np.zeros((3, 3))), ValueError, "normals must have shape"),
+    (dict(normals=np.zeros((3, 3))), ValueError, "normals has 3 rows but positions has 4"),
     (dict(normals=np.zeros((4, 3))), ValueError, "is zero"),
     (dict(normals=np.full((4, 3), np.nan)), ValueError, "NaN"),
     (dict(normals=np.full((4, 3), "x")), TypeError, "float array"),
     (dict(uvs=np.zeros((4, 3))), ValueError, "uvs must have shape"),
-    (dict(uvs=np.full((4, 2), np.inf)), ValueError, "NaN or Inf"),
+    (dict(uvs=np.full((4, 2), np.inf)), ValueError, "uvs[0] = [inf, inf] is not finite"),
     (dict(texture=np.zeros((2, 2, 4), np.float32)), ValueError, "needs uvs"),
     (dict(uvs=np.zeros((4, 2)), texture=np.zeros((2, 2, 3))), ValueError, "(h, w, 4)"),
     (dict(uvs=np.zeros((4, 2)), texture=np.full((2, 2, 4), 1.5)), ValueError, "[0, 1]"),
-    (dict(shading="phong"), ValueError, "shading must be one of"),
+    (dict(shading="phong"), ValueError, "shading must be 'unlit', 'flat' or 'smooth'"),
     (dict(specular=-0.1), ValueError, "specular"),
     (dict(shininess=0.0), ValueError, "shininess"),
     (dict(opacity=1.5), ValueError, "opacity"),

@@ -169,8 +169,10 @@ def test_a_pixel_deeper_than_any_tile_is_refused_by_name():
 def test_memory_budget_is_checked():
     with pytest.raises(TypeError, match="memory_budget must be an int"):
         oit.Renderer(8, 8, memory_budget=1e6)
-    with pytest.raises(ValueError, match="memory_budget must be positive"):
+    with pytest.raises(ValueError, match="memory_budget must be at least 1024 bytes, got 0"):
         oit.Renderer(8, 8, memory_budget=0)
+    with pytest.raises(ValueError, match="memory_budget must be at least 1024 bytes, got -5"):
+        oit.Renderer(8, 8, memory_budget=-5)
     with pytest.raises(ValueError, match="memory_budget must be at least 1024 bytes"):
         oit.Renderer(8, 8, memory_budget=100)
 

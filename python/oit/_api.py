@@ -1,5 +1,7 @@
-"""The public API: validation of every input happens here (or in the core), with
-messages that name the argument and say what to do."""
+"""The public API. Arguments are converted here into what the native layer takes (dtypes,
+shapes, Python types), with errors that name the argument; every check of their values
+(ranges, finiteness, index bounds, counts) happens once, in the core, whose errors say what to
+do."""
 
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ from typing import Any, TypedDict
 import numpy as np
 
 from . import _oit
-from ._checks import _I64_MAX, _U32_MAX, SHADINGS, _float_array, _int, _number, _rows, _surface, _vector
+from ._checks import _I64_MAX, _U32_MAX, SHADINGS, _float_array, _instance_colors, _int, _number, _rows, _surface, _transforms, _vector
 from ._memory import available_memory
 from ._trimesh import trimesh_arrays
 from .imageio import encode_png
@@ -38,8 +40,8 @@ class Scene:
         and `set_instances` draw the same vertices again under other transforms.
 
         positions: (n, 3) float; indices: (m, 3) non-negative integers below n (converted to
-        uint32 after range checks); colors: (n, 4) per vertex or (4,) for the whole mesh,
-        straight (not premultiplied) linear RGBA in [0, 1].
+        uint32); colors: (n, 4) per vertex or (4,) or (1, 4) for the whole mesh, straight (not
+        premultiplied) linear RGBA in [0, 1].
 
         The surface (docs/shading.md): `normals` (n, 3) per vertex, `uvs` (n, 2) per vertex,
         `texture` (h, w, 4) straight RGBA -- float in [0, 1] taken as linear, or uint8 taken as
@@ -60,22 +62,17 @@ class Scene:
             raise TypeError(f"indices must be an integer array (uint32 preferred), got dtype {idx.dtype}")
         idx = _rows(idx, 3, "indices")
         if idx.size:
+            # uint32 cannot hold these: the conversion would wrap them into range.
             lo, hi = int(idx.min()), int(idx.max())
-            if lo < 0:
-                raise ValueError(f"indices has a negative entry ({lo}); indices must be in [0, {len(pos)})")
-            if hi >= len(pos):
-                raise ValueError(f"indices refers to vertex {hi} but positions has {len(pos)} rows; indices must be in [0, {len(pos)})")
+            if lo < 0 or hi > _U32_MAX:
+                bad = lo if lo < 0 else hi
+                raise ValueError(f"indices has an entry {bad}; indices must be in [0, {len(pos)})")
         idx = np.ascontiguousarray(idx, dtype=np.uint32)
         col = _float_array(colors, "colors")
         if col.shape == (4,):
             col = col.reshape(1, 4)
-        elif col.ndim != 2 or col.shape != (len(pos), 4):
+        elif col.ndim != 2 or col.shape[1] != 4:
             raise ValueError(f"colors must have shape ({len(pos)}, 4) (one RGBA per vertex) or (4,), got {col.shape}")
-        if col.size and (col.min() < 0.0 or col.max() > 1.0):
-            raise ValueError(
-                "colors must be straight linear RGBA in [0, 1] (alpha included); "
-                f"got values in [{col.min():g}, {col.max():g}]: clip or rescale them"
-            )
         if not isinstance(opaque, (bool, np.bool_)):
             raise TypeError(f"opaque must be a bool, got {type(opaque).__name__}")
         surface = _surface(len(pos), normals, uvs, texture, shading, specular, shininess, opacity, two_sided,
@@ -111,27 +108,16 @@ class Scene:
         return self._native.instances(self._mesh_index(mesh))
 
     def _mesh_index(self, mesh: Any) -> int:
+        """The index as the native layer takes it (an i64); the core checks its range."""
         index = _int(mesh, "mesh", "an int (the index add_mesh returned)")
-        if not 0 <= index < self.mesh_count:
-            raise ValueError(f"mesh index {index} is out of range: the scene has {self.mesh_count} meshes")
-        return index
+        return max(min(index, _I64_MAX), -_I64_MAX)
 
     def add_light(self, direction: Sequence[float], color: Sequence[float] = (1.0, 1.0, 1.0), intensity: float = 1.0) -> int:
         """Adds a directional light travelling along `direction` (world space: L is
         -normalize(direction)) with linear RGB `color` times `intensity`; returns its index. With
         no light added, one white headlight travels along the camera's view direction."""
-        d = _vector(direction, 3, "direction")
-        if not np.any(d):
-            raise ValueError("light direction must be non-zero: it is the direction in which the light travels")
-        c = _vector(color, 3, "color")
-        if c.min() < 0:
-            raise ValueError(f"light color must be linear RGB >= 0, got {tuple(c)}")
-        i = _number(intensity, "intensity")
-        if i < 0:
-            raise ValueError(f"light intensity must be >= 0, got {i}")
-        if len(self.lights) >= _CONSTANTS["MAX_LIGHTS"]:
-            raise ValueError(f"a scene holds at most {_CONSTANTS['MAX_LIGHTS']} lights: merge some")
-        return self._native.add_light(tuple(d), tuple(c), i)
+        d, c = _vector(direction, 3, "direction"), _vector(color, 3, "color")
+        return self._native.add_light(tuple(d), tuple(c), _number(intensity, "intensity"))
 
     def clear_lights(self) -> None:
         """Removes every light added (the headlight shines again)."""
@@ -150,17 +136,11 @@ class Scene:
 
     @ambient.setter
     def ambient(self, rgb: Sequence[float]) -> None:
-        a = _vector(rgb, 3, "ambient")
-        if a.min() < 0:
-            raise ValueError(f"ambient must be linear RGB >= 0, got {tuple(a)}")
-        self._native.set_ambient(tuple(a))
+        self._native.set_ambient(tuple(_vector(rgb, 3, "ambient")))
 
     def set_mesh_alpha(self, mesh: int, alpha: float) -> None:
         """Sets every vertex alpha of one mesh."""
-        index = self._mesh_index(mesh)
-        if isinstance(alpha, (bool, np.bool_)) or not isinstance(alpha, (int, float, np.integer, np.floating)):
-            raise TypeError(f"alpha must be a number in [0, 1], got {type(alpha).__name__}")
-        self._native.set_mesh_alpha(index, float(alpha))
+        self._native.set_mesh_alpha(self._mesh_index(mesh), _number(alpha, "alpha"))
 
     @property
     def mesh_count(self) -> int:
@@ -260,29 +240,6 @@ class Scene:
                                   shading=shading, specular=specular, shininess=shininess, two_sided=two_sided)
             if transforms is not None:
                 self.set_instances(index, transforms)  # one identity instance leaves the scene uninstanced
-
-
-def _transforms(value: Any, name: str) -> np.ndarray:
-    """(n, 4, 4) float64 from (n, 4, 4) or (4, 4); affinity and finiteness are the core's checks."""
-    a = np.asarray(value)
-    if a.dtype == object or a.dtype == bool or not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)):
-        raise TypeError(f"{name} must be a float array of 4 x 4 matrices, got dtype {a.dtype}")
-    if a.shape == (4, 4):
-        a = a.reshape(1, 4, 4)
-    if a.ndim != 3 or a.shape[1:] != (4, 4):
-        raise ValueError(f"{name} must have shape (n, 4, 4) or (4, 4), got {a.shape}")
-    return np.ascontiguousarray(a, dtype=np.float64)
-
-
-def _instance_colors(value: Any, n: int) -> np.ndarray | None:
-    if value is None:
-        return None
-    c = _float_array(value, "colors")
-    if c.shape == (4,):
-        c = np.tile(c, (n, 1))
-    if c.shape != (n, 4):
-        raise ValueError(f"colors must have shape ({n}, 4) (one RGBA factor an instance) or (4,), got {c.shape}")
-    return np.ascontiguousarray(c)
 
 
 class Camera:
@@ -456,7 +413,7 @@ class Stats(TypedDict, total=False):
     instances: int  # instances drawn, over every mesh (a mesh added once counts one)
     peak_memory_bytes: int  # memory_bytes + target_bytes: all the frame allocated at once, within memory_budget
     adapter: str  # the adapter's name
-    extra: dict[str, float]  # method-specific (the schema lists them)
+    extra: dict[str, float]  # method-specific figures, each declared with its merge rule (oit._oit.extra_merge_rules())
     error_bound_max: float  # the largest of frame.error_bound, where the method derives one
 
 
@@ -497,14 +454,12 @@ class Renderer:
         if adapter is not None and not isinstance(adapter, str):
             raise TypeError(f"adapter must be a string (part of an adapter's name) or None, "
                             f"got {type(adapter).__name__}")
+        # Byte counts as the native layer takes them (i64; the core caps a binding limit at the
+        # adapter's and checks both).
         if max_binding_bytes is not None:
-            if _int(max_binding_bytes, "max_binding_bytes", "an int (bytes) or None") <= 0:
-                raise ValueError(f"max_binding_bytes must be positive, got {max_binding_bytes}")
-            max_binding_bytes = min(int(max_binding_bytes), _I64_MAX)  # the core caps it at the adapter's
+            max_binding_bytes = max(min(_int(max_binding_bytes, "max_binding_bytes", "an int (bytes) or None"), _I64_MAX), -_I64_MAX)
         if memory_budget is not None:
-            if _int(memory_budget, "memory_budget", "an int (bytes) or None") <= 0:
-                raise ValueError(f"memory_budget must be positive, got {memory_budget}")
-            memory_budget = min(int(memory_budget), _I64_MAX)
+            memory_budget = max(min(_int(memory_budget, "memory_budget", "an int (bytes) or None"), _I64_MAX), -_I64_MAX)
         self.width, self.height = int(width), int(height)
         # Sizes past u32 are past every adapter's largest texture: let the core say which
         # size is the largest, about the size asked for.

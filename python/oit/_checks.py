@@ -1,5 +1,6 @@
-"""Checks of the public API's arguments, shared by its classes and the scene files: each
-error names the argument and says what to do."""
+"""Conversions of the public API's arguments into what the native layer takes (dtypes, shapes,
+Python types), shared by its classes and the scene files; each error names the argument. The
+values are checked once, in the core (ranges, finiteness, index bounds, counts)."""
 
 from __future__ import annotations
 
@@ -16,9 +17,10 @@ def _float_array(value: Any, name: str) -> np.ndarray:
         raise TypeError(f"{name} must be a float array (float32 preferred), got dtype {a.dtype}")
     with np.errstate(over="ignore", invalid="ignore"):
         out = np.ascontiguousarray(a, dtype=np.float32)
-    if not np.isfinite(out).all():
+    if np.isfinite(a).all() and not np.isfinite(out).all():
+        # The conversion made it infinite: say so, since the core would see only the infinity.
         bad = np.argwhere(~np.isfinite(out))[0]
-        raise ValueError(f"{name} has a NaN or Inf (or a value too large for float32) at index {tuple(int(i) for i in bad)}")
+        raise ValueError(f"{name} has a value too large for float32 at index {tuple(int(i) for i in bad)}")
     return out
 
 
@@ -44,10 +46,7 @@ _I64_MAX = 2 ** 63 - 1
 def _number(value: Any, name: str) -> float:
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise TypeError(f"{name} must be a number, got {type(value).__name__}")
-    v = float(value)
-    if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {v}")
-    return v
+    return float(value)
 
 
 def _vector(value: Any, n: int, name: str) -> np.ndarray:
@@ -70,11 +69,7 @@ def _texture(texture: Any) -> np.ndarray:
         out = t.astype(np.float64) / 255.0
         out[..., :3] = srgb_to_linear(out[..., :3])
         return np.ascontiguousarray(out, dtype=np.float32)
-    out = _float_array(t, "texture")
-    if out.min() < 0.0 or out.max() > 1.0:
-        raise ValueError(f"a float texture must be linear RGBA in [0, 1], got values in [{out.min():g}, {out.max():g}]: "
-                         "clip it, or pass uint8 sRGB")
-    return out
+    return _float_array(t, "texture")
 
 
 def _surface(n: int, normals: Any, uvs: Any, texture: Any, shading: str | None, specular: float, shininess: float,
@@ -82,35 +77,18 @@ def _surface(n: int, normals: Any, uvs: Any, texture: Any, shading: str | None, 
     """The keyword arguments of the native add_mesh that describe the surface, checked."""
     out: dict[str, Any] = {}
     if normals is not None:
-        nrm = _float_array(normals, "normals")
-        if nrm.shape != (n, 3):
-            raise ValueError(f"normals must have shape ({n}, 3) (one per vertex), got {nrm.shape}")
-        zero = np.flatnonzero(~np.any(nrm, axis=1))
-        if len(zero):
-            raise ValueError(f"normals[{zero[0]}] is zero: pass unit vertex normals, or none to have them computed")
-        out["normals"] = nrm
+        out["normals"] = _rows(_float_array(normals, "normals"), 3, "normals")
     if uvs is not None:
-        uv = _float_array(uvs, "uvs")
-        if uv.shape != (n, 2):
-            raise ValueError(f"uvs must have shape ({n}, 2) (one (u, v) per vertex), got {uv.shape}")
-        out["uvs"] = uv
+        out["uvs"] = _rows(_float_array(uvs, "uvs"), 2, "uvs")
     if texture is not None:
-        if uvs is None:
-            raise ValueError("a texture needs uvs: pass one (u, v) per vertex")
         out["texture"] = _texture(texture)
     if shading is None:
         shading = "smooth" if normals is not None else "unlit"
-    if not isinstance(shading, str) or shading not in SHADINGS:
-        raise ValueError(f"shading must be one of {SHADINGS}, got {shading!r}")
+    if not isinstance(shading, str):
+        raise TypeError(f"shading must be one of {SHADINGS}, got {shading!r}")
     out["shading"] = shading
     for name, v in (("specular", specular), ("shininess", shininess), ("opacity", opacity)):
         out[name] = _number(v, name)
-    if out["specular"] < 0:
-        raise ValueError(f"specular must be >= 0, got {specular}")
-    if out["shininess"] <= 0:
-        raise ValueError(f"shininess must be > 0, got {shininess}")
-    if not 0.0 <= out["opacity"] <= 1.0:
-        raise ValueError(f"opacity must be in [0, 1], got {opacity}")
     if not isinstance(two_sided, (bool, np.bool_)):
         raise TypeError(f"two_sided must be a bool, got {type(two_sided).__name__}")
     out["two_sided"] = bool(two_sided)
@@ -118,3 +96,24 @@ def _surface(n: int, normals: Any, uvs: Any, texture: Any, shading: str | None, 
         raise TypeError(f"cull_back_faces must be a bool, got {type(cull_back_faces).__name__}")
     out["cull_back_faces"] = bool(cull_back_faces)
     return out
+
+
+def _transforms(value: Any, name: str) -> np.ndarray:
+    """(n, 4, 4) float64 from (n, 4, 4) or (4, 4); affinity and finiteness are the core's checks."""
+    a = np.asarray(value)
+    if a.dtype == object or a.dtype == bool or not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)):
+        raise TypeError(f"{name} must be a float array of 4 x 4 matrices, got dtype {a.dtype}")
+    if a.shape == (4, 4):
+        a = a.reshape(1, 4, 4)
+    if a.ndim != 3 or a.shape[1:] != (4, 4):
+        raise ValueError(f"{name} must have shape (n, 4, 4) or (4, 4), got {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _instance_colors(value: Any, n: int) -> np.ndarray | None:
+    if value is None:
+        return None
+    c = _float_array(value, "colors")
+    if c.shape == (4,):
+        c = np.tile(c, (n, 1))
+    return np.ascontiguousarray(_rows(c, 4, "colors"))

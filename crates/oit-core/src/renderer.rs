@@ -182,7 +182,7 @@ impl Renderer {
     /// (never more than it really does). Methods are rebuilt.
     pub fn set_max_binding_bytes(&mut self, bytes: u64) -> Result<()> {
         if bytes < 256 {
-            return Err(invalid!("max_binding_bytes must be at least 256, got {bytes}"));
+            return Err(invalid!("max_binding_bytes must be at least 256 bytes, got {bytes}"));
         }
         self.limits.max_binding_bytes = bytes.min(self.gpu.max_binding_bytes());
         self.methods.clear();

@@ -253,9 +253,20 @@ impl Scene {
         self.meshes.len() - 1
     }
 
+    /// `mesh` as the index of one of the scene's meshes (what `add_mesh` returned), or an error
+    /// that says how many there are; callers with signed indices (Python) pass them as they are.
+    pub fn mesh_index(&self, mesh: i64) -> Result<usize> {
+        let count = self.meshes.len();
+        usize::try_from(mesh)
+            .ok()
+            .filter(|&i| i < count)
+            .ok_or_else(|| invalid!("mesh index {mesh} is out of range: the scene has {count} meshes (add_mesh returns the index to pass)"))
+    }
+
     /// Appends instances to mesh `mesh`; returns the index of the first one added.
     pub fn add_instances(&mut self, mesh: usize, instances: &[Instance]) -> Result<usize> {
-        let list = self.instances.get_mut(mesh).ok_or_else(|| invalid!("no mesh {mesh}: add_mesh returns the index to pass"))?;
+        let mesh = self.mesh_index(mesh as i64)?;
+        let list = &mut self.instances[mesh];
         list.extend_from_slice(instances);
         self.revision += 1;
         Ok(list.len() - instances.len())
@@ -263,8 +274,8 @@ impl Scene {
 
     /// Replaces the instances of mesh `mesh`.
     pub fn set_instances(&mut self, mesh: usize, instances: Vec<Instance>) -> Result<()> {
-        let list = self.instances.get_mut(mesh).ok_or_else(|| invalid!("no mesh {mesh}: add_mesh returns the index to pass"))?;
-        *list = instances;
+        let mesh = self.mesh_index(mesh as i64)?;
+        self.instances[mesh] = instances;
         self.revision += 1;
         Ok(())
     }
@@ -314,7 +325,8 @@ impl Scene {
         if !(0.0..=1.0).contains(&alpha) {
             return Err(invalid!("alpha {alpha} is outside [0, 1]"));
         }
-        let m = self.meshes.get_mut(mesh).ok_or_else(|| invalid!("no mesh {mesh}"))?;
+        let mesh = self.mesh_index(mesh as i64)?;
+        let m = &mut self.meshes[mesh];
         m.colors.iter_mut().for_each(|c| c[3] = alpha);
         self.revision += 1;
         Ok(())

@@ -86,13 +86,7 @@ pub const SCHEMA: &[StatKey] = &[
     key("instances", "int", "instances drawn, over every mesh (a mesh added once counts one)"),
     key("peak_memory_bytes", "int", "memory_bytes + target_bytes: all the frame allocated at once, within memory_budget"),
     key("adapter", "str", "the adapter's name"),
-    key(
-        "extra",
-        "dict[str, float]",
-        "method-specific: pool_nodes, pool_regrown, resolve_sweeps (list methods); tail_fragments (k-TAB methods); \
-         geometry_passes, peeled_fragments (peeling); auto_k, auto_mean_k, auto_slots, auto_predicted_k, auto_exact, \
-         auto_attempts (auto)",
-    ),
+    key("extra", "dict[str, float]", "method-specific figures, each declared with its merge rule (oit._oit.extra_merge_rules())"),
     key("error_bound_max", "float", "the largest of frame.error_bound, where the method derives one"),
 ];
 

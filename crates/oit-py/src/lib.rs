@@ -11,7 +11,10 @@ use pyo3::types::{PyDict, PyList};
 
 use oit_core::{OitError, ParamKind, ParamValue};
 
+mod convert;
 mod load;
+
+use convert::{instances, matrix, rows, InstanceArrays};
 
 struct Error(OitError);
 
@@ -33,57 +36,6 @@ impl From<Error> for PyErr {
 }
 
 type Res<T> = Result<T, Error>;
-
-fn rows<T: Copy + numpy::Element, const N: usize>(a: &PyReadonlyArray2<'_, T>, name: &str) -> PyResult<Vec<[T; N]>> {
-    let shape = a.as_array().shape().to_vec();
-    if shape[1] != N {
-        return Err(PyValueError::new_err(format!("{name} must have shape (n, {N}), got {shape:?}")));
-    }
-    let flat: Vec<T> = a.as_array().iter().copied().collect();
-    Ok(flat.chunks_exact(N).map(|c| c.try_into().expect("chunk of N")).collect())
-}
-
-fn matrix(m: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<[[f64; 4]; 4]> {
-    let a = m.as_array();
-    if a.shape() != [4, 4] {
-        return Err(PyValueError::new_err(format!("{name} must be 4 x 4, got {:?}", a.shape())));
-    }
-    let mut out = [[0.0; 4]; 4];
-    for r in 0..4 {
-        for c in 0..4 {
-            out[r][c] = a[[r, c]];
-        }
-    }
-    Ok(out)
-}
-
-/// Transforms (n, 4, 4) and color factors (n, 4), as numpy arrays.
-type InstanceArrays<'py> = (Bound<'py, numpy::PyArray3<f64>>, Bound<'py, numpy::PyArray2<f32>>);
-
-/// Instances from transforms (n, 4, 4) and optional color factors (n, 4).
-fn instances(transforms: &PyReadonlyArray3<'_, f64>, colors: Option<&PyReadonlyArray2<'_, f32>>) -> PyResult<Vec<oit_core::Instance>> {
-    let t = transforms.as_array();
-    let n = t.shape()[0];
-    if t.shape()[1..] != [4, 4] {
-        return Err(PyValueError::new_err(format!("transforms must have shape (n, 4, 4), got {:?}", t.shape())));
-    }
-    let colors: Vec<[f32; 4]> = match colors {
-        Some(c) => rows(c, "instance colors")?,
-        None => vec![[1.0; 4]; n],
-    };
-    if colors.len() != n {
-        return Err(PyValueError::new_err(format!(
-            "colors has {} rows but transforms has {n}: pass one RGBA factor an instance",
-            colors.len()
-        )));
-    }
-    (0..n)
-        .map(|i| {
-            let rows: [[f64; 4]; 4] = std::array::from_fn(|r| std::array::from_fn(|c| t[[i, r, c]]));
-            oit_core::Instance::from_rows(rows, colors[i]).map_err(|e| PyValueError::new_err(format!("instance {i}: {e}")))
-        })
-        .collect()
-}
 
 /// Meshes in submission order (validated on the way in).
 #[pyclass(module = "oit._oit")]
@@ -161,7 +113,7 @@ impl Scene {
     #[pyo3(signature = (mesh, transforms, colors=None))]
     fn add_instances(
         &mut self,
-        mesh: usize,
+        mesh: i64,
         transforms: PyReadonlyArray3<'_, f64>,
         colors: Option<PyReadonlyArray2<'_, f32>>,
     ) -> PyResult<usize> {
@@ -173,7 +125,7 @@ impl Scene {
     #[pyo3(signature = (mesh, transforms, colors=None))]
     fn set_instances(
         &mut self,
-        mesh: usize,
+        mesh: i64,
         transforms: PyReadonlyArray3<'_, f64>,
         colors: Option<PyReadonlyArray2<'_, f32>>,
     ) -> PyResult<()> {
@@ -182,7 +134,7 @@ impl Scene {
     }
 
     /// Transforms (n, 4, 4) row-major and color factors (n, 4) of mesh `mesh`'s instances.
-    fn instances<'py>(&self, py: Python<'py>, mesh: usize) -> PyResult<InstanceArrays<'py>> {
+    fn instances<'py>(&self, py: Python<'py>, mesh: i64) -> PyResult<InstanceArrays<'py>> {
         let list = self.inner.instances(self.mesh_index(mesh)?);
         let t: Vec<f64> = list.iter().flat_map(|i| i.transform.transpose().to_cols_array()).collect();
         let c: Vec<f32> = list.iter().flat_map(|i| i.color).collect();
@@ -221,11 +173,7 @@ impl Scene {
     }
 
     fn set_mesh_alpha(&mut self, mesh: i64, alpha: f32) -> Res<()> {
-        let count = self.inner.meshes().len();
-        let index = usize::try_from(mesh)
-            .ok()
-            .filter(|&i| i < count)
-            .ok_or_else(|| OitError::InvalidInput(format!("mesh index {mesh} is out of range: the scene has {count} meshes")))?;
+        let index = self.inner.mesh_index(mesh)?;
         Ok(self.inner.set_mesh_alpha(index, alpha)?)
     }
 
@@ -269,12 +217,8 @@ impl Scene {
 }
 
 impl Scene {
-    fn mesh_index(&self, mesh: usize) -> PyResult<usize> {
-        let count = self.inner.meshes().len();
-        if mesh >= count {
-            return Err(PyValueError::new_err(format!("mesh index {mesh} is out of range: the scene has {count} meshes")));
-        }
-        Ok(mesh)
+    fn mesh_index(&self, mesh: i64) -> PyResult<usize> {
+        Ok(self.inner.mesh_index(mesh).map_err(Error::from)?)
     }
 }
 
@@ -365,13 +309,14 @@ impl Renderer {
         py.detach(|| {
             let context = oit_core::shared_context(adapter.as_deref())?;
             let mut inner = oit_core::Renderer::new(context.clone(), w, h)?;
+            // The core checks both limits; a negative count (which u64 cannot hold) is below
+            // either, and is refused in the core's words.
+            let below = |what: &str, least: u32, b: i64| OitError::InvalidInput(format!("{what} must be at least {least} bytes, got {b}"));
             if let Some(b) = max_binding_bytes {
-                let b = u64::try_from(b).map_err(|_| OitError::InvalidInput(format!("max_binding_bytes must be positive, got {b}")))?;
-                inner.set_max_binding_bytes(b)?;
+                inner.set_max_binding_bytes(u64::try_from(b).map_err(|_| below("max_binding_bytes", 256, b))?)?;
             }
             if let Some(b) = memory_budget {
-                let b = u64::try_from(b).map_err(|_| OitError::InvalidInput(format!("memory_budget must be positive, got {b}")))?;
-                inner.set_memory_budget(Some(b))?;
+                inner.set_memory_budget(Some(u64::try_from(b).map_err(|_| below("memory_budget", 1024, b))?))?;
             }
             Ok(Self { inner: Mutex::new(inner), context })
         })

@@ -1,0 +1,60 @@
+//! numpy arrays into the core's types: rows of N values, 4 x 4 matrices, instance lists. Shapes
+//! are checked here, where the arrays are taken apart; their values are the core's to check.
+
+use numpy::{PyReadonlyArray2, PyReadonlyArray3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+pub(crate) fn rows<T: Copy + numpy::Element, const N: usize>(a: &PyReadonlyArray2<'_, T>, name: &str) -> PyResult<Vec<[T; N]>> {
+    let shape = a.as_array().shape().to_vec();
+    if shape[1] != N {
+        return Err(PyValueError::new_err(format!("{name} must have shape (n, {N}), got {shape:?}")));
+    }
+    let flat: Vec<T> = a.as_array().iter().copied().collect();
+    Ok(flat.chunks_exact(N).map(|c| c.try_into().expect("chunk of N")).collect())
+}
+
+pub(crate) fn matrix(m: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<[[f64; 4]; 4]> {
+    let a = m.as_array();
+    if a.shape() != [4, 4] {
+        return Err(PyValueError::new_err(format!("{name} must be 4 x 4, got {:?}", a.shape())));
+    }
+    let mut out = [[0.0; 4]; 4];
+    for r in 0..4 {
+        for c in 0..4 {
+            out[r][c] = a[[r, c]];
+        }
+    }
+    Ok(out)
+}
+
+/// Transforms (n, 4, 4) and color factors (n, 4), as numpy arrays.
+pub(crate) type InstanceArrays<'py> = (Bound<'py, numpy::PyArray3<f64>>, Bound<'py, numpy::PyArray2<f32>>);
+
+/// Instances from transforms (n, 4, 4) and optional color factors (n, 4).
+pub(crate) fn instances(
+    transforms: &PyReadonlyArray3<'_, f64>,
+    colors: Option<&PyReadonlyArray2<'_, f32>>,
+) -> PyResult<Vec<oit_core::Instance>> {
+    let t = transforms.as_array();
+    let n = t.shape()[0];
+    if t.shape()[1..] != [4, 4] {
+        return Err(PyValueError::new_err(format!("transforms must have shape (n, 4, 4), got {:?}", t.shape())));
+    }
+    let colors: Vec<[f32; 4]> = match colors {
+        Some(c) => rows(c, "instance colors")?,
+        None => vec![[1.0; 4]; n],
+    };
+    if colors.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "colors has {} rows but transforms has {n}: pass one RGBA factor an instance",
+            colors.len()
+        )));
+    }
+    (0..n)
+        .map(|i| {
+            let rows: [[f64; 4]; 4] = std::array::from_fn(|r| std::array::from_fn(|c| t[[i, r, c]]));
+            oit_core::Instance::from_rows(rows, colors[i]).map_err(|e| PyValueError::new_err(format!("instance {i}: {e}")))
+        })
+        .collect()
+}
