@@ -9,6 +9,12 @@
 //                 (tail = "blend": faster, order-dependent in float rounding).
 //   fs_final      full screen: eqs. 7-11 over the opaque scene or background (fs_final_blend
 //                 reads the blended targets).
+// With COMPACT (tail = "compact", Eq. 12's 2k + 2 words a pixel), fs_clear zeroes the tile's
+// output, fs_shade_compact blends the core's C * v into the output and the tail's sums into one
+// RGBA16F target, and fs_final_compact adds the rest over the output: there is no accumulator
+// buffer (group 2's binding 2 is the census counts, which give the tail count), the nearest
+// evicted key lives in the first slot's visibility word (the transmittance in front of the
+// first slot is always 1), and T_core is computed again from the keys.
 // Keys, ties and error bounds: docs/methods.md ("hybrid").
 //!include common/scene.wgsl
 //!include common/targets.wgsl
@@ -27,7 +33,9 @@ const TAIL_HI: u32 = 17u;    // largest tail color channel (f32 bits)
 const ACCUM_WORDS: u32 = HYBRID_ACCUM_WORDS;
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
-@group(2) @binding(1) var<storage, read_write> vis: array<f32>;
+// Transmittance in front of each core slot, as f32 bits (the first slot's word: see front_trans).
+@group(2) @binding(1) var<storage, read_write> vis: array<atomic<u32>>;
+// The accumulators; with COMPACT, the census counts, a fragment count a pixel.
 @group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
 @group(2) @binding(4) var<storage, read_write> overflow: atomic<u32>;
 // With PER_PIXEL, pixel px owns slots offsets[px] .. offsets[px + 1] (a prefix sum of each
@@ -44,6 +52,31 @@ fn slots(px: u32) -> vec2<u32> {
 }
 //!include common/fixed.wgsl
 //!include common/alpha8.wgsl
+
+// The transmittance in front of core slot i of the pixel whose slots start at `base`: 1 in
+// front of the first, so that its word is free for the evicted key (COMPACT).
+fn front_trans(base: u32, i: u32) -> f32 {
+    if i == 0u {
+        return 1.0;
+    }
+    return bitcast<f32>(atomicLoad(&vis[base + i]));
+}
+
+// The nearest key pushed out of pixel px's full table (0: none), kept by atomicMax.
+fn raise_evicted(px: u32, v: u32) {
+    if COMPACT != 0u {
+        atomicMax(&vis[slots(px).x], v);
+    } else {
+        atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
+    }
+}
+
+fn evicted_key(px: u32) -> u32 {
+    if COMPACT != 0u {
+        return atomicLoad(&vis[slots(px).x]);
+    }
+    return atomicLoad(&accum[px * ACCUM_WORDS + EVICTED]);
+}
 
 // 24-bit depth over 8-bit alpha, inverted so that a cleared (zero) slot is empty and
 // atomicMax keeps the nearest: a larger key is a nearer fragment (lower alpha first on ties).
@@ -67,14 +100,14 @@ fn fs_store(raw: VsOut) {
     let base = sl.x;
     var v = pack_key(in.clip.z, in.color.a);
     if sl.y == 0u {
-        atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
+        raise_evicted(px, v);
         return;
     }
     // Slots only ever grow (atomicMax), so a key not above a full table's last one now will
     // not be in the final table: record it as evicted without walking the table.
     let last = atomicLoad(&ktab[base + sl.y - 1u]);
     if last != 0u && v <= last {
-        atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
+        raise_evicted(px, v);
         return;
     }
     for (var i = 0u; i < sl.y; i++) {
@@ -84,7 +117,7 @@ fn fs_store(raw: VsOut) {
         }
         v = min(old, v); // the farther of the two moves on
     }
-    atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
+    raise_evicted(px, v);
 }
 
 // The smallest key that counts as core. Every stored key does, except when a fragment with
@@ -96,7 +129,7 @@ fn core_bound(px: u32) -> u32 {
         return 0xffffffffu; // no slots: nothing is core
     }
     let last = atomicLoad(&ktab[sl.x + sl.y - 1u]);
-    let evicted = atomicLoad(&accum[px * ACCUM_WORDS + EVICTED]);
+    let evicted = evicted_key(px);
     return select(last, last + 1u, evicted != 0u && evicted == last);
 }
 
@@ -124,10 +157,24 @@ fn cs_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = core_slots(px);
     var t = 1.0;
     for (var i = 0u; i < n; i++) {
-        vis[base + i] = t; // transmittance in front of slot i: v_i = alpha_i * t (eq. 2)
+        if i > 0u {
+            atomicStore(&vis[base + i], bitcast<u32>(t)); // in front of slot i: v_i = alpha_i * t (eq. 2)
+        }
         t *= 1.0 - key_alpha(atomicLoad(&ktab[base + i]));
     }
-    atomicStore(&accum[px * ACCUM_WORDS + T_CORE], bitcast<u32>(t));
+    if COMPACT == 0u {
+        atomicStore(&accum[px * ACCUM_WORDS + T_CORE], bitcast<u32>(t));
+    }
+}
+
+// T_core of pixel px from its n core keys, as cs_visibility computes it (COMPACT keeps no word).
+fn core_trans(px: u32, n: u32) -> f32 {
+    let base = slots(px).x;
+    var t = 1.0;
+    for (var i = 0u; i < n; i++) {
+        t *= 1.0 - key_alpha(atomicLoad(&ktab[base + i]));
+    }
+    return t;
 }
 
 // Where a fragment of pixel px with depth z and alpha a goes: the core, with the weight of its
@@ -160,7 +207,7 @@ fn place(px: u32, z: f32, a: f32) -> Placed {
         if m > 0u {
             // m fragments share one quantized key: they share the visibility of their slots.
             let share = select((1.0 - pow(1.0 - a, f32(m))) / f32(m), a, m == 1u);
-            let v = vis[base + lo];
+            let v = front_trans(base, lo);
             return Placed(true, v * share, v, abs(a - key_alpha(key)));
         }
     }
@@ -280,4 +327,53 @@ fn fs_final_blend(@builtin(position) pos: vec4<f32>) -> Final {
     // relative to the sum; eqs. 7-10 move the tail by at most 3 such relative errors.
     let rounding = 3.0 * f32(count) * 5.96e-8 * t_core;
     return finish(pos, core.rgb, t_core, count, tail, quant.xy, lo_hi, rounding);
+}
+
+// tail = "compact": the tile's output starts at zero, the shade pass adds the core's C * v to
+// it and the tail's C * alpha and alpha to an RGBA16F target, and fs_final_compact adds the rest.
+@fragment
+fn fs_clear(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(0.0);
+}
+
+struct ShadeCompact {
+    @location(0) core: vec4<f32>,
+    @location(1) tail: vec4<f32>,
+}
+
+@fragment @early_depth_test(force)
+fn fs_shade_compact(raw: VsOut) -> ShadeCompact {
+    let in = shaded(raw);
+    if behind_opaque(in.clip) || in.color.a <= 0.0 {
+        discard;
+    }
+    let p = place(pixel_index(in.clip), in.clip.z, in.color.a);
+    if p.core {
+        return ShadeCompact(vec4<f32>(in.color.rgb * p.w, 0.0), vec4<f32>(0.0));
+    }
+    return ShadeCompact(vec4<f32>(0.0), vec4<f32>(in.color.rgb * in.color.a, in.color.a));
+}
+
+@group(3) @binding(4) var compact_sums: texture_2d<f32>;
+
+// Half-float unit roundoff: each blended RGBA16F sum of n terms is within n 2^-11 of its value
+// relative to the sum.
+const HALF_ROUNDOFF: f32 = 0.00048828125;
+
+// Eq. 11 without the core color, which is in the output already (blended in by adding), and
+// the error bound. The tail count is the census count less the core's fragments (so alpha-0
+// fragments, which the other tails skip, count in it); the quantization sums are bounded by
+// their largest values (each core alpha within ALPHA_8BIT_ERROR of its key's, each
+// transmittance at most 1) and the tail's colors by [0, 1], as no word keeps them.
+@fragment
+fn fs_final_compact(@builtin(position) pos: vec4<f32>) -> Final {
+    let px = pixel_index(pos);
+    let n = core_slots(px);
+    let t_core = core_trans(px, n);
+    let count = atomicLoad(&accum[px]) - n;
+    let sums = textureLoad(compact_sums, vec2<i32>(pos.xy), 0);
+    let tail = tail_from_sums(sums.rgb, sums.a, count);
+    let d = f32(n) * ALPHA_8BIT_ERROR;
+    let rounding = 3.0 * f32(count) * HALF_ROUNDOFF * t_core;
+    return finish(pos, vec3<f32>(0.0), t_core, count, tail, vec2<f32>(d, d), vec2<f32>(0.0, 1.0), rounding);
 }

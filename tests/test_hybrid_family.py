@@ -263,9 +263,62 @@ def test_blended_tail_depends_on_order_only_within_its_rounding(renderer):
         assert (np.abs(frame.image - ref)[..., :3] <= frame.error_bound + 1e-6).all()
 
 
+# tail="compact" (docs/methods.md, "hybrid"): Eq. 12's 2k + 2 words a pixel. The tail's three
+# sums are RGBA16F blends, each within n 2^-11 of its value relative to the sum (half-float unit
+# roundoff), so eqs. 7-10 move the tail by at most 3 n 2^-11; the count comes from the census.
+HALF = 2.0**-11
+
+
+@pytest.mark.parametrize("alphas", ["random", "worst"])
+@pytest.mark.parametrize("k", [1, 4])
+def test_compact_tail_matches_the_model_within_half_float_sums(renderer, k, alphas):
+    layers = 100
+    built = stacks(layers=layers, alphas=alphas, size=(6, 6), seed=layers)
+    frame = renderer(6, 6).render(built.scene, built.camera, "hybrid", background=tuple(BG), k=k, tail="compact")
+    want = model_image(built, "hybrid", {"k": k})
+    assert np.abs(frame.image.reshape(-1, 4) - want).max() <= 2e-6 + 3 * layers * HALF
+    assert frame.stats["census"] and frame.stats["params"]["tail"] == "compact"
+    exact = renderer(6, 6).render(built.scene, built.camera, "hybrid", background=tuple(BG), k=k)
+    assert frame.stats["overflow_fragments"] == exact.stats["overflow_fragments"]
+
+
+@pytest.mark.parametrize("k", [1, 8, 32])
+def test_compact_tail_keeps_eq_12s_words(renderer, k):
+    built = stacks(layers=40, alphas="random", size=(8, 6), seed=2)
+    frame = renderer(8, 6).render(built.scene, built.camera, "hybrid", k=k, tail="compact")
+    assert frame.stats["memory_bytes"] == memory_bytes("hybrid", 8, 6, k=k, tail="compact") == 8 * 6 * (2 * k + 2) * 4 + 8
+    assert memory_bytes("hybrid", 8, 6, k=k) == 8 * 6 * (2 * k + 18) * 4 + 4
+
+
+def test_compact_tail_depends_on_order_only_within_its_rounding(renderer):
+    meshes = random_meshes(7, transparent=12, opaque=1, triangles=8, space="ndc", spread=0.9)
+    r = renderer(40, 40)
+    bg = (0.3, 0.3, 0.3)
+    first = r.render(build_scene(meshes), IDENTITY, "hybrid", background=bg, k=2, tail="compact")
+    n = first.stats["max_depth_complexity"]
+    assert first.stats["overflow_fragments"] > 0  # a tail to sum
+    ref = r.render(build_scene(meshes), IDENTITY, "abuffer", background=bg).image
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        shuffled = [meshes[i].shuffled(rng) for i in rng.permutation(len(meshes))]
+        frame = r.render(build_scene(shuffled), IDENTITY, "hybrid", background=bg, k=2, tail="compact")
+        # The tail's half-float sums, and the core's float32 sums (k terms) in the output.
+        assert np.abs(frame.image - first.image).max() <= 2 * 3 * n * HALF + 2 * 2 * 2.0**-24
+        assert (np.abs(frame.image - ref)[..., :3] <= frame.error_bound + 1e-6).all()
+
+
+def test_compact_tail_in_tiles_is_the_untiled_frame(renderer):
+    built = oit.scenes.hair(strands=300)
+    whole = renderer(64, 48).render(built.scene, built.camera, "hybrid", k=4, tail="compact")
+    budget = whole.stats["target_bytes"] + whole.stats["memory_bytes"] // 3
+    tiled = oit.Renderer(64, 48, memory_budget=budget).render(built.scene, built.camera, "hybrid", k=4, tail="compact")
+    assert tiled.stats["tiles"] > 1 and tiled.stats["peak_memory_bytes"] <= budget
+    assert np.abs(tiled.image - whole.image).max() <= 1e-6
+
+
 def test_tail_must_be_exact_or_blend(renderer):
     built = stacks(layers=4, alphas="random", size=(2, 2), seed=1)
-    with pytest.raises(ValueError, match="exact, blend"):
+    with pytest.raises(ValueError, match="exact, blend, compact"):
         renderer(2, 2).render(built.scene, built.camera, "hybrid", tail="fast")
     with pytest.raises(ValueError, match="no parameter 'tail'"):
         renderer(2, 2).render(built.scene, built.camera, "ktab", tail="blend")

@@ -23,6 +23,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("K", 8),
     Const::U32("PER_PIXEL", 0),
     Const::U32("TAIL", 1),
+    Const::U32("COMPACT", 0),
     Const::U32("WEIGHT", 10),
     Const::U32("NODES", 8),
     Const::U32("NODES_PLUS_ONE", 9),

@@ -2,7 +2,7 @@
 //! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
 use super::frame::{FrameCtx, Limits, Method, MethodReport};
-use super::info::{AntialiasMode, ErrorBound, Memory, MethodInfo, Order, Tiling};
+use super::info::{never, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, Tiling};
 use super::list_pipelines::{swept, FRAME, SAMPLES};
 use super::lists::{state_words, Aux, ListLayout, ListMethod, PIXEL_BYTES, STATE_WORDS};
 use crate::cache::PipelineSpec;
@@ -27,6 +27,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
     census: true,
+    census_when: never,
     main: None,
     pipelines: &[PIPELINES, COVERAGE],
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),

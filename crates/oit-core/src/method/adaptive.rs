@@ -4,7 +4,7 @@
 //! order and composites every fragment by it (shaders/adaptive_lists.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::list_pipelines::{single, FRAME};
 use super::lists::{check_replay_budget, Aux, ListLayout, ListMethod};
 use super::params::{ParamInfo, ParamKind};
@@ -33,6 +33,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Storage { per_pixel: 4, per_fragment: 32, per_triangle: 0 },
     census: true,
+    census_when: never,
     main: Some("nodes"),
     pipelines: &[PIPELINES],
     create: |gpu, limits| {

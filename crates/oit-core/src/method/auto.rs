@@ -9,7 +9,7 @@
 //! predicted to meet t, the A-buffer is rendered directly.
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::ktab::{self, KTab, Slots};
 use super::params::{ParamInfo, ParamKind, Params};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -48,6 +48,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Storage { per_pixel: 96, per_fragment: 24, per_triangle: 0 },
     census: true,
+    census_when: never,
     main: None,
     pipelines: &[PIPELINES, ktab::PIPELINES],
     create: |gpu, limits| Box::new(Auto::new(gpu, limits)),

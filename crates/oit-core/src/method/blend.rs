@@ -2,7 +2,7 @@
 //! submission order or per mesh back to front by centroid (docs/methods.md).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use crate::bindings::COLOR_FORMAT;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -23,6 +23,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    census_when: never,
     main: None,
     pipelines: &[PIPELINES],
     create: |_, _| Box::new(Blend { kind: Kind::Unsorted }),

@@ -3,7 +3,7 @@
 //! kept, the others dropped and counted (shaders/bucket_peeling.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -24,6 +24,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    census_when: never,
     main: Some("buckets"),
     pipelines: &[PIPELINES],
     create: |_, _| Box::new(Buckets { buffers: None, dropped: None }),

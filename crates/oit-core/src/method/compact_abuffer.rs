@@ -4,7 +4,7 @@
 //! shades each fragment from it, deferred (shaders/compact_abuffer.wgsl, docs/shading.md).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::list_pipelines::{swept_after, FRAME};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{PIXEL_BYTES, STATE_WORDS};
@@ -28,6 +28,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 12, per_triangle: 176 },
     census: true,
+    census_when: never,
     main: None,
     pipelines: &[PIPELINES],
     create: |gpu, limits| {

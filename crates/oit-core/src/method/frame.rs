@@ -122,6 +122,17 @@ impl<'a> FrameCtx<'a> {
         self.render_pipeline(spec.render(consts, Draw::Fullscreen, resolve_targets(bound)))
     }
 
+    /// A full-screen resolve of `spec` that adds its color to the output (fixed-function
+    /// additive blending) and writes the error bound.
+    pub fn resolve_pipeline_adding(&self, spec: &PipelineSpec, consts: &[Const]) -> wgpu::RenderPipeline {
+        self.check_targets(spec);
+        let mut targets = resolve_targets(true);
+        if let Some(Some(out)) = targets.first_mut() {
+            out.blend = Some(wgpu::BlendState { color: super::accum::ADD, alpha: super::accum::ADD });
+        }
+        self.render_pipeline(spec.render(consts, Draw::Fullscreen, targets))
+    }
+
     /// A compute pipeline of `spec` over the shared groups and the method's.
     pub fn compute_pipeline(&self, spec: &PipelineSpec, consts: &[Const]) -> wgpu::ComputePipeline {
         self.check_targets(spec);

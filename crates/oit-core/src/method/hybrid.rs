@@ -3,8 +3,8 @@
 
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::ktab::{memory_bytes, KTab, Slots, Sums};
-use super::params::{ParamInfo, ParamKind};
+use super::ktab::{compact_memory_bytes, memory_bytes, KTab, Slots, Sums};
+use super::params::{ParamInfo, ParamKind, ParamValue};
 use crate::error::Result;
 
 const K_PARAM: ParamInfo = ParamInfo {
@@ -15,9 +15,11 @@ const K_PARAM: ParamInfo = ParamInfo {
 
 const TAIL_PARAM: ParamInfo = ParamInfo {
     name: "tail",
-    kind: ParamKind::Choice { choices: &["exact", "blend"], default: "exact" },
+    kind: ParamKind::Choice { choices: &["exact", "blend", "compact"], default: "exact" },
     doc: "how the second pass sums core and tail: 'exact' by fixed-point atomics (bit-identical under any order), \
-          'blend' by float blending as in the paper (faster; order changes the rounding, docs/methods.md)",
+          'blend' by float blending as in the paper (faster; order changes the rounding), 'compact' by blending into \
+          the output and one RGBA16F target at Eq. 12's 2k + 2 words a pixel, the tail count from the census \
+          (docs/methods.md)",
 };
 
 pub const HYBRID: MethodInfo = MethodInfo {
@@ -34,6 +36,7 @@ pub const HYBRID: MethodInfo = MethodInfo {
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Formula,
     census: false,
+    census_when: |p| p.0.get("tail").is_some_and(|t| matches!(t, ParamValue::Str(s) if s == "compact")),
     main: Some("k"),
     pipelines: &[super::ktab::PIPELINES],
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
@@ -44,11 +47,22 @@ pub const KTAB: MethodInfo = MethodInfo {
     summary: "k-TAB: the k nearest fragments composited exactly, the others discarded (hybrid's core alone)",
     passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core (geometry)", "final composite (full screen)"],
     params: &[K_PARAM],
+    census_when: super::info::never,
     create: |_, _| Box::new(Hybrid(KTab::new(false))),
     ..HYBRID
 };
 
-const MEMORY: Memory = Memory::Frame { formula: "W·H·(2k + 18)·4 + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) };
+const MEMORY: Memory = Memory::Frame {
+    formula: "W·H·(2k + 18)·4 + 4 (tail = 'compact': W·H·(2k + 2)·4 + 8)",
+    bytes: |px, p| {
+        let k = p.int("k") as u64;
+        if p.0.get("tail").is_some_and(|t| matches!(t, ParamValue::Str(s) if s == "compact")) {
+            compact_memory_bytes(px, k)
+        } else {
+            memory_bytes(px, k)
+        }
+    },
+};
 
 /// `hybrid` and `ktab`: the k-TAB engine with a uniform k.
 struct Hybrid(KTab);

@@ -5,7 +5,7 @@
 //! One geometry pass and one full-screen resolve (shaders/hybrid64.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -30,6 +30,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Formula,
     census: false,
+    census_when: never,
     main: Some("k"),
     pipelines: &[PIPELINES],
     create: |_, _| Box::new(Hybrid64 { buffers: None, tail: None }),

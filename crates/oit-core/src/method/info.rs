@@ -36,6 +36,9 @@ pub struct MethodInfo {
     /// pass count are planned from every pixel's fragment count). Methods that do not get no
     /// census pass unless the caller asks for the counts (`Renderer::set_census`).
     pub census: bool,
+    /// Whether, with these parameters, it reads the census although `census` is false
+    /// (hybrid's tail = "compact" takes its tail count from it); `never` for the others.
+    pub census_when: fn(&Params) -> bool,
     /// The integer parameter the method's speed-accuracy trade moves along (k, nodes, layers,
     /// samples, buckets): what `oit compare` sweeps; None where there is none.
     pub main: Option<&'static str>,
@@ -43,6 +46,11 @@ pub struct MethodInfo {
     /// tests/bindings.rs checks against each shader's bindings.
     pub pipelines: &'static [&'static [PipelineSpec]],
     pub(crate) create: fn(&GpuContext, &Limits) -> Box<dyn Method>,
+}
+
+/// `MethodInfo::census_when` of a method whose parameters never ask for the census.
+pub fn never(_: &Params) -> bool {
+    false
 }
 
 /// How a method's image depends on submission order (docs/methods.md, "Guarantees").
@@ -205,6 +213,11 @@ impl MethodInfo {
             Memory::Scene { .. } => None,
             Memory::Slots { bytes, .. } => slots.map(|s| bytes(pixels, s)),
         }
+    }
+
+    /// Whether a frame with `params` runs the census before the method (besides the caller's asking).
+    pub fn needs_census(&self, params: &Params) -> bool {
+        self.census || (self.census_when)(params)
     }
 
     pub(crate) fn instantiate(&self, gpu: &GpuContext, limits: &Limits) -> Box<dyn Method> {

@@ -19,6 +19,19 @@ pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
     pixels * (2 * k + ACCUM_WORDS) * 4 + 4
 }
 
+/// Bytes with tail = "compact" (Eq. 12's 2k + 2 words a pixel): k-TAB and visibility (k words
+/// each) and the tail's RGBA16F sums (2 words), plus the slot-offset placeholder and the
+/// overflow counter.
+pub fn compact_memory_bytes(pixels: u64, k: u64) -> u64 {
+    pixels * (2 * k + COMPACT_TAIL_WORDS) * 4 + 8
+}
+
+/// Words a pixel of the compact tail's RGBA16F target.
+const COMPACT_TAIL_WORDS: u64 = 2;
+const COMPACT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The binding fs_final_compact reads the compact tail's sums at (group 3).
+const COMPACT_BINDINGS: &[u32] = &[4];
+
 /// Bytes with each pixel's own slot count (`slots` in all): k-TAB and visibility (a word
 /// each per slot), the accumulators, the per-pixel offsets (pixels + 1 words) and the counter.
 pub fn memory_bytes_per_pixel(pixels: u64, slots: u64) -> u64 {
@@ -53,6 +66,13 @@ pub(crate) const PIPELINES: &[PipelineSpec] = &[
         "fs_final_blend",
         &[Layout::Scene, Layout::Targets, Layout::Storage(5), Layout::Textures(BLEND_BINDINGS)],
     ),
+    PipelineSpec::fullscreen(SHADER, "fs_clear", GROUPS),
+    PipelineSpec::geometry(SHADER, "fs_shade_compact", GROUPS),
+    PipelineSpec::fullscreen(
+        SHADER,
+        "fs_final_compact",
+        &[Layout::Scene, Layout::Targets, Layout::Storage(5), Layout::Textures(COMPACT_BINDINGS)],
+    ),
 ];
 
 /// How the second geometry pass sums the core and the tail.
@@ -63,14 +83,17 @@ pub(crate) enum Sums {
     /// Fixed-function additive (and max) blending into float targets, as Maule et al. do:
     /// fewer atomics, but float sums that round differently in another order.
     Blend,
+    /// Eq. 12's memory: the core blended into the output, the tail into one RGBA16F target, the
+    /// tail count from the census; no accumulator words.
+    Compact,
 }
 
 impl Sums {
     pub(crate) fn from_param(name: &str) -> Self {
-        if name == "blend" {
-            Sums::Blend
-        } else {
-            Sums::Exact
+        match name {
+            "blend" => Sums::Blend,
+            "compact" => Sums::Compact,
+            _ => Sums::Exact,
         }
     }
 }
@@ -105,11 +128,12 @@ pub(crate) struct KTab {
     buffers: Option<StorageGroup>,
     overflow: Option<Counter>,
     blend: Option<FloatTargets>,
+    compact: Option<FloatTargets>,
 }
 
 impl KTab {
     pub(crate) fn new(tail: bool) -> Self {
-        Self { tail, buffers: None, overflow: None, blend: None }
+        Self { tail, buffers: None, overflow: None, blend: None, compact: None }
     }
 
     /// Refuses buffers past a binding, and returns the slots in all and whether they are per pixel.
@@ -140,10 +164,15 @@ impl KTab {
     /// One frame with the k-TAB slots `slots` gives each pixel, its sums made as `sums` says.
     pub(crate) fn render_slots(&mut self, cx: &mut FrameCtx<'_>, slots: Slots<'_>, sums: Sums) -> Result<MethodReport> {
         let (total, per_pixel) = self.plan(cx, &slots)?;
-        if sums == Sums::Blend && !cx.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
+        if sums != Sums::Exact && !cx.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
             return Err(OitError::Unsupported(
-                "tail = 'blend' blends into float32 targets, which this adapter cannot (FLOAT32_BLENDABLE): use tail = 'exact'".into(),
+                "tail = 'blend' and 'compact' blend into float32 targets, which this adapter cannot (FLOAT32_BLENDABLE): use \
+                 tail = 'exact'"
+                    .into(),
             ));
+        }
+        if sums == Sums::Compact {
+            return self.render_compact(cx, &slots);
         }
         let pixels = cx.pixels();
         let overflow = self.overflow.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid overflow"));
@@ -161,7 +190,12 @@ impl KTab {
             Slots::Uniform(k) => k,
             Slots::PerPixel(_) => 1,
         };
-        let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", per_pixel as u32), Const::U32("TAIL", self.tail as u32)];
+        let consts = [
+            Const::U32("K", k),
+            Const::U32("PER_PIXEL", per_pixel as u32),
+            Const::U32("TAIL", self.tail as u32),
+            Const::U32("COMPACT", 0),
+        ];
         let mut enc = cx.encoder();
         enc.clear_buffer(&b.buffers[0], 0, None);
         enc.clear_buffer(&b.buffers[2], 0, None);
@@ -173,6 +207,7 @@ impl KTab {
                 cx.capture(&mut enc, "shade", &cx.capture_pipeline(spec(PIPELINES, "fs_shade"), &consts), &b.group);
                 cx.resolve(&mut enc, "final", &cx.resolve_pipeline(spec(PIPELINES, "fs_final"), &consts, true), &b.group, true);
             }
+            Sums::Compact => unreachable!("render_compact"),
             Sums::Blend => {
                 let targets = FloatTargets::ensure(&mut self.blend, cx, &BLEND_FORMATS, BLEND_BINDINGS);
                 let shade_blend = spec(PIPELINES, "fs_shade_blend");
@@ -191,6 +226,70 @@ impl KTab {
         }
         Ok(MethodReport {
             memory_bytes: memory,
+            overflow_fragments: overflow,
+            extra: vec![("tail_fragments", overflow as f64)],
+            error_bound: true,
+            ..Default::default()
+        })
+    }
+}
+
+impl KTab {
+    /// hybrid with tail = "compact" (shaders/hybrid.wgsl, COMPACT): store and visibility as the
+    /// other tails, then the tile's output zeroed, the core blended into it and the tail's sums
+    /// into one RGBA16F target, and the final pass added over it. Group 2's accumulator binding
+    /// is the frame's census counts buffer, holding this tile's counts.
+    fn render_compact(&mut self, cx: &mut FrameCtx<'_>, slots: &Slots<'_>) -> Result<MethodReport> {
+        let Slots::Uniform(k) = *slots else { unreachable!("auto renders exact tails") };
+        cx.check_per_pixel(&format!("hybrid with k = {k}"), 4 * k as u64)?;
+        let pixels = cx.pixels();
+        let overflow = self.overflow.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid overflow"));
+        let sizes = [("k-TAB", pixels * k as u64 * 4), ("core visibility", pixels * k as u64 * 4), ("slot offsets", 4)];
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[]);
+        let counts = &cx.targets.counts;
+        cx.gpu.queue.write_buffer(counts, 0, bytemuck::cast_slice(cx.depth_complexity));
+        let resources = [
+            b.buffers[0].as_entire_binding(),
+            b.buffers[1].as_entire_binding(),
+            counts.as_entire_binding(),
+            b.buffers[2].as_entire_binding(),
+            overflow.buffer.as_entire_binding(),
+        ];
+        let group = cx.group(Layout::Storage(5), &resources);
+        let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", 0), Const::U32("TAIL", 1), Const::U32("COMPACT", 1)];
+        let sums = FloatTargets::ensure(&mut self.compact, cx, &[COMPACT_FORMAT], COMPACT_BINDINGS);
+        let add = |format| Some(wgpu::ColorTargetState { format, blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }), write_mask: wgpu::ColorWrites::ALL });
+        let shade = cx.draw_pipeline(
+            spec(PIPELINES, "fs_shade_compact"),
+            &consts,
+            vec![add(crate::bindings::COLOR_FORMAT), add(COMPACT_FORMAT)],
+            crate::pipeline::depth_test_only(),
+        );
+        let clear = cx.resolve_pipeline(spec(PIPELINES, "fs_clear"), &consts, false);
+        let fin = cx.resolve_pipeline_adding(spec(PIPELINES, "fs_final_compact"), &consts);
+        let mut enc = cx.encoder();
+        enc.clear_buffer(&b.buffers[0], 0, None);
+        enc.clear_buffer(&b.buffers[1], 0, None);
+        overflow.clear(&mut enc);
+        cx.capture(&mut enc, "store", &cx.capture_pipeline(spec(PIPELINES, "fs_store"), &consts), &group);
+        cx.dispatch(&mut enc, "visibility", &cx.compute_pipeline(spec(PIPELINES, "cs_visibility"), &consts), &group);
+        cx.resolve(&mut enc, "clear", &clear, &group, false);
+        let out = wgpu::RenderPassColorAttachment {
+            view: &cx.targets.out,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+        };
+        let mut attachments = vec![Some(out)];
+        attachments.extend(sums.attachments(&[wgpu::Color::TRANSPARENT]));
+        cx.capture_into(&mut enc, "shade", &shade, &group, &attachments);
+        cx.resolve_groups(&mut enc, "final", &fin, &[&group, &sums.group], true);
+        overflow.copy(&mut enc);
+        cx.submit(enc);
+        let overflow = overflow.read(cx.gpu)?;
+        let target_pixels = cx.targets.width as u64 * cx.targets.height as u64;
+        Ok(MethodReport {
+            memory_bytes: pixels * 2 * k as u64 * 4 + target_pixels * COMPACT_TAIL_WORDS * 4 + 8,
             overflow_fragments: overflow,
             extra: vec![("tail_fragments", overflow as f64)],
             error_bound: true,

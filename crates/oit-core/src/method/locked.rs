@@ -7,7 +7,7 @@
 
 use super::accum::{FloatTargets, ACCUM_FORMAT, ADD};
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind, Params};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -70,6 +70,7 @@ pub const ADAPTIVE: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    census_when: never,
     main: Some("nodes"),
     pipelines: &[ADAPTIVE_PIPELINES],
     create: |_, _| Box::new(Locked::new(Kind::Adaptive)),

@@ -3,7 +3,7 @@
 //! the lists, unbounded (shaders/mlab_lists.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::list_pipelines::{single, FRAME};
 use super::lists::check_replay_budget;
 use super::lists::{Aux, ListLayout, ListMethod};
@@ -29,6 +29,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Storage { per_pixel: 4, per_fragment: 32, per_triangle: 0 },
     census: true,
+    census_when: never,
     main: Some("layers"),
     pipelines: &[PIPELINES],
     create: |gpu, limits| {

@@ -4,7 +4,7 @@
 //! (shaders/peel.wgsl, docs/methods.md).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -31,6 +31,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Formula,
     census: true,
+    census_when: never,
     main: Some("layers"),
     pipelines: &[PIPELINES],
     create: |_, _| Box::new(Peel { dual: false, buffers: None, peeled: None }),

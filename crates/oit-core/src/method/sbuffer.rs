@@ -4,7 +4,7 @@
 //! The pool holds exactly the counted fragments (shaders/sbuffer.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::list_pipelines::{swept_after, FRAME};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{PIXEL_BYTES, STATE_WORDS};
@@ -28,6 +28,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::Exact,
     tiling: Tiling::Storage { per_pixel: PIXEL_BYTES + 8, per_fragment: 24, per_triangle: 0 },
     census: true,
+    census_when: never,
     main: None,
     pipelines: &[PIPELINES],
     create: |gpu, limits| {

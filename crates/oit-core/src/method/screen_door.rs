@@ -3,7 +3,7 @@
 //! opaque (shaders/screen_door.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -25,6 +25,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    census_when: never,
     main: None,
     pipelines: &[PIPELINES],
     create: |_, _| Box::new(ScreenDoor { depth: None }),

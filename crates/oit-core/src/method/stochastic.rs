@@ -4,7 +4,7 @@
 
 use super::accum::{accumulation_targets, Aux, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -38,6 +38,7 @@ pub const INFO: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    census_when: never,
     main: Some("samples"),
     pipelines: &[PIPELINES],
     create: |_, _| Box::new(Stochastic { samples: None, targets: None }),

@@ -3,7 +3,7 @@
 
 use super::accum::{accumulation_targets, memory_bytes, Aux, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -43,6 +43,7 @@ pub const WSUM: MethodInfo = MethodInfo {
     error_bound: ErrorBound::None,
     tiling: Tiling::Formula,
     census: false,
+    census_when: never,
     main: None,
     pipelines: &[PIPELINES],
     create: |_, _| Box::new(Weighted::new(Kind::Sum)),

@@ -122,7 +122,7 @@ impl Renderer {
         let start = Instant::now();
         let gpu = self.gpu.clone();
         let (w, h) = (self.width, self.height);
-        let census = info.census || self.census;
+        let census = info.needs_census(params) || self.census;
         if self.memory_budget.is_some() {
             // Under a budget no method keeps storage between frames: what the frame allocates
             // is what it reports, and the census runs with the targets alone.
