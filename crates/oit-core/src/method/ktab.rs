@@ -190,12 +190,8 @@ impl KTab {
             Slots::Uniform(k) => k,
             Slots::PerPixel(_) => 1,
         };
-        let consts = [
-            Const::U32("K", k),
-            Const::U32("PER_PIXEL", per_pixel as u32),
-            Const::U32("TAIL", self.tail as u32),
-            Const::U32("COMPACT", 0),
-        ];
+        let consts =
+            [Const::U32("K", k), Const::U32("PER_PIXEL", per_pixel as u32), Const::U32("TAIL", self.tail as u32), Const::U32("COMPACT", 0)];
         let mut enc = cx.encoder();
         enc.clear_buffer(&b.buffers[0], 0, None);
         enc.clear_buffer(&b.buffers[2], 0, None);
@@ -258,7 +254,13 @@ impl KTab {
         let group = cx.group(Layout::Storage(5), &resources);
         let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", 0), Const::U32("TAIL", 1), Const::U32("COMPACT", 1)];
         let sums = FloatTargets::ensure(&mut self.compact, cx, &[COMPACT_FORMAT], COMPACT_BINDINGS);
-        let add = |format| Some(wgpu::ColorTargetState { format, blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }), write_mask: wgpu::ColorWrites::ALL });
+        let add = |format| {
+            Some(wgpu::ColorTargetState {
+                format,
+                blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }),
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        };
         let shade = cx.draw_pipeline(
             spec(PIPELINES, "fs_shade_compact"),
             &consts,
