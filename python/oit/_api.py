@@ -497,7 +497,8 @@ class Renderer:
         `census=True` counts every pixel's transparent fragments (`stats["fragments"]`,
         `stats["max_depth_complexity"]`, `frame.depth_complexity`) with one more geometry pass;
         methods that plan their storage from the counts (the A-buffers, peeling, adaptive_lists, mlab_lists,
-        auto) always do, the others by default do not, and report None there."""
+        auto) and hybrid with tail="compact" (its tail count) always do, the others by default do not, and
+        report None there."""
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be an oit.Scene, got {type(scene).__name__}")
         if not isinstance(camera, Camera):
