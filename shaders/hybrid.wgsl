@@ -33,8 +33,29 @@ const TAIL_HI: u32 = 17u;    // largest tail color channel (f32 bits)
 const ACCUM_WORDS: u32 = HYBRID_ACCUM_WORDS;
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
-// Transmittance in front of each core slot, as f32 bits (the first slot's word: see front_trans).
+// Transmittance in front of each core slot; with COMPACT as f32 bits in atomic words, the first
+// slot's word holding the evicted key instead (front_trans).
+//!if COMPACT
 @group(2) @binding(1) var<storage, read_write> vis: array<atomic<u32>>;
+
+fn vis_load(i: u32) -> f32 {
+    return bitcast<f32>(atomicLoad(&vis[i]));
+}
+
+fn vis_store(i: u32, v: f32) {
+    atomicStore(&vis[i], bitcast<u32>(v));
+}
+//!else
+@group(2) @binding(1) var<storage, read_write> vis: array<f32>;
+
+fn vis_load(i: u32) -> f32 {
+    return vis[i];
+}
+
+fn vis_store(i: u32, v: f32) {
+    vis[i] = v;
+}
+//!endif
 // The accumulators; with COMPACT, the census counts, a fragment count a pixel.
 @group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
 @group(2) @binding(4) var<storage, read_write> overflow: atomic<u32>;
@@ -53,29 +74,30 @@ fn slots(px: u32) -> vec2<u32> {
 //!include common/fixed.wgsl
 //!include common/alpha8.wgsl
 
-// The transmittance in front of core slot i of the pixel whose slots start at `base`: 1 in
-// front of the first, so that its word is free for the evicted key (COMPACT).
+// The transmittance in front of core slot i of the pixel whose slots start at `base`; with
+// COMPACT 1 in front of the first, whose word holds the evicted key.
 fn front_trans(base: u32, i: u32) -> f32 {
-    if i == 0u {
+    if COMPACT != 0u && i == 0u {
         return 1.0;
     }
-    return bitcast<f32>(atomicLoad(&vis[base + i]));
+    return vis_load(base + i);
 }
 
 // The nearest key pushed out of pixel px's full table (0: none), kept by atomicMax.
 fn raise_evicted(px: u32, v: u32) {
-    if COMPACT != 0u {
-        atomicMax(&vis[slots(px).x], v);
-    } else {
-        atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
-    }
+//!if COMPACT
+    atomicMax(&vis[slots(px).x], v);
+//!else
+    atomicMax(&accum[px * ACCUM_WORDS + EVICTED], v);
+//!endif
 }
 
 fn evicted_key(px: u32) -> u32 {
-    if COMPACT != 0u {
-        return atomicLoad(&vis[slots(px).x]);
-    }
+//!if COMPACT
+    return atomicLoad(&vis[slots(px).x]);
+//!else
     return atomicLoad(&accum[px * ACCUM_WORDS + EVICTED]);
+//!endif
 }
 
 // 24-bit depth over 8-bit alpha, inverted so that a cleared (zero) slot is empty and
@@ -157,8 +179,8 @@ fn cs_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = core_slots(px);
     var t = 1.0;
     for (var i = 0u; i < n; i++) {
-        if i > 0u {
-            atomicStore(&vis[base + i], bitcast<u32>(t)); // in front of slot i: v_i = alpha_i * t (eq. 2)
+        if COMPACT == 0u || i > 0u {
+            vis_store(base + i, t); // transmittance in front of slot i: v_i = alpha_i * t (eq. 2)
         }
         t *= 1.0 - key_alpha(atomicLoad(&ktab[base + i]));
     }
