@@ -228,19 +228,30 @@ def test_a_flat_alpha_of_0_7_shades_flat(renderer, method):
     assert np.abs(rgb - rgb[0]).max() <= 2e-6
 
 
-# tail="blend" (docs/methods.md, "hybrid"): the same sums by float blending, in whatever order
-# fragments arrive. Each of the three tail sums (C alpha, alpha, count) is within n 2^-24 of
-# its value relative to the sum, and eqs. 7-10 move the tail by at most three such relative
-# errors: 3 n 2^-24 on top of the fixed-point tail's tolerance.
+# The float tails (docs/methods.md, "hybrid"): tail="blend" sums by float32 blending, in whatever
+# order fragments arrive; tail="compact" (Eq. 12's 2k + 2 words a pixel) blends its sums into
+# RGBA16F and takes the count from the census. Each of the three tail sums (C alpha, alpha,
+# count) is within n u of its value relative to the sum (u: the format's unit roundoff, 2^-24
+# or 2^-11), and eqs. 7-10 move the tail by at most three such relative errors: 3 n u on top of
+# the fixed-point tail's tolerance.
+ROUNDOFF = {"blend": 2.0**-24, "compact": 2.0**-11}
+HALF = ROUNDOFF["compact"]
+
+
 @pytest.mark.parametrize("alphas", ["random", "worst"])
 @pytest.mark.parametrize("k", [1, 4])
-def test_blended_tail_matches_the_model_within_float_sums(renderer, k, alphas):
+@pytest.mark.parametrize("tail", list(ROUNDOFF))
+def test_float_tails_match_the_model_within_their_sums(renderer, tail, k, alphas):
     layers = 100
     built = stacks(layers=layers, alphas=alphas, size=(6, 6), seed=layers)
-    frame = renderer(6, 6).render(built.scene, built.camera, "hybrid", background=tuple(BG), k=k, tail="blend")
+    frame = renderer(6, 6).render(built.scene, built.camera, "hybrid", background=tuple(BG), k=k, tail=tail)
     want = model_image(built, "hybrid", {"k": k})
-    assert np.abs(frame.image.reshape(-1, 4) - want).max() <= 2e-6 + 3 * layers * 2.0**-24
-    assert frame.stats["params"]["tail"] == "blend"
+    assert np.abs(frame.image.reshape(-1, 4) - want).max() <= 2e-6 + 3 * layers * ROUNDOFF[tail]
+    assert frame.stats["params"]["tail"] == tail
+    # compact's count is the census's less the core's: the same tail as the others'.
+    assert frame.stats["census"] == (tail == "compact")
+    exact = renderer(6, 6).render(built.scene, built.camera, "hybrid", background=tuple(BG), k=k)
+    assert frame.stats["overflow_fragments"] == exact.stats["overflow_fragments"]
 
 
 def test_blended_tail_depends_on_order_only_within_its_rounding(renderer):
@@ -261,25 +272,6 @@ def test_blended_tail_depends_on_order_only_within_its_rounding(renderer):
     ref = r.render(build_scene(meshes), IDENTITY, "abuffer", background=(0.3, 0.3, 0.3)).image
     for frame in (first, exact):
         assert (np.abs(frame.image - ref)[..., :3] <= frame.error_bound + 1e-6).all()
-
-
-# tail="compact" (docs/methods.md, "hybrid"): Eq. 12's 2k + 2 words a pixel. The tail's three
-# sums are RGBA16F blends, each within n 2^-11 of its value relative to the sum (half-float unit
-# roundoff), so eqs. 7-10 move the tail by at most 3 n 2^-11; the count comes from the census.
-HALF = 2.0**-11
-
-
-@pytest.mark.parametrize("alphas", ["random", "worst"])
-@pytest.mark.parametrize("k", [1, 4])
-def test_compact_tail_matches_the_model_within_half_float_sums(renderer, k, alphas):
-    layers = 100
-    built = stacks(layers=layers, alphas=alphas, size=(6, 6), seed=layers)
-    frame = renderer(6, 6).render(built.scene, built.camera, "hybrid", background=tuple(BG), k=k, tail="compact")
-    want = model_image(built, "hybrid", {"k": k})
-    assert np.abs(frame.image.reshape(-1, 4) - want).max() <= 2e-6 + 3 * layers * HALF
-    assert frame.stats["census"] and frame.stats["params"]["tail"] == "compact"
-    exact = renderer(6, 6).render(built.scene, built.camera, "hybrid", background=tuple(BG), k=k)
-    assert frame.stats["overflow_fragments"] == exact.stats["overflow_fragments"]
 
 
 @pytest.mark.parametrize("k", [1, 8, 32])
