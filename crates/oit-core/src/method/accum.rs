@@ -28,21 +28,18 @@ pub(crate) enum Aux {
     Reveal,
 }
 
+/// A color target of `format` that fragments blend into by `blend` (color and alpha alike).
+pub(crate) fn blended(format: wgpu::TextureFormat, blend: wgpu::BlendComponent) -> Option<wgpu::ColorTargetState> {
+    Some(wgpu::ColorTargetState {
+        format,
+        blend: Some(wgpu::BlendState { color: blend, alpha: blend }),
+        write_mask: wgpu::ColorWrites::ALL,
+    })
+}
+
 /// The two color targets of the accumulation pass (`Accum` of shaders/common/accum_targets.wgsl).
 pub(crate) fn accumulation_targets(aux: Aux) -> Vec<Option<wgpu::ColorTargetState>> {
-    let aux_blend = if aux == Aux::Reveal { REVEAL } else { ADD };
-    vec![
-        Some(wgpu::ColorTargetState {
-            format: ACCUM_FORMAT,
-            blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }),
-            write_mask: wgpu::ColorWrites::ALL,
-        }),
-        Some(wgpu::ColorTargetState {
-            format: AUX_FORMAT,
-            blend: Some(wgpu::BlendState { color: aux_blend, alpha: aux_blend }),
-            write_mask: wgpu::ColorWrites::ALL,
-        }),
-    ]
+    vec![blended(ACCUM_FORMAT, ADD), blended(AUX_FORMAT, if aux == Aux::Reveal { REVEAL } else { ADD })]
 }
 
 /// Bytes a pixel of the two targets.

@@ -3,7 +3,7 @@
 //! second geometry pass, composite. Accumulation in fixed point, so that frames do not depend
 //! on fragment order (docs/methods.md, "hybrid"). Each pixel gets a uniform k or its own slots.
 
-use super::accum::{FloatTargets, ADD};
+use super::accum::{blended, FloatTargets, ADD};
 use super::frame::{FrameCtx, MethodReport};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::{OitError, Result};
@@ -163,7 +163,6 @@ impl KTab {
 
     /// One frame with the k-TAB slots `slots` gives each pixel, its sums made as `sums` says.
     pub(crate) fn render_slots(&mut self, cx: &mut FrameCtx<'_>, slots: Slots<'_>, sums: Sums) -> Result<MethodReport> {
-        let (total, per_pixel) = self.plan(cx, &slots)?;
         if sums != Sums::Exact && !cx.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
             return Err(OitError::Unsupported(
                 "tail = 'blend' and 'compact' blend into float32 targets, which this adapter cannot (FLOAT32_BLENDABLE): use \
@@ -172,8 +171,10 @@ impl KTab {
             ));
         }
         if sums == Sums::Compact {
+            // Checked by its own words: it keeps no accumulators, which `plan` counts.
             return self.render_compact(cx, &slots);
         }
+        let (total, per_pixel) = self.plan(cx, &slots)?;
         let pixels = cx.pixels();
         let overflow = self.overflow.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid overflow"));
         let sizes = [
@@ -254,17 +255,10 @@ impl KTab {
         let group = cx.group(Layout::Storage(5), &resources);
         let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", 0), Const::U32("TAIL", 1), Const::U32("COMPACT", 1)];
         let sums = FloatTargets::ensure(&mut self.compact, cx, &[COMPACT_FORMAT], COMPACT_BINDINGS);
-        let add = |format| {
-            Some(wgpu::ColorTargetState {
-                format,
-                blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }),
-                write_mask: wgpu::ColorWrites::ALL,
-            })
-        };
         let shade = cx.draw_pipeline(
             spec(PIPELINES, "fs_shade_compact"),
             &consts,
-            vec![add(crate::bindings::COLOR_FORMAT), add(COMPACT_FORMAT)],
+            vec![blended(crate::bindings::COLOR_FORMAT, ADD), blended(COMPACT_FORMAT, ADD)],
             crate::pipeline::depth_test_only(),
         );
         let clear = cx.resolve_pipeline(spec(PIPELINES, "fs_clear"), &consts, false);

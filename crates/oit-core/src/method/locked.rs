@@ -5,7 +5,7 @@
 //! it in a second (shaders/adaptive.wgsl); `mlab` blends its layers in one (shaders/mlab.wgsl).
 //! The list versions they replace are `adaptive_lists` and `mlab_lists`.
 
-use super::accum::{FloatTargets, ACCUM_FORMAT, ADD};
+use super::accum::{blended, FloatTargets, ACCUM_FORMAT, ADD};
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind, Params};
@@ -134,12 +134,8 @@ impl Method for Locked {
                 let pipelines = ADAPTIVE_PIPELINES;
                 cx.capture(&mut enc, "insert", &cx.capture_pipeline(spec(pipelines, "fs_insert"), &consts), &b.group);
                 let sums = FloatTargets::ensure(&mut self.sums, cx, &[ACCUM_FORMAT], SUMS);
-                let target = wgpu::ColorTargetState {
-                    format: ACCUM_FORMAT,
-                    blend: Some(wgpu::BlendState { color: ADD, alpha: ADD }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                };
-                let shade = cx.draw_pipeline(spec(pipelines, "fs_shade"), &consts, vec![Some(target)], crate::pipeline::depth_test_only());
+                let target = blended(ACCUM_FORMAT, ADD);
+                let shade = cx.draw_pipeline(spec(pipelines, "fs_shade"), &consts, vec![target], crate::pipeline::depth_test_only());
                 cx.capture_into(&mut enc, "shade", &shade, &b.group, &sums.attachments(&[wgpu::Color::TRANSPARENT]));
                 let resolve = cx.resolve_pipeline(spec(pipelines, "fs_resolve"), &consts, false);
                 cx.resolve_groups(&mut enc, "composite", &resolve, &[&b.group, &sums.group], false);
