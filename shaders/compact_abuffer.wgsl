@@ -35,6 +35,20 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
     let t = drawn_triangle(d);
     var s: PrimShading;
     for (var k = 0u; k < 3u; k++) {
+//!if PRIMITIVES
+        if chunk.kind != PRIM_MESH {
+            let c = corner_of(3u * t.t + k, t.inst);
+            s.clip[k] = frame.view_proj * vec4<f32>(c.world, 1.0);
+            s.color[k] = c.color;
+            s.normal[k] = vec4<f32>(0.0);
+            s.uv[k] = vec2<f32>(0.0);
+            if SHADED != 0u {
+                s.normal[k] = vec4<f32>(c.tangent, bitcast<f32>(chunk.set_surface));
+                s.uv[k] = c.uv;
+            }
+            continue;
+        }
+//!endif
         let v = indices[3u * t.t + k];
         s.clip[k] = clip_vertex(t, k);
         s.color[k] = placed_color(v, t.inst);

@@ -15,13 +15,13 @@ import numpy as np
 from . import _oit
 from ._checks import _I64_MAX, _U32_MAX, SHADINGS, _float_array, _instance_colors, _int, _number, _rows, _surface, _transforms, _vector
 from ._memory import available_memory
+from ._primitives import PrimitiveMethods
 from ._trimesh import trimesh_arrays
 from .imageio import encode_png
 
 
-class Scene:
-    """Meshes in submission order. Transparent meshes are composited by the chosen method;
-    opaque meshes render first and occlude what lies behind them."""
+class Scene(PrimitiveMethods):
+    """Meshes, strands and particles in submission order, composited by the chosen method; opaque ones occlude."""
 
     def __init__(self) -> None:
         self._native = _oit.Scene()
@@ -46,10 +46,10 @@ class Scene:
         The surface (docs/shading.md): `normals` (n, 3) per vertex, `uvs` (n, 2) per vertex,
         `texture` (h, w, 4) straight RGBA -- float in [0, 1] taken as linear, or uint8 taken as
         sRGB color with linear alpha -- sampled bilinearly with repeat wrap, row 0 at v = 0.
-        `shading`: "unlit" (the vertex color), "flat" (the triangle's normal) or "smooth"
-        (interpolated vertex normals, computed angle-weighted when `normals` is None); the
-        default is "smooth" when `normals` is given, else "unlit". `specular` >= 0 and
-        `shininess` > 0 weigh a Blinn-Phong highlight; `opacity` in [0, 1] multiplies alpha;
+        `shading`: "unlit" (the vertex color), "flat" (the triangle's normal), "smooth"
+        (interpolated vertex normals, angle-weighted when `normals` is None) or "hair" (Kajiya-Kay,
+        `normals` read as strand tangents); by default "smooth" with `normals`, else "unlit".
+        `specular` >= 0 and `shininess` > 0 weigh the highlight; `opacity` in [0, 1] multiplies alpha;
         `two_sided` turns the normal towards the viewer (else the back is lit as the front's
         reverse side, and stays drawn); `cull_back_faces` drops the triangles seen from behind
         (clockwise on screen), as glTF's `doubleSided: false` asks.

@@ -36,11 +36,17 @@ struct Light {
 // Geometry is uploaded in chunks that each fit a binding: this chunk's first uploaded triangle
 // in the scene's order, its uploaded triangle count, its segments (common/setup.wgsl) and the
 // triangles drawn from it, instances included. Indices are local to the chunk.
+// A chunk holds meshes, or one strand or particle set (`kind`: PRIM_MESH, PRIM_STRANDS,
+// PRIM_PARTICLES; common/primitives.wgsl) whose material is the chunk's.
 struct Chunk {
     first_triangle: u32,
     triangles: u32,
     segments: u32,
     drawn: u32,
+    kind: u32,
+    set_surface: u32,
+    pad0: u32,
+    pad1: u32,
 }
 @group(0) @binding(4) var<uniform> chunk: Chunk;
 // Two vec4 a vertex where the scene is shaded: (unit normal, material index bits), (u, v, 0, 0).
@@ -91,6 +97,11 @@ fn vs_main(
 //!if !INSTANCED
     let ii = 0u;
 //!endif
+//!if PRIMITIVES
+    if chunk.kind != PRIM_MESH {
+        return expanded_vertex(vi, ii);
+    }
+//!endif
     let v = indices[vi];
     var out: VsOut;
     out.clip = frame.view_proj * placed(v, ii);
@@ -128,7 +139,11 @@ fn faces_front(vi: u32, ii: u32) -> bool {
 // drawn index of the chunk's local triangle `t` under it; whether it mirrors.
 //!if INSTANCED
 fn placed(v: u32, ii: u32) -> vec4<f32> {
-    return instances[ii].model * vec4<f32>(scene_position(v), 1.0);
+    return placed_at(scene_position(v), ii);
+}
+
+fn placed_at(p: vec3<f32>, ii: u32) -> vec4<f32> {
+    return instances[ii].model * vec4<f32>(p, 1.0);
 }
 
 fn placed_color(v: u32, ii: u32) -> vec4<f32> {
@@ -149,7 +164,11 @@ fn mirrors(ii: u32) -> bool {
 }
 //!else
 fn placed(v: u32, ii: u32) -> vec4<f32> {
-    return vec4<f32>(scene_position(v), 1.0);
+    return placed_at(scene_position(v), ii);
+}
+
+fn placed_at(p: vec3<f32>, ii: u32) -> vec4<f32> {
+    return vec4<f32>(p, 1.0);
 }
 
 fn placed_color(v: u32, ii: u32) -> vec4<f32> {
@@ -199,4 +218,7 @@ fn compute_pixel(gid: vec3<u32>) -> u32 {
     }
     return gid.y * frame.tile_size.x + gid.x;
 }
+//!if PRIMITIVES
+//!include common/primitives.wgsl
+//!endif
 //!include common/shading.wgsl

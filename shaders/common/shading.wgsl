@@ -60,6 +60,9 @@ fn surface_base(in: VsOut, m0: vec4<f32>) -> vec4<f32> {
     }
 //!endif
     base.a = base.a * m0.z;
+//!if PRIMITIVES
+    base.a = base.a * falloff((bitcast<u32>(m0.w) & FALLOFF_MASK) >> FALLOFF_SHIFT, in.uv);
+//!endif
     return base;
 }
 
@@ -75,6 +78,11 @@ fn shade(in: VsOut) -> vec4<f32> {
     if (flags & SHADING_MODE) == SHADING_UNLIT {
         return vec4<f32>(base.rgb + extra, base.a);
     }
+//!if PRIMITIVES
+    if (flags & SHADING_MODE) == SHADING_HAIR {
+        return vec4<f32>(hair(base.rgb, normalize(in.normal), v, m0) + extra, base.a);
+    }
+//!endif
     var n = normalize(in.normal);
     if (flags & TWO_SIDED) != 0u && dot(n, v) < 0.0 {
         n = -n;

@@ -12,6 +12,7 @@ pub mod load;
 pub mod method;
 mod passes;
 mod pipeline;
+pub mod primitive;
 pub mod reference;
 pub mod renderer;
 pub mod resources;
@@ -30,8 +31,9 @@ pub use error::{OitError, Result};
 pub use method::{
     memory_bytes, methods, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, ParamInfo, ParamKind, ParamValue, Params, Tiling,
 };
+pub use primitive::Primitive;
 pub use reference::{reference, reference_antialiased, ReferenceImage};
 pub use renderer::{coverage_methods, shared_context, Frame, Renderer, Target, COVERAGE_SAMPLES};
 pub use scene::{Camera, Instance, Mesh, Scene};
-pub use shading::{Light, Material, Shading, Texture, MAX_LIGHTS};
+pub use shading::{Falloff, Light, Material, Shading, Texture, MAX_LIGHTS};
 pub use stats::Stats;

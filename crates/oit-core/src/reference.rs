@@ -154,6 +154,15 @@ pub fn reference_antialiased(
     // its inverse transpose (renormalized), colors times the instance's.
     for (mesh, (m, instances)) in scene.placed().enumerate() {
         for inst in instances {
+            if m.primitive != crate::primitive::Primitive::Triangles {
+                // Strands and particles: the triangles the vertex stage builds, in float64.
+                for c in crate::primitive::expand(m, inst, camera).chunks_exact(3) {
+                    let c = [c[0], c[1], c[2]];
+                    let (v, c, n, uv) = (c.map(|k| k.position), c.map(|k| k.color), c.map(|k| k.tangent), c.map(|k| k.uv));
+                    tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull: false, mirror: false, back: false });
+                }
+                continue;
+            }
             let nm = inst.normal_matrix();
             let factor = DVec4::from(inst.color.map(|x| x as f64));
             let carry = |n: DVec3| (nm * n).normalize_or_zero();

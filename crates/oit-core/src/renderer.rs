@@ -357,6 +357,7 @@ impl Renderer {
             textured: scene.textured,
             shading_cost: self.shading_cost,
             instanced: scene.instanced,
+            primitives: scene.primitives,
         }
     }
 }

@@ -5,10 +5,13 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::{DMat3, DMat4, DVec4, Mat4};
 
 use crate::error::{invalid, Result};
+use crate::primitive::Primitive;
 use crate::shading::{self, Light, Lighting, Material, Shading, MAX_LIGHTS};
 
 /// A triangle mesh with straight (not premultiplied) linear RGBA per vertex, and its surface:
-/// unit vertex normals and UVs (empty when not given) and a material (src/shading.rs).
+/// unit vertex normals and UVs (empty when not given) and a material (src/shading.rs). A
+/// strand or particle set (`primitive`, src/primitive.rs) is one too: its positions are its
+/// points, it has no indices, and its triangles are built facing the camera.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
@@ -18,6 +21,7 @@ pub struct Mesh {
     pub normals: Vec<[f32; 3]>,
     pub uvs: Vec<[f32; 2]>,
     pub material: Material,
+    pub primitive: Primitive,
 }
 
 impl Mesh {
@@ -54,6 +58,15 @@ impl Mesh {
     /// normals they are computed (angle-weighted); a texture needs UVs.
     pub fn with_surface(mut self, normals: Option<Vec<[f32; 3]>>, uvs: Option<Vec<[f32; 2]>>, material: Material) -> Result<Self> {
         material.validate()?;
+        if self.primitive != Primitive::Triangles {
+            return Err(invalid!("{} take their surface from with_primitive_surface", self.primitive.name()));
+        }
+        if material.falloff != crate::shading::Falloff::None {
+            return Err(invalid!("a falloff is for particles: add_particles"));
+        }
+        if material.shading == Shading::Hair && normals.is_none() {
+            return Err(invalid!("'hair' shading reads each vertex's strand tangent: pass the tangents as normals"));
+        }
         let n = self.positions.len();
         self.normals = match normals {
             Some(v) => shading::check_normals(v, n)?,
@@ -76,8 +89,12 @@ impl Mesh {
         Ok(self)
     }
 
+    /// Triangles drawn for one placement: a mesh's own, two a strand segment or particle.
     pub fn triangle_count(&self) -> usize {
-        self.indices.len()
+        match self.primitive {
+            Primitive::Triangles => self.indices.len(),
+            _ => 2 * self.primitive_count(),
+        }
     }
 }
 

@@ -38,6 +38,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("TEXTURES", 1),
     Const::U32("SHADING_COST", 0),
     Const::U32("INSTANCED", 1),
+    Const::U32("PRIMITIVES", 1),
 ];
 
 /// What a scene's geometry passes compile for (`//!if` blocks and loop bounds in
@@ -54,27 +55,31 @@ pub struct SceneVariant {
     pub textured: bool,
     pub shading_cost: u32,
     pub instanced: bool,
+    pub primitives: bool,
 }
 
 impl SceneVariant {
-    pub fn consts(&self) -> [Const; 5] {
+    pub fn consts(&self) -> [Const; 6] {
         [
             Const::U32("SHADED", self.shaded as u32),
             Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
             Const::U32("TEXTURES", (self.shaded && self.textured) as u32),
             Const::U32("SHADING_COST", self.shading_cost),
             Const::U32("INSTANCED", self.instanced as u32),
+            Const::U32("PRIMITIVES", self.primitives as u32),
         ]
     }
 }
 
 /// Scene variants besides the defaults' that tests validate every shader in: unlit, lit
-/// without textures, the shading-cost knob on an unlit scene, and an unlit instanced scene.
-pub const VALIDATION_VARIANTS: [SceneVariant; 4] = [
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false },
-    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0, instanced: false },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3, instanced: false },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: true },
+/// without textures, the shading-cost knob on an unlit scene, an unlit instanced scene, and
+/// unlit strands or particles.
+pub const VALIDATION_VARIANTS: [SceneVariant; 5] = [
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false, primitives: false },
+    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0, instanced: false, primitives: false },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3, instanced: false, primitives: false },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: true, primitives: false },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false, primitives: true },
 ];
 
 /// `DEFAULT_CONSTS` with `variant`'s constants in place of the defaults of the same names.

@@ -15,6 +15,10 @@ pub const TWO_SIDED: u32 = 0x100;
 pub const TEXTURED: u32 = 0x200;
 /// Back faces (clockwise on screen) are not drawn: the vertex shader moves them off screen.
 pub const CULL_BACK: u32 = 0x400;
+/// A particle's falloff (`Falloff::code`) in bits 12 and 13: its alpha times a function of the
+/// distance from its center (uv, the disc coordinates); 0 for every other surface.
+pub const FALLOFF_SHIFT: u32 = 12;
+pub const FALLOFF_MASK: u32 = 0x3000;
 
 /// How a mesh's normal is found; `Unlit` keeps the vertex color (times texture and opacity).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -25,6 +29,9 @@ pub enum Shading {
     Flat,
     /// Vertex normals interpolated across the triangle and renormalized.
     Smooth,
+    /// A strand's tangent (carried where other surfaces carry the normal) shades it:
+    /// Kajiya and Kay's diffuse term with a half-vector highlight (docs/shading.md).
+    Hair,
 }
 
 impl Shading {
@@ -33,7 +40,8 @@ impl Shading {
             "unlit" => Ok(Self::Unlit),
             "flat" => Ok(Self::Flat),
             "smooth" => Ok(Self::Smooth),
-            _ => Err(invalid!("shading must be 'unlit', 'flat' or 'smooth', got '{name}'")),
+            "hair" => Ok(Self::Hair),
+            _ => Err(invalid!("shading must be 'unlit', 'flat', 'smooth' or 'hair', got '{name}'")),
         }
     }
 
@@ -42,10 +50,11 @@ impl Shading {
             Self::Unlit => "unlit",
             Self::Flat => "flat",
             Self::Smooth => "smooth",
+            Self::Hair => "hair",
         }
     }
 
-    /// The code the shaders read (`SHADING_UNLIT`, `SHADING_FLAT`, `SHADING_SMOOTH`).
+    /// The code the shaders read (`SHADING_UNLIT`, `SHADING_FLAT`, `SHADING_SMOOTH`, `SHADING_HAIR`).
     pub fn code(self) -> u32 {
         self as u32
     }
@@ -56,6 +65,59 @@ impl Shading {
             | if material.two_sided { TWO_SIDED } else { 0 }
             | if material.texture.is_some() { TEXTURED } else { 0 }
             | if material.cull_back_faces { CULL_BACK } else { 0 }
+            | material.falloff.code() << FALLOFF_SHIFT
+    }
+}
+
+/// How a particle's alpha falls off from its center to its rim, as a factor of the distance
+/// r from the center in radii (r > 1 is outside the disc: 0). `None` for every surface that is
+/// not a particle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Falloff {
+    #[default]
+    None,
+    /// 1 inside the disc.
+    Hard,
+    /// 1 - r.
+    Linear,
+    /// exp(-r² / (2σ²)) with σ = 1/3 (the rim at 3σ, where it is 0.011), cut at the rim.
+    Gaussian,
+}
+
+impl Falloff {
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "hard" => Ok(Self::Hard),
+            "linear" => Ok(Self::Linear),
+            "gaussian" => Ok(Self::Gaussian),
+            _ => Err(invalid!("falloff must be 'hard', 'linear' or 'gaussian', got '{name}'")),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Hard => "hard",
+            Self::Linear => "linear",
+            Self::Gaussian => "gaussian",
+        }
+    }
+
+    pub fn code(self) -> u32 {
+        self as u32
+    }
+
+    /// The factor at disc coordinates `uv` (the rim at |uv| = 1), and whether float32 may put
+    /// the point on the other side of a hard rim (|uv| within 1e-5 of 1: an ambiguous pixel).
+    pub fn factor(self, uv: DVec2) -> (f64, bool) {
+        let r2 = uv.length_squared();
+        let inside = r2 <= 1.0;
+        match self {
+            Self::None => (1.0, false),
+            Self::Hard => (if inside { 1.0 } else { 0.0 }, (r2 - 1.0).abs() < 1e-5),
+            Self::Linear => (if inside { 1.0 - r2.sqrt() } else { 0.0 }, false),
+            Self::Gaussian => (if inside { (-4.5 * r2).exp() } else { 0.0 }, (r2 - 1.0).abs() < 1e-5),
+        }
     }
 }
 
@@ -115,6 +177,8 @@ pub struct Material {
     /// dropped, as glTF's `doubleSided: false` asks.
     pub cull_back_faces: bool,
     pub texture: Option<Texture>,
+    /// A particle set's falloff (set by `Mesh::particles`; `None` for every other surface).
+    pub falloff: Falloff,
 }
 
 impl Default for Material {
@@ -127,6 +191,7 @@ impl Default for Material {
             two_sided: true,
             cull_back_faces: false,
             texture: None,
+            falloff: Falloff::None,
         }
     }
 }
@@ -148,7 +213,11 @@ impl Material {
     /// Whether the material leaves the vertex color as it is and every triangle drawn (today's
     /// unlit meshes): else the scene is drawn with its material table.
     pub fn is_plain(&self) -> bool {
-        self.shading == Shading::Unlit && self.texture.is_none() && self.opacity == 1.0 && !self.cull_back_faces
+        self.shading == Shading::Unlit
+            && self.texture.is_none()
+            && self.opacity == 1.0
+            && !self.cull_back_faces
+            && self.falloff == Falloff::None
     }
 }
 
@@ -265,8 +334,13 @@ pub fn shade(s: &Surface<'_>, lighting: &Lighting) -> (DVec4, bool) {
         base *= t.sample(s.uv);
     }
     base.w *= m.opacity as f64;
+    let (falloff, rim) = m.falloff.factor(s.uv);
+    base.w *= falloff;
     if m.shading == Shading::Unlit {
-        return (base, false);
+        return (base, rim);
+    }
+    if m.shading == Shading::Hair {
+        return (hair(base, s, lighting), false);
     }
     let mut n = s.normal.normalize();
     let nv = n.dot(s.to_eye);
@@ -282,6 +356,23 @@ pub fn shade(s: &Surface<'_>, lighting: &Lighting) -> (DVec4, bool) {
     }
     let rgb = (base.truncate() * diffuse + m.specular as f64 * highlight).clamp(DVec3::ZERO, DVec3::ONE);
     (rgb.extend(base.w), m.two_sided && nv.abs() < 1e-5)
+}
+
+/// Kajiya and Kay's strand model with the tangent T (the surface's `normal`): diffuse
+/// sin(T, L) = sqrt(1 - (T·L)²), and a highlight sin(T, H)^shininess with H the half vector of
+/// L and V (docs/shading.md).
+fn hair(base: DVec4, s: &Surface<'_>, lighting: &Lighting) -> DVec4 {
+    let m = s.material;
+    let t = s.normal.normalize();
+    let sine = |c: f64| (1.0 - c * c).max(0.0).sqrt();
+    let mut diffuse = lighting.ambient;
+    let mut highlight = DVec3::ZERO;
+    for &(l, radiance) in &lighting.lights {
+        diffuse += radiance * sine(t.dot(l));
+        let h = (l + s.to_eye).normalize_or_zero();
+        highlight += radiance * sine(t.dot(h)).powf(m.shininess as f64);
+    }
+    (base.truncate() * diffuse + m.specular as f64 * highlight).clamp(DVec3::ZERO, DVec3::ONE).extend(base.w)
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ use glam::Vec3;
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::{GpuInstance, GpuMaterial, GpuSegment};
+use crate::primitive::{self, Primitive, PRIM_MESH, PRIM_PARTICLES, PRIM_STRANDS};
 use crate::scene::{Instance, Mesh, Scene};
 use crate::shading::Shading;
 use crate::targets::storage_buffer;
@@ -112,9 +113,15 @@ pub struct GpuScene {
     /// instances drawn.
     pub instanced: bool,
     pub instances: u64,
+    /// Whether any set is strands or particles, or any mesh shades as hair (the constant
+    /// PRIMITIVES, which compiles common/primitives.wgsl).
+    pub primitives: bool,
 }
 
-/// Chunk contents on the host while they are gathered.
+/// Chunk contents on the host while they are gathered. A chunk of strands or particles
+/// (`kind`) holds one set's points (x, y, z and half the width or the radius), their colors,
+/// and for strands a word a segment (`primitive::segment_words`) where a mesh chunk has its
+/// indices; the set's material is the chunk's.
 #[derive(Default)]
 struct Gather {
     positions: Vec<f32>,
@@ -124,6 +131,8 @@ struct Gather {
     attributes: Vec<[f32; 4]>,
     first_triangle: u32,
     shaded: bool,
+    kind: u32,
+    material: u32,
 }
 
 impl Gather {
@@ -132,7 +141,31 @@ impl Gather {
     }
 
     fn triangles(&self) -> u32 {
-        (self.indices.len() / 3) as u32
+        match self.kind {
+            PRIM_STRANDS => 2 * self.indices.len() as u32,
+            PRIM_PARTICLES => 2 * self.colors.len() as u32,
+            _ => (self.indices.len() / 3) as u32,
+        }
+    }
+
+    /// The next chunk after this one, of `kind` with `material`.
+    fn next(&self, kind: u32, material: u32) -> Gather {
+        Gather { first_triangle: self.first_triangle + self.triangles(), shaded: self.shaded, kind, material, ..Default::default() }
+    }
+
+    /// Whether `points` more points and `segments` more segment words fit `max` bytes each.
+    fn room_points(&self, points: u64, segments: u64, max: u64) -> bool {
+        let v = self.vertices() + points;
+        v * 16 <= max && (self.indices.len() as u64 + segments) * 4 <= max && v <= primitive::POINT_MASK as u64
+    }
+
+    /// Points `range` of `m` (one strand, or particles) with their half widths or radii.
+    fn push_points(&mut self, m: &Mesh, sizes: &[f32], scale: f32, range: std::ops::Range<usize>) {
+        for v in range {
+            self.positions.extend(m.positions[v]);
+            self.positions.push(sizes[v] * scale);
+            self.colors.push(m.colors[v]);
+        }
     }
 
     /// Whether `vertices` more vertices and `triangles` more triangles keep every buffer within `max` bytes.
@@ -192,7 +225,7 @@ fn upload<'a>(
         } else {
             m
         };
-        let tris = m.indices.len() as u64;
+        let tris = m.triangle_count() as u64;
         if drawn + tris * list.len() as u64 > u32::MAX as u64 / 3 {
             return Err(OitError::OutOfMemory(format!(
                 "the {label} meshes draw more than {} triangles (instances included), the most one frame numbers: \
@@ -218,7 +251,9 @@ fn upload<'a>(
         }
         unique += tris;
         let mut mine = Vec::new();
-        if cur.room(m.positions.len() as u64, tris, max) {
+        if m.primitive != Primitive::Triangles {
+            cur = upload_set(cur, &mut done, &mut mine, m, mesh as u32, max)?;
+        } else if cur.room(m.positions.len() as u64, tris, max) {
             // The whole mesh: its vertices in order, its indices offset.
             let base = cur.vertices() as u32;
             mine.push(Segment { chunk: done.len(), lo: cur.triangles(), hi: cur.triangles() + tris as u32 });
@@ -231,8 +266,8 @@ fn upload<'a>(
             mine.push(Segment { chunk: done.len(), lo: cur.triangles(), hi: cur.triangles() });
             for tri in &m.indices {
                 if !cur.room(3, 1, max) {
-                    let next = cur.first_triangle + cur.triangles();
-                    done.push(std::mem::replace(&mut cur, Gather { first_triangle: next, shaded: shared.shaded, ..Default::default() }));
+                    let next = cur.next(PRIM_MESH, 0);
+                    done.push(std::mem::replace(&mut cur, next));
                     mine.push(Segment { chunk: done.len(), lo: 0, hi: 0 });
                 }
                 let id = done.len();
@@ -307,13 +342,14 @@ fn upload<'a>(
                 g.positions.len() as u64 * 4 + g.colors.len() as u64 * 16 + g.indices.len() as u64 * 4 + g.attributes.len() as u64 * 16;
             let list = &chunk_segments[k];
             bytes += list.len() as u64 * segment_bytes;
+            let place = [g.first_triangle, g.triangles(), list.len() as u32, chunk_drawn[k], g.kind, g.material, 0, 0];
             let info = gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("chunk"),
-                size: 16,
+                size: std::mem::size_of_val(&place) as u64,
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
-            gpu.queue.write_buffer(&info, 0, bytemuck::cast_slice(&[g.first_triangle, g.triangles(), list.len() as u32, chunk_drawn[k]]));
+            gpu.queue.write_buffer(&info, 0, bytemuck::cast_slice(&place));
             let pos = make("positions", bytemuck::cast_slice(&g.positions));
             let col = make("colors", bytemuck::cast_slice(&g.colors));
             let idx = make("indices", bytemuck::cast_slice(&g.indices));
@@ -338,6 +374,59 @@ fn upload<'a>(
         })
         .collect();
     Ok(Geometry { chunks, triangles: drawn as u32, placements, segments, instances, instanced: shared.instanced, bytes })
+}
+
+/// Uploads a strand or particle set, the scene's mesh `material`, into chunks of its own after
+/// `cur` (closed first where it holds anything): whole strands or particles while they fit a
+/// binding. Returns the mesh chunk that follows it; `mine` gets the set's segments.
+fn upload_set(cur: Gather, done: &mut Vec<Gather>, mine: &mut Vec<Segment>, m: &Mesh, material: u32, max: u64) -> Result<Gather> {
+    let kind = m.primitive.kind();
+    let mut cur = if cur.vertices() > 0 || !cur.indices.is_empty() {
+        let next = cur.next(kind, material);
+        done.push(cur);
+        next
+    } else {
+        Gather { kind, material, ..cur }
+    };
+    let start = |mine: &mut Vec<Segment>, done: &Vec<Gather>| mine.push(Segment { chunk: done.len(), lo: 0, hi: 0 });
+    start(mine, done);
+    let units: Vec<(usize, usize)> = match &m.primitive {
+        Primitive::Strands { counts, .. } => {
+            let mut first = 0;
+            counts
+                .iter()
+                .map(|&c| {
+                    first += c as usize;
+                    (first - c as usize, c as usize)
+                })
+                .collect()
+        }
+        _ => (0..m.positions.len()).map(|i| (i, 1)).collect(),
+    };
+    for (first, points) in units {
+        let segments = if kind == PRIM_STRANDS { points as u64 - 1 } else { 0 };
+        if !cur.room_points(points as u64, segments, max) {
+            if cur.vertices() == 0 {
+                return Err(OitError::OutOfMemory(format!("a strand of {points} points passes a storage binding ({max} bytes): split it")));
+            }
+            let next = cur.next(kind, material);
+            done.push(std::mem::replace(&mut cur, next));
+            start(mine, done);
+        }
+        let base = cur.vertices() as u32;
+        match &m.primitive {
+            Primitive::Strands { widths, .. } => {
+                cur.push_points(m, widths, 0.5, first..first + points);
+                cur.indices.extend(primitive::segment_words(&[points as u32], base));
+            }
+            Primitive::Particles { radii } => cur.push_points(m, radii, 1.0, first..first + points),
+            Primitive::Triangles => unreachable!("meshes are uploaded by upload"),
+        }
+        mine.last_mut().expect("started above").hi = cur.triangles();
+    }
+    let next = cur.next(PRIM_MESH, 0);
+    done.push(cur);
+    Ok(next)
 }
 
 impl GpuScene {
@@ -369,7 +458,8 @@ impl GpuScene {
             transparent.bytes += table.len() as u64 * 16;
         }
         let textured = shaded && scene.meshes().iter().any(|m| m.material.texture.is_some());
-        Ok(Self { transparent, opaque, shaded, textured, instanced, instances: scene.instance_count() as u64 })
+        let primitives = scene.meshes().iter().any(|m| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair);
+        Ok(Self { transparent, opaque, shaded, textured, instanced, instances: scene.instance_count() as u64, primitives })
     }
 }
 
@@ -386,6 +476,7 @@ fn flat_corners(m: &Mesh) -> Mesh {
         opaque: m.opaque,
         normals: Vec::with_capacity(3 * m.indices.len()),
         material: Default::default(),
+        primitive: Primitive::Triangles,
     };
     for t in &m.indices {
         let p = t.map(|v| glam::DVec3::from(m.positions[v as usize].map(|x| x as f64)));

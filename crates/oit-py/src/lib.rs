@@ -4,7 +4,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -13,6 +13,7 @@ use oit_core::{OitError, ParamKind, ParamValue};
 
 mod convert;
 mod load;
+mod primitives;
 
 use convert::{instances, matrix, rows, InstanceArrays};
 
@@ -101,11 +102,61 @@ impl Scene {
             two_sided,
             cull_back_faces,
             texture,
+            ..Default::default()
         };
         let normals = normals.map(|n| rows(&n, "normals")).transpose()?;
         let uvs = uvs.map(|u| rows(&u, "uvs")).transpose()?;
         let mesh = mesh.with_surface(normals, uvs, material).map_err(Error::from)?;
         Ok(self.inner.add_placed(mesh, vec![placement]))
+    }
+
+    /// A strand set: points (n, 3), counts (strands,) uint32, widths (n,) or (1,), colors (n, 4)
+    /// or (1, 4) float32; shading "unlit" or "hair".
+    #[pyo3(signature = (points, counts, widths, colors, opaque, shading="unlit", specular=0.0, shininess=32.0, opacity=1.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_strands(
+        &mut self,
+        points: PyReadonlyArray2<'_, f32>,
+        counts: PyReadonlyArray1<'_, u32>,
+        widths: PyReadonlyArray1<'_, f32>,
+        colors: PyReadonlyArray2<'_, f32>,
+        opaque: bool,
+        shading: &str,
+        specular: f32,
+        shininess: f32,
+        opacity: f32,
+    ) -> PyResult<usize> {
+        let look = primitives::Look { shading, specular, shininess, opacity };
+        Ok(self.inner.add_mesh(primitives::strands(&points, &counts, &widths, &colors, opaque, &look)?))
+    }
+
+    /// A particle set: centers (n, 3), radii (n,) or (1,), colors (n, 4) or (1, 4) float32.
+    #[pyo3(signature = (centers, radii, colors, opaque, falloff="hard", opacity=1.0))]
+    fn add_particles(
+        &mut self,
+        centers: PyReadonlyArray2<'_, f32>,
+        radii: PyReadonlyArray1<'_, f32>,
+        colors: PyReadonlyArray2<'_, f32>,
+        opaque: bool,
+        falloff: &str,
+        opacity: f32,
+    ) -> PyResult<usize> {
+        Ok(self.inner.add_mesh(primitives::particles(&centers, &radii, &colors, opaque, falloff, opacity)?))
+    }
+
+    /// Mesh `mesh` as the triangles it is drawn as under `view_proj`.
+    fn to_triangles<'py>(
+        &self,
+        py: Python<'py>,
+        mesh: i64,
+        view_proj: PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<primitives::TriangleArrays<'py>> {
+        primitives::to_triangles(py, &self.inner.meshes()[self.mesh_index(mesh)?], &view_proj)
+    }
+
+    /// "triangles", "strands" or "particles" per mesh.
+    fn mesh_primitives(&self) -> Vec<&'static str> {
+        self.inner.meshes().iter().map(|m| m.primitive.name()).collect()
     }
 
     /// Appends instances to mesh `mesh`: transforms (n, 4, 4) float64, colors (n, 4) float32
@@ -212,7 +263,7 @@ impl Scene {
 
     /// (triangles, vertices, opaque) per mesh.
     fn mesh_summary(&self) -> Vec<(usize, usize, bool)> {
-        self.inner.meshes().iter().map(|m| (m.indices.len(), m.positions.len(), m.opaque)).collect()
+        self.inner.meshes().iter().map(|m| (m.triangle_count(), m.positions.len(), m.opaque)).collect()
     }
 }
 

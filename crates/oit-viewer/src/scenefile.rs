@@ -158,7 +158,7 @@ fn read_surface(r: &mut Reader<'_>, mesh: Mesh, n: usize) -> Result<Mesh, String
     } else {
         None
     };
-    let material = Material { shading, specular, shininess, opacity, two_sided, cull_back_faces, texture };
+    let material = Material { shading, specular, shininess, opacity, two_sided, cull_back_faces, texture, ..Default::default() };
     mesh.with_surface(normals, uvs, material).map_err(|e| e.to_string())
 }
 

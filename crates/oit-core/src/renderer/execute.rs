@@ -45,7 +45,8 @@ enum CensusKind {
 /// vertex shader drops the back faces a material culls (common/scene.wgsl); instanced where the
 /// scene is.
 fn census_pipeline(gpu: &GpuContext, kind: CensusKind, scene: &GpuScene) -> wgpu::RenderPipeline {
-    let variant = SceneVariant { shaded: scene.shaded, instanced: scene.instanced, ..Default::default() }.consts();
+    let variant =
+        SceneVariant { shaded: scene.shaded, instanced: scene.instanced, primitives: scene.primitives, ..Default::default() }.consts();
     let add = wgpu::BlendComponent {
         src_factor: wgpu::BlendFactor::One,
         dst_factor: wgpu::BlendFactor::One,

@@ -1,0 +1,82 @@
+//! Strand and particle sets from numpy arrays, and any set as the triangles it is drawn as.
+//! Shapes are checked here; values are the core's to check (oit_core::primitive).
+
+use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+
+use crate::convert::{matrix, rows};
+use crate::Error;
+
+/// The surface words shared by strands and particles.
+pub(crate) struct Look<'a> {
+    pub shading: &'a str,
+    pub specular: f32,
+    pub shininess: f32,
+    pub opacity: f32,
+}
+
+fn surfaced(mesh: oit_core::Mesh, look: &Look<'_>) -> PyResult<oit_core::Mesh> {
+    let shading = oit_core::Shading::from_name(look.shading).map_err(Error::from)?;
+    Ok(mesh.with_primitive_surface(shading, look.specular, look.shininess, look.opacity).map_err(Error::from)?)
+}
+
+pub(crate) fn strands(
+    points: &PyReadonlyArray2<'_, f32>,
+    counts: &PyReadonlyArray1<'_, u32>,
+    widths: &PyReadonlyArray1<'_, f32>,
+    colors: &PyReadonlyArray2<'_, f32>,
+    opaque: bool,
+    look: &Look<'_>,
+) -> PyResult<oit_core::Mesh> {
+    let counts = counts.as_array().to_vec();
+    let widths = widths.as_array().to_vec();
+    let mesh = oit_core::Mesh::strands(rows(points, "points")?, counts, widths, rows(colors, "colors")?, opaque).map_err(Error::from)?;
+    surfaced(mesh, look)
+}
+
+pub(crate) fn particles(
+    centers: &PyReadonlyArray2<'_, f32>,
+    radii: &PyReadonlyArray1<'_, f32>,
+    colors: &PyReadonlyArray2<'_, f32>,
+    opaque: bool,
+    falloff: &str,
+    opacity: f32,
+) -> PyResult<oit_core::Mesh> {
+    let falloff = oit_core::Falloff::from_name(falloff).map_err(Error::from)?;
+    let radii = radii.as_array().to_vec();
+    let mesh =
+        oit_core::Mesh::particles(rows(centers, "centers")?, radii, rows(colors, "colors")?, opaque, falloff).map_err(Error::from)?;
+    surfaced(mesh, &Look { shading: "unlit", specular: 0.0, shininess: 32.0, opacity })
+}
+
+/// Positions (n, 3), indices (m, 3), colors (n, 4), normals (n, 3) or None, uvs (n, 2) or None.
+pub(crate) type TriangleArrays<'py> = (
+    Bound<'py, numpy::PyArray2<f32>>,
+    Bound<'py, numpy::PyArray2<u32>>,
+    Bound<'py, numpy::PyArray2<f32>>,
+    Option<Bound<'py, numpy::PyArray2<f32>>>,
+    Option<Bound<'py, numpy::PyArray2<f32>>>,
+);
+
+fn array<'py, T: numpy::Element + Copy, const N: usize>(py: Python<'py>, v: &[[T; N]]) -> Bound<'py, numpy::PyArray2<T>> {
+    let flat: Vec<T> = v.iter().flatten().copied().collect();
+    numpy::ndarray::Array2::from_shape_vec((v.len(), N), flat).expect("n x N").into_pyarray(py)
+}
+
+/// `mesh` as triangles under the camera `view_proj` (strands and particles face it).
+pub(crate) fn to_triangles<'py>(
+    py: Python<'py>,
+    mesh: &oit_core::Mesh,
+    view_proj: &PyReadonlyArray2<'_, f64>,
+) -> PyResult<TriangleArrays<'py>> {
+    let camera = oit_core::Camera::from_rows(matrix(view_proj, "camera matrix")?).map_err(Error::from)?;
+    let m = oit_core::primitive::to_triangles(mesh, &camera);
+    let optional = |v: Bound<'py, numpy::PyArray2<f32>>, empty: bool| (!empty).then_some(v);
+    Ok((
+        array(py, &m.positions),
+        array(py, &m.indices),
+        array(py, &m.colors),
+        optional(array(py, &m.normals), m.normals.is_empty()),
+        optional(array(py, &m.uvs), m.uvs.is_empty()),
+    ))
+}

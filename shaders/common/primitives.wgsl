@@ -1,0 +1,126 @@
+// Strands and particles (oit_core::primitive, whose float64 `expand` this mirrors): a chunk of
+// kind PRIM_STRANDS or PRIM_PARTICLES holds one set's points as four floats each (x, y, z and
+// half the width, or the radius) and their colors; a strand chunk has a word a segment in
+// `indices` (its first point, FIRST_SEGMENT, LAST_SEGMENT). The vertex stage builds the
+// triangles facing the eye, six corners a segment or particle in the order of
+// primitive::CORNERS, so that every pass that pulls corners (the vertex shader, triangle setup,
+// the compact A-buffer's records) sees the same triangles.
+
+struct Corner {
+    world: vec3<f32>,
+    color: vec4<f32>,
+    // A strand's unit tangent (what 'hair' shading reads as the normal); zero for particles.
+    tangent: vec3<f32>,
+    // A particle's disc coordinates, the rim at |uv| = 1; zero for strands.
+    uv: vec2<f32>,
+}
+
+// From `p` towards the homogeneous eye E = inv_view_proj (0, 0, 1, 0): the camera's center, or
+// for an orthographic camera its view direction at infinity (not normalized).
+fn towards_eye(p: vec3<f32>) -> vec3<f32> {
+    let e = frame.inv_view_proj[2];
+    return e.xyz - p * e.w;
+}
+
+fn point_at(i: u32, ii: u32) -> vec3<f32> {
+    return placed_at(vec3<f32>(positions[4u * i], positions[4u * i + 1u], positions[4u * i + 2u]), ii).xyz;
+}
+
+// `v` / |v|, or zero where |v|² <= 1e-30 (primitive.rs: normalize_or_zero and its cut).
+fn unit_or_zero(v: vec3<f32>) -> vec3<f32> {
+    let l2 = dot(v, v);
+    return select(vec3<f32>(0.0), v * inverseSqrt(l2), l2 > 1e-30);
+}
+
+// Corner `vi` of the chunk (corner vi % 3 of local triangle vi / 3) under instance `ii`.
+fn corner_of(vi: u32, ii: u32) -> Corner {
+    let unit = vi / 6u;
+    let c = vi % 6u;
+    let far = c == 2u || c == 3u || c == 5u;
+    let side = select(-1.0, 1.0, c == 1u || c == 4u || c == 5u);
+    if chunk.kind == PRIM_STRANDS {
+        return strand_corner(unit, far, side, ii);
+    }
+    return particle_corner(unit, far, side, ii);
+}
+
+// A ribbon corner at the segment's near or far point: the point moved by half its width
+// across the strand and across the view. The tangent at a point is the chord from the point
+// before it to the point after it (one-sided at a strand's ends), so that the two segments
+// meeting at a joint compute its corners from the same numbers: no gap, no overlap.
+fn strand_corner(s: u32, far: bool, side: f32, ii: u32) -> Corner {
+    let word = indices[s];
+    let i = (word & POINT_MASK) + u32(far);
+    let prev = select(i - 1u, i, !far && (word & FIRST_SEGMENT) != 0u);
+    let next = select(i + 1u, i, far && (word & LAST_SEGMENT) != 0u);
+    let p = point_at(i, ii);
+    let t = point_at(next, ii) - point_at(prev, ii);
+    let across = unit_or_zero(cross(t, towards_eye(p))) * positions[4u * i + 3u];
+    return Corner(p + across * side, placed_color(i, ii), unit_or_zero(t), vec2<f32>(0.0));
+}
+
+// A particle's quad corner: its center moved by the radius along the axes of the plane that
+// faces the eye (right from the camera's up, the world direction of clip y).
+fn particle_corner(q: u32, far: bool, side: f32, ii: u32) -> Corner {
+    let c = point_at(q, ii);
+    let d = unit_or_zero(towards_eye(c));
+    let hint = vec3<f32>(frame.view_proj[0].y, frame.view_proj[1].y, frame.view_proj[2].y);
+    var right = cross(hint, d);
+    if dot(right, right) <= 1e-30 {
+        right = cross(vec3<f32>(1.0, 0.0, 0.0), d);
+    }
+    right = unit_or_zero(right);
+    let up = unit_or_zero(cross(d, right));
+    let uv = vec2<f32>(side, select(-1.0, 1.0, far));
+    let r = positions[4u * q + 3u];
+    return Corner(c + (right * uv.x + up * uv.y) * r, placed_color(q, ii), vec3<f32>(0.0), uv);
+}
+
+// The vertex shader's output for corner `vi` of a strand or particle chunk.
+fn expanded_vertex(vi: u32, ii: u32) -> VsOut {
+    let k = corner_of(vi, ii);
+    var out: VsOut;
+    out.clip = frame.view_proj * vec4<f32>(k.world, 1.0);
+    out.color = k.color;
+    out.prim = drawn_prim(vi / 3u, ii);
+    out.view_w = out.clip.w;
+//!if SHADED
+    out.normal = k.tangent;
+    out.uv = k.uv;
+    out.material = chunk.set_surface;
+//!endif
+    return out;
+}
+
+// A particle's alpha factor at disc coordinates `uv` (shading::Falloff::factor): 1 inside a
+// hard disc, 1 - r linear, exp(-4.5 r²) Gaussian, 0 past the rim; 1 where there is no falloff.
+fn falloff(mode: u32, uv: vec2<f32>) -> f32 {
+    if mode == 0u {
+        return 1.0;
+    }
+    let r2 = dot(uv, uv);
+    var f = 1.0;
+    if mode == FALLOFF_LINEAR {
+        f = 1.0 - sqrt(r2);
+    } else if mode == FALLOFF_GAUSSIAN {
+        f = exp(-4.5 * r2);
+    }
+    return select(0.0, f, r2 <= 1.0);
+}
+
+// Kajiya and Kay's strand model with unit tangent `t` (shading::hair): diffuse sin(T, L), a
+// highlight sin(T, H)^shininess, H the half vector of L and the eye direction `v`.
+fn hair(base: vec3<f32>, t: vec3<f32>, v: vec3<f32>, m0: vec4<f32>) -> vec3<f32> {
+    var diffuse = frame.ambient.rgb;
+    var highlight = vec3<f32>(0.0);
+    for (var i = 0u; i < LIGHTS; i++) {
+        let l = frame.lights[i].to_light.xyz;
+        let radiance = frame.lights[i].radiance.rgb;
+        let tl = dot(t, l);
+        diffuse += radiance * sqrt(max(1.0 - tl * tl, 0.0));
+        let hv = l + v;
+        let th = dot(t, hv * inverseSqrt(max(dot(hv, hv), 1e-30)));
+        highlight += radiance * pow(sqrt(max(1.0 - th * th, 0.0)), m0.y);
+    }
+    return clamp(base * diffuse + m0.x * highlight, vec3<f32>(0.0), vec3<f32>(1.0));
+}
