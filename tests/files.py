@@ -138,3 +138,11 @@ def stl_cube(path: Path) -> Path:
         data += struct.pack("<3f", 0, 0, 0) + CUBE[f].astype("<f4").tobytes() + b"\0\0"
     path.write_bytes(bytes(data))
     return path
+
+
+def ply_points(path: Path) -> Path:
+    """A point cloud: three points with 8-bit RGBA colors and no faces."""
+    head = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\nend_header\n")
+    path.write_text(head + "-0.5 0 0 255 0 0 128\n0.5 0 0 0 255 0 128\n0 0.5 0.2 0 0 255 255\n")
+    return path

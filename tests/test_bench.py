@@ -448,3 +448,14 @@ def test_shading_cost_sweep_keeps_the_image_and_measures_each_method():
         assert math.isfinite(r["ms_per_100"]) and r["wall_ms"] > 0
     assert {r["method"]: r["shadings"] for r in rows} == {"abuffer": "1", "compact_abuffer": "stored only (deferred)",
                                                           "hybrid": "1 + alpha"}
+
+
+def test_cli_strands_writes_the_strand_table(tmp_path):
+    code = cli.main(["bench", "--strands", "--quick", "--methods", "unsorted", "--out", str(tmp_path)])
+    assert code == 0
+    with open(tmp_path / "strands.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["method"] for r in rows] == ["unsorted"]
+    # Points and a word a segment against two shaded vertices a point and six indices a segment.
+    assert float(rows[0]["bytes_x"]) > 3.0
+    assert (tmp_path / "strands.md").read_text().count("| 300 | unsorted |") == 1

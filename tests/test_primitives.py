@@ -210,3 +210,87 @@ def test_bad_array_types_are_refused():
         oit.Scene().add_strands(np.zeros((2, 3)), [2.0], 0.1, [1, 1, 1, 1])
     with pytest.raises(ValueError, match="points must have shape"):
         oit.Scene().add_strands(np.zeros((2, 2)), [2], 0.1, [1, 1, 1, 1])
+
+
+def test_hair_and_smoke_built_on_strands_and_particles_look_as_their_triangles(renderer):
+    r = renderer(64, 64)
+    for build, kinds in [(oit.scenes.hair, ("ribbons", "strands")), (oit.scenes.smoke, ("fans", "particles"))]:
+        a, b = (build(**({"strands": 400} if build is oit.scenes.hair else {"particles": 150}), primitive=k) for k in kinds)
+        assert b.scene.primitives() == [kinds[1]] and b.meta["primitive"] == kinds[1]
+        assert a.scene.triangle_count == b.scene.triangle_count or build is oit.scenes.smoke
+        fa, fb = r.render(a.scene, a.camera, "abuffer"), r.render(b.scene, b.camera, "abuffer")
+        # The same look: ribbons facing +z against ribbons facing the eye, fans against discs.
+        assert np.abs(fa.image - fb.image).mean() < 0.02, build.__name__
+        assert fb.stats["scene_bytes"] * 3 <= fa.stats["scene_bytes"], build.__name__
+    with pytest.raises(ValueError, match="primitive must be one of"):
+        oit.scenes.hair(strands=10, primitive="cards")
+
+
+# ---- files
+
+
+def test_a_ply_of_points_loads_as_particles(tmp_path, renderer):
+    from files import ply_points
+
+    path = ply_points(tmp_path / "points.ply")
+    scene = oit.Scene.from_file(path)
+    assert scene.primitives() == ["particles"] and scene.triangle_count == 6
+    # By default 1/200 of the box's diagonal; the points' colors are kept.
+    t = scene.to_triangles(0, IDENTITY)
+    diagonal = np.linalg.norm(np.array([0.5, 0.5, 0.2]) - [-0.5, 0.0, 0.0])
+    corner = np.linalg.norm(t["positions"][:6] - [-0.5, 0.0, 0.0], axis=1)
+    np.testing.assert_allclose(corner, diagonal / 200 * np.sqrt(2), rtol=1e-5)
+    np.testing.assert_allclose(t["colors"][0], [1.0, 0.0, 0.0, 128 / 255], rtol=1e-6)
+    big = oit.Scene.from_file(path, point_radius=0.25)
+    frame = renderer(64, 64).render(big, IDENTITY, "abuffer", background=WHITE)
+    ref = oit.reference(big, IDENTITY, 64, 64, background=WHITE)
+    assert np.abs(frame.image - ref).max() <= TOL
+    # The red point's disc at NDC (-0.5, 0): row 31, column 16; radius 0.25 is 8 pixels.
+    assert frame.image[31, 16, 0] > 0.9 and frame.image[31, 16, 1] < 0.6
+    assert np.all(frame.image[31, 26, :3] == 1.0)
+    with pytest.raises(ValueError, match="radius"):
+        oit.Scene.from_file(path, point_radius=-1.0)
+
+
+def test_a_hair_file_loads_as_strands(tmp_path, renderer):
+    from oit.hairfile import read_hair, write_hair
+
+    rng = np.random.default_rng(9)
+    pts = np.cumsum(rng.normal(0, 0.1, (30, 3)), 0).astype(np.float32)
+    colors = rng.uniform(0.2, 0.9, (30, 4)).astype(np.float32)
+    path = tmp_path / "model.hair"
+    write_hair(path, pts, [10, 20], widths=np.full(30, 0.05, np.float32), colors=colors)
+    scene = oit.Scene.from_file(path)
+    assert scene.primitives() == ["strands"] and scene.mesh_names == ["model"]
+    assert scene.triangle_count == 2 * 28
+    # The file keeps transparency, 1 - alpha: the colors as read back, to the bit.
+    h = read_hair(path)
+    np.testing.assert_allclose(h.colors, colors, atol=1e-7)
+    direct = oit.Scene()
+    direct.add_strands(pts, [10, 20], 0.05, h.colors, shading="hair", specular=0.25, shininess=48.0)
+    a = renderer(48, 48).render(scene, PERSPECTIVE, "abuffer")
+    b = renderer(48, 48).render(direct, PERSPECTIVE, "abuffer")
+    np.testing.assert_array_equal(a.image, b.image)
+
+
+def test_scene_files_carry_strands_and_particles(tmp_path, renderer):
+    from oit import scenefile
+
+    hair = oit.scenes.hair(strands=60, primitive="strands")
+    smoke = oit.scenes.smoke(particles=40, primitive="particles")
+    meshes = hair.meshes + smoke.meshes
+    path = tmp_path / "mixed.oitscene"
+    scenefile.save_scene(meshes, path, camera=hair.camera, lights=hair.lights, ambient=hair.ambient)
+    assert path.read_bytes()[8:12] == (3).to_bytes(4, "little")
+    back, camera, _ = scenefile.load_scene(path)
+    lights, ambient = scenefile.load_lights(path)
+    assert [m.primitive["kind"] for m in back] == ["strands", "particles"]
+    original = oit.scenes.from_meshes(meshes, hair.camera, lights=hair.lights, ambient=hair.ambient)
+    again = scenefile.scene_of(back, lights, ambient)
+    assert again.primitives() == ["strands", "particles"]
+    a = renderer(48, 48).render(original.scene, camera, "abuffer")
+    b = renderer(48, 48).render(again, camera, "abuffer")
+    np.testing.assert_array_equal(a.image, b.image)
+    # Peers get triangles: each segment and each particle two.
+    drawn = original.drawn_meshes()
+    assert [len(m.indices) for m in drawn] == [original.scene.triangle_count - 80, 80]

@@ -14,6 +14,7 @@ import numpy as np
 
 from . import _oit
 from ._checks import _I64_MAX, _U32_MAX, SHADINGS, _float_array, _instance_colors, _int, _number, _rows, _surface, _transforms, _vector
+from ._load import FileCamera, load_file
 from ._memory import available_memory
 from ._primitives import PrimitiveMethods
 from ._trimesh import trimesh_arrays
@@ -99,8 +100,7 @@ class Scene(PrimitiveMethods):
         """Replaces the instances of mesh `mesh` (its add_mesh placement included) with
         `transforms` and `colors`, as `add_instances` takes them; with none (shape (0, 4, 4))
         the mesh stays in the scene but is not drawn."""
-        index = self._mesh_index(mesh)
-        t = _transforms(transforms, "transforms")
+        index, t = self._mesh_index(mesh), _transforms(transforms, "transforms")
         self._native.set_instances(index, t, _instance_colors(colors, len(t)))
 
     def instances(self, mesh: int) -> tuple[np.ndarray, np.ndarray]:
@@ -176,16 +176,18 @@ class Scene(PrimitiveMethods):
 
     @classmethod
     def from_file(cls, path: str | os.PathLike, alpha: float | None = None, *, shading: str = "smooth",
-                  specular: float = 0.25) -> Scene:
+                  specular: float = 0.25, point_radius: float | None = None) -> Scene:
         """A scene from a mesh file, as the file has it (docs/loading.md): OBJ with its MTL
         (Kd, d or Tr, map_Kd, map_d), glTF/GLB (a mesh shared by nodes drawn as instances, every
         primitive, baseColorFactor and baseColorTexture, alphaMode and alphaCutoff, doubleSided:
-        false culls back faces), PLY (vertex colors with alpha) or STL. `alpha` makes every mesh
+        false culls back faces), PLY (vertex colors with alpha; a PLY of points only is a particle
+        set of hard discs of `point_radius`, by default 1/200 of its box's diagonal), STL, or a
+        `.hair` strand model (oit.hairfile; shaded "hair", its thickness as the width). `alpha` makes every mesh
         transparent at it; `shading` ("smooth" with the file's normals, "flat" or "unlit") and
         `specular` style every surface. `scene.mesh_names` names the meshes, and
         `scene.cameras` lists the file's cameras (`FileCamera.camera(aspect)` gives an oit.Camera).
         The same loader (oit-core's) reads files for the viewer and `python -m oit render`."""
-        return load_file(path, alpha, shading=shading, specular=specular)[0]
+        return load_file(path, alpha, shading=shading, specular=specular, point_radius=point_radius)[0]
 
     @classmethod
     def from_trimesh(cls, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False,
@@ -336,59 +338,6 @@ class Camera:
         return cls.look_at(center + d * dist, center, fov_y, near=near, far=far, aspect=aspect)
 
 
-@dataclass
-class FileCamera:
-    """A camera of a loaded file: `view` (4 x 4, world to camera, looking down -z with y up) and
-    its `projection` dict ("type" "perspective" with yfov in radians, aspect (the file's, or
-    None), near and far; or "orthographic" with xmag, ymag, near and far)."""
-
-    name: str
-    view: np.ndarray
-    projection: dict[str, Any]
-
-    def camera(self, aspect: float | None = None) -> Camera:
-        """The oit.Camera of this view at `aspect` (width / height; default: the file's, else 1)."""
-        p = self.projection
-        if p["type"] == "orthographic":
-            return Camera(Camera.orthographic(-p["xmag"], p["xmag"], -p["ymag"], p["ymag"], p["near"], p["far"]).view_proj
-                          @ self.view)
-        aspect = aspect or p["aspect"] or 1.0
-        f = 1.0 / np.tan(p["yfov"] / 2.0)
-        proj = np.zeros((4, 4))
-        proj[0, 0], proj[1, 1] = f / aspect, f
-        proj[2, 2], proj[2, 3] = p["far"] / (p["near"] - p["far"]), p["near"] * p["far"] / (p["near"] - p["far"])
-        proj[3, 2] = -1.0
-        return Camera(proj @ self.view)
-
-
-FORMATS = (".obj", ".gltf", ".glb", ".ply", ".stl")
-
-
-def load_file(path: str | os.PathLike, alpha: float | None = None, *, shading: str = "smooth", specular: float = 0.25,
-              viewing: bool = False) -> tuple[Scene, str | None]:
-    """`Scene.from_file`, and with `viewing` the command line's convenience: when nothing in
-    the file is transparent every mesh is drawn at alpha 0.4, and the second value says so."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__}")
-    path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise FileNotFoundError(f"no such file: {path}: check the path")
-    if os.path.splitext(path)[1].lower() not in FORMATS:
-        raise ValueError(f"{path}: unknown file type {os.path.splitext(path)[1]!r}: oit reads {', '.join(FORMATS)} files")
-    if alpha is not None and not 0.0 <= _number(alpha, "alpha") <= 1.0:
-        raise ValueError(f"alpha must be in [0, 1], got {alpha}")
-    if shading not in SHADINGS:
-        raise ValueError(f"shading must be one of {SHADINGS}, got {shading!r}")
-    if _number(specular, "specular") < 0:
-        raise ValueError(f"specular must be >= 0, got {specular}")
-    native, names, cameras, note = _oit.load_file(path, shading, float(specular), alpha, viewing)
-    scene = Scene()
-    scene._native, scene.mesh_names = native, list(names)
-    scene.cameras = [FileCamera(c["name"], np.array(c["view"], dtype=np.float64),
-                                {k: v for k, v in c.items() if k not in ("name", "view")}) for c in cameras]
-    return scene, note
-
-
 class Stats(TypedDict, total=False):
     """`frame.stats`: what every frame reports; method-specific figures are under `extra`. The
     keys, their types and meanings are the core's (`oit._oit.stats_schema()`,
@@ -402,6 +351,7 @@ class Stats(TypedDict, total=False):
     memory_bytes: int  # what the method allocated (oit.memory_bytes gives its formula)
     target_bytes: int  # the frame's targets and readbacks as allocated (tile-sized under a small budget)
     scene_bytes: int  # the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's
+    scene_bytes_by_primitive: dict[str, float]  # scene_bytes as 'triangles' (meshes, materials, instances), 'strands' and 'particles'
     gpu_time_ms: float | None  # the passes' GPU time; None where the adapter has no timestamp queries
     pass_times_ms: dict[str, float]  # GPU time per pass; a pass run more than once adds up
     overflow_fragments: int  # fragments a bounded structure could not hold

@@ -51,6 +51,7 @@ class _Stats(TypedDict, total=False):
     memory_bytes: int
     target_bytes: int
     scene_bytes: int
+    scene_bytes_by_primitive: dict[str, float]
     gpu_time_ms: float | None
     pass_times_ms: dict[str, float]
     overflow_fragments: int
@@ -106,8 +107,44 @@ class Scene:
     ) -> int:
         """positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
         surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
-        shading "unlit", "flat" or "smooth". `transform` (4, 4) float64 places it (else it is
+        shading "unlit", "flat", "smooth" or "hair". `transform` (4, 4) float64 places it (else it is
         drawn where its vertices are)."""
+    def add_strands(
+        self,
+        points: npt.NDArray[np.float32],
+        counts: npt.NDArray[np.uint32],
+        widths: npt.NDArray[np.float32],
+        colors: npt.NDArray[np.float32],
+        opaque: bool,
+        shading: str = "unlit",
+        specular: float = 0.0,
+        shininess: float = 32.0,
+        opacity: float = 1.0,
+    ) -> int:
+        """A strand set: points (n, 3), counts (strands,) uint32, widths (n,) or (1,), colors (n, 4)
+        or (1, 4) float32; shading "unlit" or "hair"."""
+    def add_particles(
+        self,
+        centers: npt.NDArray[np.float32],
+        radii: npt.NDArray[np.float32],
+        colors: npt.NDArray[np.float32],
+        opaque: bool,
+        falloff: str = "hard",
+        opacity: float = 1.0,
+    ) -> int:
+        """A particle set: centers (n, 3), radii (n,) or (1,), colors (n, 4) or (1, 4) float32."""
+    def to_triangles(
+        self, mesh: int, view_proj: npt.NDArray[np.float64]
+    ) -> tuple[
+        npt.NDArray[np.float32],
+        npt.NDArray[np.uint32],
+        npt.NDArray[np.float32],
+        npt.NDArray[np.float32] | None,
+        npt.NDArray[np.float32] | None,
+    ]:
+        """Mesh `mesh` as the triangles it is drawn as under `view_proj`."""
+    def mesh_primitives(self) -> list[str]:
+        """"triangles", "strands" or "particles" per mesh."""
     def add_instances(
         self, mesh: int, transforms: npt.NDArray[np.float64], colors: npt.NDArray[np.float32] | None = None
     ) -> int:
@@ -205,8 +242,14 @@ def reference(
     """CPU float64 reference: (image (h, w, 4) float64, ambiguous (h, w) bool, depth complexity),
     the mean over the standard pattern's positions when `antialias` > 1."""
 def load_file(
-    path: str, shading: str = "smooth", specular: float = 0.25, alpha: float | None = None, viewing: bool = False
+    path: str,
+    shading: str = "smooth",
+    specular: float = 0.25,
+    alpha: float | None = None,
+    viewing: bool = False,
+    point_radius: float | None = None,
 ) -> tuple[Scene, list[str], list[dict[str, Any]], str | None]:
     """Reads `path`; `shading` and `specular` style every surface (`load::Surface`). `alpha`
     makes every mesh transparent at it; `viewing` adds the command line's convenience (every
-    mesh at VIEWING_ALPHA when nothing blends) and returns its note."""
+    mesh at VIEWING_ALPHA when nothing blends) and returns its note; `point_radius` sizes a point
+    cloud's particles (None: 1/200 of its box's diagonal)."""

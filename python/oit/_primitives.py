@@ -37,6 +37,7 @@ class PrimitiveMethods:
     """The strand and particle half of `Scene` (its `_native` is the core's scene)."""
 
     _native: Any
+    _mesh_index: Any
 
     def add_strands(self, points: Any, counts: Any, width: Any, colors: Any, opaque: bool = False, *,
                     shading: str = "unlit", specular: float = 0.0, shininess: float = 32.0,
@@ -92,5 +93,5 @@ class PrimitiveMethods:
         triangles; strands come back as they look under that camera through
         `add_mesh(..., normals=tangents, shading="hair")` (or unlit), particles without their
         falloff."""
-        pos, idx, col, normals, uvs = self._native.to_triangles(int(mesh), np.asarray(camera.view_proj, dtype=np.float64))
+        pos, idx, col, normals, uvs = self._native.to_triangles(self._mesh_index(mesh), np.asarray(camera.view_proj, dtype=np.float64))
         return {"positions": pos, "indices": idx, "colors": col, "normals": normals, "uvs": uvs}

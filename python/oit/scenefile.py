@@ -15,9 +15,16 @@ layout (docs/viewer.md; crates/oit-viewer/src/scenefile.rs reads it), all little
         texture height h u32 and width w u32 (0 0: none) and h*w*4 f32 linear RGBA
     version 2 only, after the meshes: light count u32, per light direction xyz, color rgb,
         intensity (7 f32); ambient rgb (3 f32)
+    version 3: as version 2, and a mesh's flags bit 2 says it is a strand or particle set
+        (oit.Scene.add_strands, add_particles): its n vertices are the points, it has no
+        triangles (m = 0), and after its indices come kind u32 (1 strands, 2 particles), then
+        for strands the strand count s u32, the points per strand s*u32 and the widths n*f32,
+        for particles the falloff u32 (1 hard, 2 linear, 3 gaussian) and the radii n*f32; its
+        surface (bit 1) has no normals, UVs or texture, and shading 3 is "hair"
 
 A file is written as version 1 when no mesh has a surface and there are no lights or
-ambient term, so that older readers still read unlit scenes.
+ambient term, so that older readers still read unlit scenes; as version 3 only when it holds
+a strand or particle set or "hair" shading.
 """
 
 from __future__ import annotations
@@ -36,8 +43,9 @@ from .scenes import BuiltScene, MeshArrays
 __all__ = ["LookAt", "save_scene", "load_scene", "load_lights", "scene_of", "MAGIC", "VERSION"]
 
 MAGIC = b"OITSCENE"
-VERSION = 2
-SHADING_CODES = {"unlit": 0, "flat": 1, "smooth": 2}
+VERSION = 3
+SHADING_CODES = {"unlit": 0, "flat": 1, "smooth": 2, "hair": 3}
+FALLOFF_CODES = {"hard": 1, "linear": 2, "gaussian": 3}
 
 
 @dataclass(frozen=True)
@@ -82,6 +90,8 @@ def save_scene(scene: SceneLike, path: str | os.PathLike, camera: Camera | LookA
     lights = list(lights or [])
     ambient = tuple(float(a) for a in (ambient if ambient is not None else (0.0, 0.0, 0.0)))
     version = 2 if lights or any(ambient) or any(m.surface for m in meshes) else 1
+    if any(m.primitive is not None or m.surface.get("shading") == "hair" for m in meshes):
+        version = 3
     out = [MAGIC, struct.pack("<3I", version, *(size or (0, 0)))]
     if camera is None:
         out.append(struct.pack("<I", 0))
@@ -101,12 +111,14 @@ def save_scene(scene: SceneLike, path: str | os.PathLike, camera: Camera | LookA
         if len(col) != len(pos):
             raise ValueError(f"mesh {i}: {len(col)} colors for {len(pos)} vertices")
         name = names[i].encode()
-        flags = int(bool(m.opaque)) | (2 if m.surface else 0)
+        flags = int(bool(m.opaque)) | (2 if m.surface else 0) | (4 if m.primitive is not None else 0)
         out += [struct.pack("<2I", flags, len(name)), name, struct.pack("<2I", len(pos), len(idx)),
                 pos.tobytes(), col.tobytes(), idx.tobytes()]
+        if m.primitive is not None:
+            out.append(_primitive_bytes(m.primitive, len(pos)))
         if m.surface:
             out.append(_surface_bytes(m.surface, len(pos)))
-    if version == 2:
+    if version >= 2:
         out.append(struct.pack("<I", len(lights)))
         for d, c, intensity in lights:
             out.append(struct.pack("<7f", *map(float, d), *map(float, c), float(intensity)))
@@ -133,8 +145,8 @@ def _load(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | None, l
     at = 8
     version, w, h, kind = struct.unpack_from("<4I", data, at)
     at += 16
-    if version not in (1, VERSION):
-        raise ValueError(f"{path}: scene file version {version}; this reads versions 1 and {VERSION}")
+    if version not in (1, 2, VERSION):
+        raise ValueError(f"{path}: scene file version {version}; this reads versions 1 to {VERSION}")
     camera: Any = None
     if kind == 1:
         camera = Camera(np.frombuffer(data, "<f8", 16, at).reshape(4, 4))
@@ -157,13 +169,20 @@ def _load(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | None, l
         at += n * 16
         idx = np.frombuffer(data, "<u4", m * 3, at).reshape(m, 3)
         at += m * 12
+        primitive = None
+        if flags & 4:
+            primitive, at = _read_primitive(data, at, n)
         surface: dict[str, Any] = {}
         if flags & 2:
             surface, at = _read_surface(data, at, n)
-        meshes.append(MeshArrays(pos, idx, col, bool(flags & 1), surface))
+            if primitive is not None:
+                surface = {k: surface[k] for k in ("shading", "specular", "shininess", "opacity")}
+                if primitive["kind"] == "particles":
+                    surface = {"opacity": surface["opacity"]}
+        meshes.append(MeshArrays(pos, idx, col, bool(flags & 1), surface, primitive=primitive))
     lights: list = []
     ambient = (0.0, 0.0, 0.0)
-    if version == 2:
+    if version >= 2:
         (count,) = struct.unpack_from("<I", data, at)
         at += 4
         for _ in range(count):
@@ -180,11 +199,39 @@ def scene_of(meshes: Sequence[MeshArrays], lights: Sequence[tuple[Any, Any, floa
     the library)."""
     scene = Scene()
     for m in meshes:
-        scene.add_mesh(m.positions, m.indices, m.colors, opaque=m.opaque, **m.surface)
+        m.add_to(scene)
     for d, c, i in lights:
         scene.add_light(d, c, i)
     scene.ambient = tuple(ambient)
     return scene
+
+
+def _primitive_bytes(p: dict[str, Any], n: int) -> bytes:
+    """A strand or particle set's block (version 3): its kind and per-point sizes."""
+    if p["kind"] == "strands":
+        counts = np.ascontiguousarray(p["counts"], dtype="<u4").reshape(-1)
+        sizes = np.broadcast_to(np.asarray(p["widths"], dtype="<f4").reshape(-1), (n,))
+        head = struct.pack("<2I", 1, len(counts)) + counts.tobytes()
+    elif p["kind"] == "particles":
+        sizes = np.broadcast_to(np.asarray(p["radii"], dtype="<f4").reshape(-1), (n,))
+        head = struct.pack("<2I", 2, FALLOFF_CODES[p["falloff"]])
+    else:
+        raise ValueError(f"primitive kind must be 'strands' or 'particles', got {p['kind']!r}")
+    return head + np.ascontiguousarray(sizes).tobytes()
+
+
+def _read_primitive(data: bytes, at: int, n: int) -> tuple[dict[str, Any], int]:
+    kind, value = struct.unpack_from("<2I", data, at)
+    at += 8
+    if kind == 1:
+        counts = np.frombuffer(data, "<u4", value, at)
+        at += 4 * value
+        widths = np.frombuffer(data, "<f4", n, at)
+        return {"kind": "strands", "counts": counts, "widths": widths}, at + 4 * n
+    if kind == 2:
+        falloff = {v: k for k, v in FALLOFF_CODES.items()}[value]
+        return {"kind": "particles", "radii": np.frombuffer(data, "<f4", n, at), "falloff": falloff}, at + 4 * n
+    raise ValueError(f"unknown primitive kind {kind} (1: strands, 2: particles)")
 
 
 def _surface_bytes(surface: dict[str, Any], n: int) -> bytes:

@@ -37,6 +37,34 @@ class MeshArrays:
     # for a mesh drawn once where its vertices are.
     transforms: np.ndarray | None = None
     instance_colors: np.ndarray | None = None
+    # A strand or particle set instead of triangles (no indices; positions are its points):
+    # {"kind": "strands", "counts": (strands,), "widths": (n,)} or {"kind": "particles",
+    # "radii": (n,), "falloff": "hard" | "linear" | "gaussian"}; `surface` then holds
+    # add_strands' shading, specular, shininess and opacity, or add_particles' opacity.
+    primitive: dict[str, Any] | None = None
+
+    def add_to(self, scene: Scene) -> int:
+        """Adds this mesh or set to `scene` (without its instances); returns its index."""
+        p = self.primitive
+        if p is None:
+            return scene.add_mesh(self.positions, self.indices, self.colors, opaque=self.opaque, **self.surface)
+        if p["kind"] == "strands":
+            return scene.add_strands(self.positions, p["counts"], p["widths"], self.colors, self.opaque, **self.surface)
+        return scene.add_particles(self.positions, p["radii"], self.colors, self.opaque, falloff=p["falloff"], **self.surface)
+
+    def triangles(self, camera: Camera) -> MeshArrays:
+        """A strand or particle set as the triangles it is drawn as under `camera`
+        (`Scene.to_triangles`: strands keep their "hair" shading with the tangents as normals);
+        a triangle mesh as it is. For peers and files that take only triangles."""
+        if self.primitive is None:
+            return self
+        scene = Scene()
+        self.add_to(scene)
+        t = scene.to_triangles(0, camera)
+        surface = dict(self.surface)
+        if t["normals"] is not None:
+            surface["normals"] = t["normals"]
+        return MeshArrays(t["positions"], t["indices"], t["colors"], self.opaque, surface)
 
     def placed(self) -> list[MeshArrays]:
         """The mesh as drawn: one copy per instance, positions and normals carried by its
@@ -54,7 +82,8 @@ class MeshArrays:
                 surface["normals"] = (n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)).astype(np.float32)
             pos = (self.positions.astype(np.float64) @ linear.T + t[:3, 3]).astype(np.float32)
             idx = self.indices if np.linalg.det(linear) > 0 else np.ascontiguousarray(self.indices[:, ::-1])
-            out.append(MeshArrays(pos, idx, (self.colors * np.float32(f)).astype(np.float32), self.opaque, surface))
+            out.append(MeshArrays(pos, idx, (self.colors * np.float32(f)).astype(np.float32), self.opaque, surface,
+                                  primitive=self.primitive))
         return out
 
 
@@ -74,8 +103,9 @@ class BuiltScene:
         yield self.camera
 
     def drawn_meshes(self) -> list[MeshArrays]:
-        """Every mesh as drawn, each instance a copy (`MeshArrays.placed`)."""
-        return [p for m in self.meshes for p in m.placed()]
+        """Every mesh as drawn, each instance a copy (`MeshArrays.placed`), strand and particle
+        sets as their triangles under the scene's camera (`MeshArrays.triangles`)."""
+        return [p.triangles(self.camera) for m in self.meshes for p in m.placed()]
 
 
 def from_meshes(meshes: Sequence[MeshArrays], camera: Camera, size: tuple[int, int] = (512, 512),
@@ -85,7 +115,7 @@ def from_meshes(meshes: Sequence[MeshArrays], camera: Camera, size: tuple[int, i
     intensity) each; none: the headlight) and `ambient`."""
     scene = Scene()
     for m in meshes:
-        index = scene.add_mesh(m.positions, m.indices, m.colors, opaque=m.opaque, **m.surface)
+        index = m.add_to(scene)
         if m.transforms is not None:
             scene.set_instances(index, m.transforms, m.instance_colors)
     lights = [(tuple(map(float, d)), tuple(map(float, c)), float(i)) for d, c, i in lights]
@@ -173,13 +203,23 @@ def stacks(layers: int = 20, alphas: str = "random", size: tuple[int, int] = (10
     return from_meshes([mesh], Camera(np.eye(4)), (w, h), meta)
 
 
+HAIR_PRIMITIVES = ("ribbons", "strands")
+
+
 def hair(strands: int = 6000, segments: int = 16, seed: int = 0, width: float = 0.01,
-         alpha: tuple[float, float] = (0.1, 0.4)) -> BuiltScene:
+         alpha: tuple[float, float] = (0.1, 0.4), primitive: str = "ribbons") -> BuiltScene:
     """Procedural hair: strands grown from a scalp, falling under gravity and converging into
-    a tail, drawn as thin ribbons facing the camera (+z), alpha in `alpha`. The defaults give
-    several hundred layers at the worst pixel at 512 x 512. Lit with a hair highlight: each
-    vertex's normal is the key light's half vector with the strand tangent T taken out, so
-    Blinn-Phong's N.H is Kajiya-Kay's sin(T, H); strands vary in hue and darken at the root."""
+    a tail, alpha in `alpha`. The defaults give several hundred layers at the worst pixel at
+    512 x 512; the papers' model has 15,000 strands. Strands vary in hue and darken at the root.
+
+    `primitive="ribbons"`: triangle ribbons facing the camera (+z), built here, lit with a hair
+    highlight baked into the normals: each vertex's normal is the key light's half vector with
+    the strand tangent T taken out, so Blinn-Phong's N.H is Kajiya-Kay's sin(T, H).
+    `primitive="strands"`: the same polylines as one strand set (`Scene.add_strands`), its
+    ribbons built on the GPU facing the eye and shaded "hair" (Kajiya-Kay from the tangent, for
+    any eye); `drawn_meshes()` gives its triangles under the camera, for peers."""
+    if primitive not in HAIR_PRIMITIVES:
+        raise ValueError(f"primitive must be one of {HAIR_PRIMITIVES}, got {primitive!r}")
     rng = np.random.default_rng(seed)
     theta = rng.uniform(0.15 * np.pi, 0.85 * np.pi, strands)  # around the top of the head
     phi = rng.uniform(-0.6, 0.6, strands)
@@ -214,15 +254,32 @@ def hair(strands: int = 6000, segments: int = 16, seed: int = 0, width: float = 
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
     camera = Camera.look_at(eye=tuple(eye), target=(0.0, -0.1, 0.0), fov_y=45.0, near=1.0, far=4.0)
     mesh = _mesh(p, tris, colors.astype(np.float32), normals=normals.astype(np.float32), specular=0.3, shininess=48.0)
-    return from_meshes([mesh], camera, (512, 512), {"strands": strands}, lights=[(tuple(key), (1.0, 0.95, 0.9), 0.8)],
-                       ambient=(0.35, 0.35, 0.35))
+    built = from_meshes([mesh], camera, (512, 512), {"strands": strands, "primitive": primitive},
+                        lights=[(tuple(key), (1.0, 0.95, 0.9), 0.8)], ambient=(0.35, 0.35, 0.35))
+    if primitive == "strands":
+        # The ribbons' left corners carry each point's color; the width tapers as theirs.
+        point_colors = colors.reshape(strands, -1, 2, 4)[:, :, 0].reshape(-1, 4).astype(np.float32)
+        widths = np.broadcast_to(width * (1 - 0.3 * t[..., 0]), (strands, segments + 1)).reshape(-1).astype(np.float32)
+        set_ = MeshArrays(pts.reshape(-1, 3).astype(np.float32), np.zeros((0, 3), np.uint32), point_colors,
+                          surface={"shading": "hair", "specular": 0.3, "shininess": 48.0},
+                          primitive={"kind": "strands", "counts": np.full(strands, segments + 1), "widths": widths})
+        built = from_meshes([set_], camera, built.size, built.meta, built.lights, built.ambient)
+    return built
 
 
-def smoke(particles: int = 600, seed: int = 0, alpha: tuple[float, float] = (0.05, 0.25), segments: int = 10) -> BuiltScene:
-    """A smoke plume of soft particle billboards: each particle is a disc (a fan of `segments`
-    triangles) facing the camera, with its alpha in `alpha` at the center falling linearly to
-    0 at the rim. Particles rise from an emitter, widen and drift with height, glow orange near
-    the source and turn gray above; they are submitted in random (spawn) order."""
+def smoke(particles: int = 600, seed: int = 0, alpha: tuple[float, float] = (0.05, 0.25), segments: int = 10,
+          primitive: str = "fans") -> BuiltScene:
+    """A smoke plume of soft particle billboards: each particle is a disc facing the camera,
+    with its alpha in `alpha` at the center falling linearly to 0 at the rim. Particles rise
+    from an emitter, widen and drift with height, glow orange near the source and turn gray
+    above; they are submitted in random (spawn) order.
+
+    `primitive="fans"`: each disc a fan of `segments` triangles facing +z, built here (its
+    alpha linear across each triangle). `primitive="particles"`: one particle set
+    (`Scene.add_particles`, falloff "linear"), true discs facing the eye built on the GPU;
+    `drawn_meshes()` gives its quads under the camera, for peers (without the falloff)."""
+    if primitive not in ("fans", "particles"):
+        raise ValueError(f"primitive must be 'fans' or 'particles', got {primitive!r}")
     rng = np.random.default_rng(seed)
     h = rng.uniform(0.0, 1.0, particles) ** 0.8  # height along the plume, denser near the source
     spread = 0.06 + 0.3 * h
@@ -242,7 +299,13 @@ def smoke(particles: int = 600, seed: int = 0, alpha: tuple[float, float] = (0.0
     colors[:, :, :3] = np.clip(rgb, 0.0, 1.0)[:, None]
     colors[:, 0, 3] = a  # the rim keeps alpha 0: soft edges
     camera = Camera.look_at(eye=(0.0, 0.0, 3.0), target=(0.1, 0.0, 0.0), fov_y=45.0, near=1.0, far=5.0)
-    return from_meshes([_mesh(verts.reshape(-1, 3), tris, colors.reshape(-1, 4))], camera, (512, 512), {"particles": particles})
+    built = from_meshes([_mesh(verts.reshape(-1, 3), tris, colors.reshape(-1, 4))], camera, (512, 512),
+                        {"particles": particles, "primitive": primitive})
+    if primitive == "particles":
+        set_ = MeshArrays(center.astype(np.float32), np.zeros((0, 3), np.uint32), colors[:, 0].astype(np.float32),
+                          primitive={"kind": "particles", "radii": radius.astype(np.float32), "falloff": "linear"})
+        built = from_meshes([set_], camera, built.size, built.meta)
+    return built
 
 
 def foliage(leaves: int = 5000, seed: int = 0) -> BuiltScene:

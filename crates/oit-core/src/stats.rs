@@ -27,6 +27,9 @@ pub struct Stats {
     /// The scene's buffers (vertices, indices, materials, textures, the instance table), apart
     /// from the frame's.
     pub scene_bytes: u64,
+    /// `scene_bytes` by what uploaded them: meshes (with materials, textures and instance
+    /// tables), strand sets, particle sets.
+    pub scene_bytes_by_primitive: [u64; 3],
     pub gpu_time_ms: Option<f64>,
     pub pass_times_ms: Vec<(&'static str, f64)>,
     pub overflow_fragments: u64,
@@ -75,6 +78,11 @@ pub const SCHEMA: &[StatKey] = &[
     key("memory_bytes", "int", "what the method allocated (oit.memory_bytes gives its formula)"),
     key("target_bytes", "int", "the frame's targets and readbacks as allocated (tile-sized under a small budget)"),
     key("scene_bytes", "int", "the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's"),
+    key(
+        "scene_bytes_by_primitive",
+        "dict[str, float]",
+        "scene_bytes as 'triangles' (meshes, materials, instances), 'strands' and 'particles'",
+    ),
     key("gpu_time_ms", "float | None", "the passes' GPU time; None where the adapter has no timestamp queries"),
     key("pass_times_ms", "dict[str, float]", "GPU time per pass; a pass run more than once adds up"),
     key("overflow_fragments", "int", "fragments a bounded structure could not hold"),
@@ -117,6 +125,7 @@ impl Stats {
             ("memory_bytes", Int(Some(self.memory_bytes))),
             ("target_bytes", Int(Some(self.target_bytes))),
             ("scene_bytes", Int(Some(self.scene_bytes))),
+            ("scene_bytes_by_primitive", Numbers(primitive_bytes(self.scene_bytes_by_primitive))),
             ("gpu_time_ms", Float(self.gpu_time_ms)),
             ("pass_times_ms", Numbers(summed(&self.pass_times_ms))),
             ("overflow_fragments", Int(Some(self.overflow_fragments))),
@@ -142,6 +151,11 @@ impl Stats {
         self.adapter = adapter.to_string();
         self.error_bound_max = error_bound.map(|b| b.iter().fold(0.0f64, |m, &v| m.max(v as f64)));
     }
+}
+
+/// Bytes by primitive kind as named numbers ("triangles", "strands", "particles").
+fn primitive_bytes(b: [u64; 3]) -> Vec<(&'static str, f64)> {
+    vec![("triangles", b[0] as f64), ("strands", b[1] as f64), ("particles", b[2] as f64)]
 }
 
 /// How a method's extra number combines over the tiles of a frame and over the samples of an

@@ -56,7 +56,9 @@ pub struct Geometry {
     /// Whether the passes compile with transforms (else every instance is the identity, one
     /// a mesh, and a chunk draws in one call).
     pub instanced: bool,
-    pub bytes: u64,
+    /// Bytes uploaded by what uploaded them (indexed by chunk kind: meshes with the instance
+    /// and segment tables, strands, particles).
+    pub bytes: [u64; 3],
 }
 
 impl Geometry {
@@ -332,16 +334,16 @@ fn upload<'a>(
         )));
     }
     let instance_table = make("instances", bytemuck::cast_slice(&table));
-    let mut bytes = table_bytes;
+    let mut bytes = [table_bytes, 0, 0];
     let chunks = kept
         .iter()
         .enumerate()
         .map(|(k, &c)| {
             let g = &done[c];
-            bytes +=
+            bytes[g.kind as usize] +=
                 g.positions.len() as u64 * 4 + g.colors.len() as u64 * 16 + g.indices.len() as u64 * 4 + g.attributes.len() as u64 * 16;
             let list = &chunk_segments[k];
-            bytes += list.len() as u64 * segment_bytes;
+            bytes[PRIM_MESH as usize] += list.len() as u64 * segment_bytes;
             let place = [g.first_triangle, g.triangles(), list.len() as u32, chunk_drawn[k], g.kind, g.material, 0, 0];
             let info = gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("chunk"),
@@ -430,6 +432,12 @@ fn upload_set(cur: Gather, done: &mut Vec<Gather>, mine: &mut Vec<Segment>, m: &
 }
 
 impl GpuScene {
+    /// The scene's buffers by what uploaded them: meshes (with materials, textures and the
+    /// instance tables), strands, particles.
+    pub fn bytes(&self) -> [u64; 3] {
+        std::array::from_fn(|k| self.transparent.bytes[k] + self.opaque.bytes[k])
+    }
+
     /// Uploads `scene` in chunks whose buffers each fit `max_binding_bytes`.
     pub fn new(
         gpu: &GpuContext,
@@ -455,7 +463,7 @@ impl GpuScene {
         let mut transparent = upload(gpu, "transparent", meshes().filter(|(_, m, _)| !m.opaque), &shared, max_binding_bytes)?;
         let opaque = upload(gpu, "opaque", meshes().filter(|(_, m, _)| m.opaque), &shared, max_binding_bytes)?;
         if shaded {
-            transparent.bytes += table.len() as u64 * 16;
+            transparent.bytes[PRIM_MESH as usize] += table.len() as u64 * 16;
         }
         let textured = shaded && scene.meshes().iter().any(|m| m.material.texture.is_some());
         let primitives = scene.meshes().iter().any(|m| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair);

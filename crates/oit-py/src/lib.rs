@@ -53,7 +53,7 @@ impl Scene {
 
     /// positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
     /// surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
-    /// shading "unlit", "flat" or "smooth".
+    /// shading "unlit", "flat", "smooth" or "hair".
     /// `transform` (4, 4) float64 places it (else it is drawn where its vertices are).
     #[pyo3(signature = (positions, indices, colors, opaque, normals=None, uvs=None, texture=None, shading="unlit",
                         specular=0.0, shininess=32.0, opacity=1.0, two_sided=true, cull_back_faces=false, transform=None))]

@@ -12,9 +12,10 @@ use crate::{Error, Scene};
 
 /// Reads `path`; `shading` and `specular` style every surface (`load::Surface`). `alpha`
 /// makes every mesh transparent at it; `viewing` adds the command line's convenience (every
-/// mesh at VIEWING_ALPHA when nothing blends) and returns its note.
+/// mesh at VIEWING_ALPHA when nothing blends) and returns its note; `point_radius` sizes a point
+/// cloud's particles (None: 1/200 of its box's diagonal).
 #[pyfunction]
-#[pyo3(signature = (path, shading="smooth", specular=0.25, alpha=None, viewing=false))]
+#[pyo3(signature = (path, shading="smooth", specular=0.25, alpha=None, viewing=false, point_radius=None))]
 #[allow(clippy::type_complexity)]
 pub fn load_file<'py>(
     py: Python<'py>,
@@ -23,8 +24,9 @@ pub fn load_file<'py>(
     specular: f32,
     alpha: Option<f32>,
     viewing: bool,
+    point_radius: Option<f32>,
 ) -> PyResult<(Scene, Vec<String>, Bound<'py, PyList>, Option<String>)> {
-    let surface = Surface { shading: oit_core::Shading::from_name(shading).map_err(Error::from)?, specular };
+    let surface = Surface { shading: oit_core::Shading::from_name(shading).map_err(Error::from)?, specular, point_radius };
     let (file, note) = py
         .detach(|| -> oit_core::Result<_> {
             let mut file = load::load_file(&path, surface)?;

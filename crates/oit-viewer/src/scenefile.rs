@@ -4,11 +4,12 @@
 
 use std::path::Path;
 
-use oit_core::{Light, Material, Mesh, Shading, Texture};
+use oit_core::{Falloff, Light, Material, Mesh, Primitive, Shading, Texture};
 
 pub const MAGIC: &[u8; 8] = b"OITSCENE";
-/// The newest version; a file without surfaces, lights or ambient term is written as 1.
-pub const VERSION: u32 = 2;
+/// The newest version; a file without surfaces, lights or ambient term is written as 1, one
+/// without strands, particles or "hair" shading as 2.
+pub const VERSION: u32 = 3;
 
 /// A camera as a scene file stores it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,8 +73,8 @@ pub fn parse(data: &[u8]) -> Result<SceneData, String> {
         return Err("not an oit scene file (it does not start with OITSCENE)".into());
     }
     let version = r.u32("the version")?;
-    if version != 1 && version != VERSION {
-        return Err(format!("scene file version {version}; this viewer reads versions 1 and {VERSION}"));
+    if !(1..=VERSION).contains(&version) {
+        return Err(format!("scene file version {version}; this viewer reads versions 1 to {VERSION}"));
     }
     let (w, h) = (r.u32("the size")?, r.u32("the size")?);
     let size = (w > 0 && h > 0).then_some((w, h));
@@ -107,14 +108,20 @@ pub fn parse(data: &[u8]) -> Result<SceneData, String> {
         let positions: Vec<[f32; 3]> = r.array(n, "positions")?;
         let colors: Vec<[f32; 4]> = r.array(n, "colors")?;
         let indices: Vec<[u32; 3]> = r.array(m, "indices")?;
-        let mut mesh = Mesh::new(positions, indices, colors, flags & 1 != 0).map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
+        let opaque = flags & 1 != 0;
+        let mut mesh = if flags & 4 != 0 {
+            read_primitive(&mut r, positions, colors, opaque, n)
+        } else {
+            Mesh::new(positions, indices, colors, opaque).map_err(|e| e.to_string())
+        }
+        .map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
         if flags & 2 != 0 {
             mesh = read_surface(&mut r, mesh, n).map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
         }
         meshes.push(NamedMesh::new(if name.is_empty() { format!("mesh {i}") } else { name }, mesh));
     }
     let (mut lights, mut ambient) = (Vec::new(), [0.0; 3]);
-    if version == 2 {
+    if version >= 2 {
         for _ in 0..r.u32("the light count")? {
             let v: [f32; 7] = r.f32s("a light")?;
             lights.push(Light::new([v[0], v[1], v[2]], [v[3], v[4], v[5]], v[6]).map_err(|e| e.to_string())?);
@@ -127,14 +134,39 @@ pub fn parse(data: &[u8]) -> Result<SceneData, String> {
     Ok(SceneData { meshes, camera, size, lights, ambient })
 }
 
+/// A strand or particle set (flags bit 2, version 3): its kind, then the points per strand and
+/// the widths, or the falloff and the radii.
+fn read_primitive(r: &mut Reader<'_>, points: Vec<[f32; 3]>, colors: Vec<[f32; 4]>, opaque: bool, n: usize) -> Result<Mesh, String> {
+    let (kind, value) = (r.u32("the primitive kind")?, r.u32("the primitive block")?);
+    match kind {
+        1 => {
+            let counts: Vec<u32> = r.array(value as usize, "the strand counts")?;
+            let widths: Vec<f32> = r.array(n, "the widths")?;
+            Mesh::strands(points, counts, widths, colors, opaque).map_err(|e| e.to_string())
+        }
+        2 => {
+            let falloff = match value {
+                1 => Falloff::Hard,
+                2 => Falloff::Linear,
+                3 => Falloff::Gaussian,
+                k => return Err(format!("unknown falloff {k} (1: hard, 2: linear, 3: gaussian)")),
+            };
+            let radii: Vec<f32> = r.array(n, "the radii")?;
+            Mesh::particles(points, radii, colors, opaque, falloff).map_err(|e| e.to_string())
+        }
+        k => Err(format!("unknown primitive kind {k} (1: strands, 2: particles)")),
+    }
+}
+
 /// A mesh's surface (flags bit 1): shading, two-sidedness, specular, shininess, opacity, then
-/// optional normals, UVs and texture.
+/// optional normals, UVs and texture. A strand or particle set's has none of those three.
 fn read_surface(r: &mut Reader<'_>, mesh: Mesh, n: usize) -> Result<Mesh, String> {
     let shading = match r.u32("the shading")? {
         0 => Shading::Unlit,
         1 => Shading::Flat,
         2 => Shading::Smooth,
-        k => return Err(format!("unknown shading {k} (0: unlit, 1: flat, 2: smooth)")),
+        3 => Shading::Hair,
+        k => return Err(format!("unknown shading {k} (0: unlit, 1: flat, 2: smooth, 3: hair)")),
     };
     // The sidedness word: bit 0 two-sided lighting, bit 1 back faces culled.
     let sides = r.u32("two-sidedness")?;
@@ -158,6 +190,12 @@ fn read_surface(r: &mut Reader<'_>, mesh: Mesh, n: usize) -> Result<Mesh, String
     } else {
         None
     };
+    if mesh.primitive != Primitive::Triangles {
+        if normals.is_some() || uvs.is_some() || texture.is_some() {
+            return Err(format!("{} carry no normals, UVs or texture", mesh.primitive.name()));
+        }
+        return mesh.with_primitive_surface(shading, specular, shininess, opacity).map_err(|e| e.to_string());
+    }
     let material = Material { shading, specular, shininess, opacity, two_sided, cull_back_faces, texture, ..Default::default() };
     mesh.with_surface(normals, uvs, material).map_err(|e| e.to_string())
 }
@@ -174,9 +212,19 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
     let f64s = |out: &mut Vec<u8>, v: &[f64]| v.iter().for_each(|x| out.extend(x.to_le_bytes()));
     out.extend(MAGIC);
     let (w, h) = scene.size.unwrap_or((0, 0));
-    let surfaced = |m: &Mesh| !m.material.is_plain() || !m.normals.is_empty() || !m.uvs.is_empty();
-    let version =
-        if scene.lights.is_empty() && scene.ambient == [0.0; 3] && !scene.meshes.iter().any(|m| surfaced(&m.mesh)) { 1 } else { VERSION };
+    // A particle set's falloff is in its primitive block, not its surface.
+    let surfaced = |m: &Mesh| {
+        let material = Material { falloff: Falloff::None, ..m.material.clone() };
+        !material.is_plain() || !m.normals.is_empty() || !m.uvs.is_empty()
+    };
+    let newest = |m: &Mesh| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair;
+    let version = if scene.meshes.iter().any(|m| newest(&m.mesh)) {
+        VERSION
+    } else if scene.lights.is_empty() && scene.ambient == [0.0; 3] && !scene.meshes.iter().any(|m| surfaced(&m.mesh)) {
+        1
+    } else {
+        2
+    };
     u32s(&mut out, &[version, w, h]);
     match scene.camera {
         None => u32s(&mut out, &[0]),
@@ -193,12 +241,25 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
     u32s(&mut out, &[scene.meshes.len() as u32]);
     for m in &scene.meshes {
         let surface = surfaced(&m.mesh);
-        u32s(&mut out, &[m.mesh.opaque as u32 | if surface { 2 } else { 0 }, m.name.len() as u32]);
+        let set = m.mesh.primitive != Primitive::Triangles;
+        u32s(&mut out, &[m.mesh.opaque as u32 | if surface { 2 } else { 0 } | if set { 4 } else { 0 }, m.name.len() as u32]);
         out.extend(m.name.as_bytes());
         u32s(&mut out, &[m.mesh.positions.len() as u32, m.mesh.indices.len() as u32]);
         out.extend(bytemuck::cast_slice(&m.mesh.positions));
         out.extend(bytemuck::cast_slice(&m.mesh.colors));
         out.extend(bytemuck::cast_slice(&m.mesh.indices));
+        match &m.mesh.primitive {
+            Primitive::Triangles => {}
+            Primitive::Strands { counts, widths } => {
+                u32s(&mut out, &[1, counts.len() as u32]);
+                u32s(&mut out, counts);
+                out.extend(bytemuck::cast_slice(widths));
+            }
+            Primitive::Particles { radii } => {
+                u32s(&mut out, &[2, m.mesh.material.falloff.code()]);
+                out.extend(bytemuck::cast_slice(radii));
+            }
+        }
         if surface {
             let mat = &m.mesh.material;
             u32s(&mut out, &[mat.shading.code(), mat.two_sided as u32 | (mat.cull_back_faces as u32) << 1]);
@@ -216,7 +277,7 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
             }
         }
     }
-    if version == VERSION {
+    if version >= 2 {
         u32s(&mut out, &[scene.lights.len() as u32]);
         for l in &scene.lights {
             out.extend(bytemuck::cast_slice(&[l.direction, l.color].concat()));
@@ -230,6 +291,28 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn strands_and_particles_round_trip_as_version_3() {
+        let strands = Mesh::strands(vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]], vec![3], vec![0.1, 0.2, 0.3], vec![[0.5; 4]], false)
+            .and_then(|m| m.with_primitive_surface(Shading::Hair, 0.3, 48.0, 0.9))
+            .unwrap();
+        let particles = Mesh::particles(vec![[0.0; 3], [0.0, 1.0, 0.0]], vec![0.25], vec![[1.0; 4]], true, Falloff::Gaussian).unwrap();
+        let scene = SceneData {
+            meshes: vec![NamedMesh::new("hair".into(), strands.clone()), NamedMesh::new("smoke".into(), particles.clone())],
+            ..Default::default()
+        };
+        let bytes = encode(&scene);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 3);
+        let back = parse(&bytes).unwrap();
+        assert_eq!(back.meshes[0].mesh.primitive, strands.primitive);
+        assert_eq!(back.meshes[0].mesh.material.shading, Shading::Hair);
+        assert_eq!(back.meshes[0].mesh.material.opacity, 0.9);
+        assert_eq!(back.meshes[1].mesh.primitive, particles.primitive);
+        assert_eq!(back.meshes[1].mesh.material.falloff, Falloff::Gaussian);
+        assert!(back.meshes[1].mesh.opaque);
+        assert!(parse(&bytes[..bytes.len() - 3]).unwrap_err().contains("file ends"));
+    }
 
     fn triangle(opaque: bool) -> NamedMesh {
         let mesh =

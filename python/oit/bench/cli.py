@@ -21,6 +21,8 @@ from .harness import QUICK_SIZE, write_tables
 from .results import COLUMNS, run
 from .scale import SCALE_METHODS, SWEEPS, parse_size, scale, write_scale
 from .shading import SHADING_COLUMNS, SHADING_COSTS, SHADING_METHODS, shading_cost
+from .strands import STRAND_COLUMNS, STRAND_COUNTS, strands_vs_ribbons
+from .strands import STRAND_METHODS as STRAND_METHODS_DEFAULT
 from .temporal import TEMPORAL_COLUMNS, TEMPORAL_FRAMES, TEMPORAL_STEP_DEG, temporal
 
 
@@ -87,6 +89,11 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="--peers-floor: keep this run's ratios as the new baseline (after a change that is meant to cost "
                          "time); it is the package's file, so run from an editable install (scripts/dev-install.sh) "
                          "to change the repository's")
+    ap.add_argument("--strands", action="store_true",
+                    help="instead of the method sweep: hair as a strand set against the same hair as triangle ribbons, "
+                         "upload bytes, upload time and frame time of the floor and the methods over it (strands.csv, "
+                         f"strands.md); --strand-counts sets the hair sizes (default: {' '.join(map(str, STRAND_COUNTS))})")
+    ap.add_argument("--strand-counts", type=int, nargs="+", default=list(STRAND_COUNTS), help=argparse.SUPPRESS)
     ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
                     help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
 
@@ -129,6 +136,11 @@ def run_cli(a: argparse.Namespace) -> int:
             print(f"wrote {BASELINE}")
             return 0
         return 1 if slower else 0
+    if a.strands:
+        methods = tuple(a.methods) if a.methods else None
+        result = strands_vs_ribbons(tuple(a.strand_counts), methods or STRAND_METHODS_DEFAULT, repeat, a.quick)
+        write_tables(a.out, "strands", result, STRAND_COLUMNS)
+        return 0
     if a.claims:
         write_tables(a.out, "claims", run_claims(full=a.full, only=a.only), CLAIM_COLUMNS)
         return 0

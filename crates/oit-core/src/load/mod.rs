@@ -67,11 +67,14 @@ pub struct FileCamera {
 pub struct Surface {
     pub shading: Shading,
     pub specular: f32,
+    /// The radius of a point cloud's particles (a PLY of points only); None: 1/200 of its
+    /// box's diagonal.
+    pub point_radius: Option<f32>,
 }
 
 impl Default for Surface {
     fn default() -> Self {
-        Self { shading: Shading::Smooth, specular: 0.25 }
+        Self { shading: Shading::Smooth, specular: 0.25, point_radius: None }
     }
 }
 
@@ -96,14 +99,36 @@ pub fn load_file(path: &Path, surface: Surface) -> Result<LoadedFile> {
         "gltf" | "glb" => gltf::load(path).map_err(fail)?,
         _ => return Err(invalid!("{}: unknown file type '.{ext}': oit reads {FORMATS}", path.display())),
     };
+    if ext == "ply" && file.meshes.iter().all(|m| m.mesh.indices.is_empty() && !m.mesh.positions.is_empty()) {
+        // A point cloud: hard discs facing the eye, one a point.
+        for m in &mut file.meshes {
+            m.mesh = points_as_particles(std::mem::take(&mut m.mesh), surface.point_radius).map_err(|e| fail(e.to_string()))?;
+        }
+        return Ok(file);
+    }
     if file.meshes.iter().all(|m| m.mesh.indices.is_empty()) {
-        return Err(invalid!("{} has no triangles: oit draws triangle meshes", path.display()));
+        return Err(invalid!("{} has no triangles: oit draws triangle meshes (and a PLY of points only as particles)", path.display()));
     }
     file.meshes.retain(|m| !m.mesh.indices.is_empty());
     for m in &mut file.meshes {
         restyle(&mut m.mesh, surface).map_err(|e| invalid!("{}: '{}': {e}", path.display(), m.name))?;
     }
     Ok(file)
+}
+
+/// A mesh of points only as a particle set of hard discs of `radius` (None: 1/200 of the
+/// points' box diagonal, or 1 where the points coincide), its colors kept.
+fn points_as_particles(mesh: Mesh, radius: Option<f32>) -> Result<Mesh> {
+    let radius = radius.unwrap_or_else(|| {
+        let b = crate::scene::placed_bounds(std::iter::once((&mesh, &[crate::scene::Instance::IDENTITY][..])));
+        let diagonal = b.map_or(0.0, |(lo, hi)| (hi - lo).length()) as f32;
+        if diagonal > 0.0 {
+            diagonal / 200.0
+        } else {
+            1.0
+        }
+    });
+    Mesh::particles(mesh.positions, vec![radius], mesh.colors, mesh.opaque, crate::shading::Falloff::Hard)
 }
 
 /// Applies `surface` to a loaded mesh, keeping what the file gave (normals, UVs, texture,
