@@ -256,7 +256,7 @@ BAD = [
     (dict(texture=np.zeros((2, 2, 4), np.float32)), ValueError, "needs uvs"),
     (dict(uvs=np.zeros((4, 2)), texture=np.zeros((2, 2, 3))), ValueError, "(h, w, 4)"),
     (dict(uvs=np.zeros((4, 2)), texture=np.full((2, 2, 4), 1.5)), ValueError, "[0, 1]"),
-    (dict(shading="phong"), ValueError, "shading must be 'unlit', 'flat' or 'smooth'"),
+    (dict(shading="phong"), ValueError, "shading must be 'unlit', 'flat', 'smooth' or 'hair'"),
     (dict(specular=-0.1), ValueError, "specular"),
     (dict(shininess=0.0), ValueError, "shininess"),
     (dict(opacity=1.5), ValueError, "opacity"),

@@ -14,7 +14,7 @@ import numpy as np
 
 from . import _oit
 from ._checks import _I64_MAX, _U32_MAX, SHADINGS, _float_array, _instance_colors, _int, _number, _rows, _surface, _transforms, _vector
-from ._load import FileCamera, load_file
+from ._load import read
 from ._memory import available_memory
 from ._primitives import PrimitiveMethods
 from ._trimesh import trimesh_arrays
@@ -336,6 +336,43 @@ class Camera:
         dist = radius / np.sin(np.radians(fov_y) / 2) * 1.05
         near, far = max(dist - radius * 1.5, dist * 1e-3), dist + radius * 1.5
         return cls.look_at(center + d * dist, center, fov_y, near=near, far=far, aspect=aspect)
+
+
+@dataclass
+class FileCamera:
+    """A camera of a loaded file: `view` (4 x 4, world to camera, looking down -z with y up) and
+    its `projection` dict ("type" "perspective" with yfov in radians, aspect (the file's, or
+    None), near and far; or "orthographic" with xmag, ymag, near and far)."""
+
+    name: str
+    view: np.ndarray
+    projection: dict[str, Any]
+
+    def camera(self, aspect: float | None = None) -> Camera:
+        """The oit.Camera of this view at `aspect` (width / height; default: the file's, else 1)."""
+        p = self.projection
+        if p["type"] == "orthographic":
+            return Camera(Camera.orthographic(-p["xmag"], p["xmag"], -p["ymag"], p["ymag"], p["near"], p["far"]).view_proj
+                          @ self.view)
+        aspect = aspect or p["aspect"] or 1.0
+        f = 1.0 / np.tan(p["yfov"] / 2.0)
+        proj = np.zeros((4, 4))
+        proj[0, 0], proj[1, 1] = f / aspect, f
+        proj[2, 2], proj[2, 3] = p["far"] / (p["near"] - p["far"]), p["near"] * p["far"] / (p["near"] - p["far"])
+        proj[3, 2] = -1.0
+        return Camera(proj @ self.view)
+
+
+def load_file(path: str | os.PathLike, alpha: float | None = None, *, shading: str = "smooth", specular: float = 0.25,
+              viewing: bool = False, point_radius: float | None = None) -> tuple[Scene, str | None]:
+    """`Scene.from_file`, and with `viewing` the command line's convenience: when nothing in
+    the file is transparent every mesh is drawn at alpha 0.4, and the second value says so."""
+    native, names, cameras, note = read(path, alpha, shading, specular, viewing, point_radius)
+    scene = Scene()
+    scene._native, scene.mesh_names = native, names
+    scene.cameras = [FileCamera(c["name"], np.array(c["view"], dtype=np.float64),
+                                {k: v for k, v in c.items() if k not in ("name", "view")}) for c in cameras]
+    return scene, note
 
 
 class Stats(TypedDict, total=False):

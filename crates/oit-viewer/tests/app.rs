@@ -39,8 +39,12 @@ fn scene() -> SceneData {
 
 /// The app on the test renderer's device, as eframe would run it.
 fn harness(method: &str) -> Harness<'static, ViewerApp> {
+    harness_of(method, scene())
+}
+
+fn harness_of(method: &str, scene: SceneData) -> Harness<'static, ViewerApp> {
     let renderer = common::WgpuRenderer::new();
-    let app = ViewerApp::with_gpu(renderer.context(), scene(), Settings::new(method), "test scene".into());
+    let app = ViewerApp::with_gpu(renderer.context(), scene, Settings::new(method), "test scene".into());
     let mut h = Harness::builder()
         .with_size(SIZE)
         .with_pixels_per_point(1.0)
@@ -196,4 +200,37 @@ fn antialiasing_from_the_panel() {
     let stats = &h.state().frame.as_ref().unwrap().stats;
     assert_eq!((stats.method.as_str(), stats.antialias, stats.antialias_mode), ("hybrid", 4, oit_core::AntialiasMode::Frames));
     assert!(!h.state().settings.coverage);
+}
+
+/// Strands and particles (the GPU builds their triangles) show in the viewer as the engine
+/// draws them, mixed with meshes.
+#[test]
+fn the_viewer_draws_strands_and_particles() {
+    let strand = |x: f32| [[x, -0.6, 0.1], [x + 0.1, 0.0, 0.0], [x, 0.6, -0.1]];
+    let points: Vec<[f32; 3]> = [-0.4f32, 0.0, 0.4].iter().flat_map(|&x| strand(x)).collect();
+    let strands = Mesh::strands(points, vec![3; 3], vec![0.08], vec![[0.8, 0.5, 0.2, 0.6]], false)
+        .and_then(|m| m.with_primitive_surface(oit_core::Shading::Hair, 0.3, 32.0, 1.0))
+        .unwrap();
+    let particles =
+        Mesh::particles(vec![[0.3, 0.3, 0.2], [-0.3, -0.2, 0.3]], vec![0.2], vec![[0.2, 0.4, 0.9, 0.5]], false, oit_core::Falloff::Linear)
+            .unwrap();
+    let mut data = scene();
+    data.meshes.truncate(1);
+    data.meshes.push(NamedMesh::new("strands".into(), strands));
+    data.meshes.push(NamedMesh::new("particles".into(), particles));
+    let h = harness_of("abuffer", data.clone());
+    let app = h.state();
+    let f = app.frame.as_ref().unwrap();
+    let camera = Camera::from_rows(app.camera.rows(f.width as f64 / f.height as f64)).unwrap();
+    let mut own_scene = oit_core::Scene::new();
+    data.meshes.into_iter().for_each(|m| {
+        own_scene.add_mesh(m.mesh);
+    });
+    let gpu = oit_core::shared_context(None).unwrap();
+    let mut r = Renderer::new(gpu, f.width, f.height).unwrap();
+    let own = r.render(&own_scene, &camera, "abuffer", &[], [1.0; 3]).unwrap();
+    let diff = own.image.iter().zip(&f.image).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    assert!(diff < 1e-6, "max difference {diff}");
+    assert!(own.stats.scene_bytes_by_primitive[1] > 0 && own.stats.scene_bytes_by_primitive[2] > 0);
+    assert_eq!(app.triangle_count(), 2 + 2 * 6 + 2 * 2);
 }
