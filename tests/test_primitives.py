@@ -180,9 +180,13 @@ def test_strands_upload_their_points_not_triangles(renderer):
     triangles.add_mesh(t["positions"], t["indices"], t["colors"])
     a = renderer(32, 32).render(strands, PERSPECTIVE, "unsorted")
     b = renderer(32, 32).render(triangles, PERSPECTIVE, "unsorted")
-    # Points: x, y, z, half width and RGBA (32 bytes), and a word a segment (4 bytes).
-    assert a.stats["scene_bytes"] == 300 * 32 + 270 * 4
-    assert b.stats["scene_bytes"] >= 4 * a.stats["scene_bytes"]
+    # Uploaded: x, y, z, half width and RGBA a point (32 bytes), and a word a segment (4 bytes);
+    # built on the GPU each frame: two corners and a tangent a point (48 bytes).
+    assert a.stats["expanded_bytes"] == 300 * 48 and b.stats["expanded_bytes"] == 0
+    assert a.stats["scene_bytes"] - a.stats["expanded_bytes"] == 300 * 32 + 270 * 4
+    assert a.stats["scene_bytes_by_primitive"] == {"triangles": 0.0, "strands": a.stats["scene_bytes"], "particles": 0.0}
+    assert b.stats["scene_bytes"] >= 4 * (a.stats["scene_bytes"] - a.stats["expanded_bytes"])
+    assert b.stats["scene_bytes"] > a.stats["scene_bytes"]
 
 
 @pytest.mark.parametrize("call, match", [
@@ -221,7 +225,9 @@ def test_hair_and_smoke_built_on_strands_and_particles_look_as_their_triangles(r
         fa, fb = r.render(a.scene, a.camera, "abuffer"), r.render(b.scene, b.camera, "abuffer")
         # The same look: ribbons facing +z against ribbons facing the eye, fans against discs.
         assert np.abs(fa.image - fb.image).mean() < 0.02, build.__name__
-        assert fb.stats["scene_bytes"] * 3 <= fa.stats["scene_bytes"], build.__name__
+        uploaded = fb.stats["scene_bytes"] - fb.stats["expanded_bytes"]
+        assert uploaded * 3 <= fa.stats["scene_bytes"], build.__name__
+        assert fb.stats["scene_bytes"] < fa.stats["scene_bytes"], build.__name__
     with pytest.raises(ValueError, match="primitive must be one of"):
         oit.scenes.hair(strands=10, primitive="cards")
 

@@ -1,10 +1,18 @@
 // Strands and particles (oit_core::primitive, whose float64 `expand` this mirrors): a chunk of
 // kind PRIM_STRANDS or PRIM_PARTICLES holds one set's points as four floats each (x, y, z and
 // half the width, or the radius) and their colors; a strand chunk has a word a segment in
-// `indices` (its first point, FIRST_SEGMENT, LAST_SEGMENT). The vertex stage builds the
-// triangles facing the eye, six corners a segment or particle in the order of
-// primitive::CORNERS, so that every pass that pulls corners (the vertex shader, triangle setup,
-// the compact A-buffer's records) sees the same triangles.
+// `indices` (its first point, FIRST_SEGMENT, LAST_SEGMENT). Once a frame, before any geometry
+// pass, shaders/expand.wgsl builds the corners facing the eye into `expanded` (each point's two
+// ribbon corners and its tangent, or each particle's four quad corners, for each instance of
+// the set); every pass that pulls corners (the vertex shader, triangle setup, the compact
+// A-buffer's records) reads them there, six corners a segment or particle in the order of
+// primitive::CORNERS, so all of them see the same triangles.
+
+//!if EXPANDING
+@group(0) @binding(9) var<storage, read_write> expanded: array<vec4<f32>>;
+//!else
+@group(0) @binding(9) var<storage, read> expanded: array<vec4<f32>>;
+//!endif
 
 struct Corner {
     world: vec3<f32>,
@@ -32,36 +40,48 @@ fn unit_or_zero(v: vec3<f32>) -> vec3<f32> {
     return select(vec3<f32>(0.0), v * inverseSqrt(l2), l2 > 1e-30);
 }
 
+// Where instance `ii`'s corners of the chunk's set begin in `expanded`: strands keep two
+// corners a point, then a tangent a point; particles four corners a particle.
+fn expanded_base(ii: u32) -> u32 {
+    let per = select(4u, 3u, chunk.kind == PRIM_STRANDS);
+    return (ii - chunk.set_instance) * per * chunk.set_points;
+}
+
 // Corner `vi` of the chunk (corner vi % 3 of local triangle vi / 3) under instance `ii`.
 fn corner_of(vi: u32, ii: u32) -> Corner {
     let unit = vi / 6u;
     let c = vi % 6u;
-    let far = c == 2u || c == 3u || c == 5u;
-    let side = select(-1.0, 1.0, c == 1u || c == 4u || c == 5u);
+    let far = u32(c == 2u || c == 3u || c == 5u);
+    let side = u32(c == 1u || c == 4u || c == 5u);
+    let base = expanded_base(ii);
     if chunk.kind == PRIM_STRANDS {
-        return strand_corner(unit, far, side, ii);
+        let i = (indices[unit] & POINT_MASK) + far;
+        let tangent = expanded[base + 2u * chunk.set_points + i].xyz;
+        return Corner(expanded[base + 2u * i + side].xyz, placed_color(i, ii), tangent, vec2<f32>(0.0));
     }
-    return particle_corner(unit, far, side, ii);
+    let uv = vec2<f32>(f32(side) * 2.0 - 1.0, f32(far) * 2.0 - 1.0);
+    return Corner(expanded[base + 4u * unit + 2u * far + side].xyz, placed_color(unit, ii), vec3<f32>(0.0), uv);
 }
 
-// A ribbon corner at the segment's near or far point: the point moved by half its width
-// across the strand and across the view. The tangent at a point is the chord from the point
-// before it to the point after it (one-sided at a strand's ends), so that the two segments
-// meeting at a joint compute its corners from the same numbers: no gap, no overlap.
-fn strand_corner(s: u32, far: bool, side: f32, ii: u32) -> Corner {
-    let word = indices[s];
+// A ribbon corner at point `i` of segment word `word` (`far`: its second point): the point
+// moved by half its width across the strand and across the view, and the strand's unit
+// tangent there. The tangent at a point is the chord from the point before it to the point
+// after it (one-sided at a strand's ends), so that the two segments meeting at a joint would
+// compute its corners from the same numbers: each point is expanded once, by the segment that
+// starts at it (and a strand's last point by its last segment).
+fn strand_point(word: u32, far: bool, ii: u32) -> array<vec3<f32>, 3> {
     let i = (word & POINT_MASK) + u32(far);
     let prev = select(i - 1u, i, !far && (word & FIRST_SEGMENT) != 0u);
     let next = select(i + 1u, i, far && (word & LAST_SEGMENT) != 0u);
     let p = point_at(i, ii);
     let t = point_at(next, ii) - point_at(prev, ii);
     let across = unit_or_zero(cross(t, towards_eye(p))) * positions[4u * i + 3u];
-    return Corner(p + across * side, placed_color(i, ii), unit_or_zero(t), vec2<f32>(0.0));
+    return array<vec3<f32>, 3>(p - across, p + across, unit_or_zero(t));
 }
 
-// A particle's quad corner: its center moved by the radius along the axes of the plane that
-// faces the eye (right from the camera's up, the world direction of clip y).
-fn particle_corner(q: u32, far: bool, side: f32, ii: u32) -> Corner {
+// A particle's quad corner (u, v in {-1, 1}): its center moved by the radius along the axes of
+// the plane that faces the eye (right from the camera's up, the world direction of clip y).
+fn particle_corners(q: u32, ii: u32) -> array<vec3<f32>, 4> {
     let c = point_at(q, ii);
     let d = unit_or_zero(towards_eye(c));
     let hint = vec3<f32>(frame.view_proj[0].y, frame.view_proj[1].y, frame.view_proj[2].y);
@@ -69,11 +89,9 @@ fn particle_corner(q: u32, far: bool, side: f32, ii: u32) -> Corner {
     if dot(right, right) <= 1e-30 {
         right = cross(vec3<f32>(1.0, 0.0, 0.0), d);
     }
-    right = unit_or_zero(right);
-    let up = unit_or_zero(cross(d, right));
-    let uv = vec2<f32>(side, select(-1.0, 1.0, far));
-    let r = positions[4u * q + 3u];
-    return Corner(c + (right * uv.x + up * uv.y) * r, placed_color(q, ii), vec3<f32>(0.0), uv);
+    right = unit_or_zero(right) * positions[4u * q + 3u];
+    let up = unit_or_zero(cross(d, right)) * positions[4u * q + 3u];
+    return array<vec3<f32>, 4>(c - right - up, c + right - up, c - right + up, c + right + up);
 }
 
 // The vertex shader's output for corner `vi` of a strand or particle chunk.
@@ -109,7 +127,8 @@ fn falloff(mode: u32, uv: vec2<f32>) -> f32 {
 }
 
 // Kajiya and Kay's strand model with unit tangent `t` (shading::hair): diffuse sin(T, L), a
-// highlight sin(T, H)^shininess, H the half vector of L and the eye direction `v`.
+// highlight sin(T, H)^shininess = (1 - (T·H)²)^(shininess / 2), H the half vector of L and the
+// eye direction `v`.
 fn hair(base: vec3<f32>, t: vec3<f32>, v: vec3<f32>, m0: vec4<f32>) -> vec3<f32> {
     var diffuse = frame.ambient.rgb;
     var highlight = vec3<f32>(0.0);
@@ -120,7 +139,7 @@ fn hair(base: vec3<f32>, t: vec3<f32>, v: vec3<f32>, m0: vec4<f32>) -> vec3<f32>
         diffuse += radiance * sqrt(max(1.0 - tl * tl, 0.0));
         let hv = l + v;
         let th = dot(t, hv * inverseSqrt(max(dot(hv, hv), 1e-30)));
-        highlight += radiance * pow(sqrt(max(1.0 - th * th, 0.0)), m0.y);
+        highlight += radiance * pow(max(1.0 - th * th, 0.0), 0.5 * m0.y);
     }
     return clamp(base * diffuse + m0.x * highlight, vec3<f32>(0.0), vec3<f32>(1.0));
 }

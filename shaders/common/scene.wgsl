@@ -45,8 +45,10 @@ struct Chunk {
     drawn: u32,
     kind: u32,
     set_surface: u32,
-    pad0: u32,
-    pad1: u32,
+    // A strand or particle set's first instance (its row of the instance table; 0 without
+    // instances) and its points in this chunk (the stride of `expanded` per instance).
+    set_instance: u32,
+    set_points: u32,
 }
 @group(0) @binding(4) var<uniform> chunk: Chunk;
 // Two vec4 a vertex where the scene is shaded: (unit normal, material index bits), (u, v, 0, 0).

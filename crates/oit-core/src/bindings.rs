@@ -38,15 +38,37 @@ fn buffer_entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BufferBi
 
 /// Group 0 (shaders/common/scene.wgsl): the frame uniform, positions, colors, indices, the
 /// chunk's place in the scene, the vertex attributes of shading, the material table that
-/// fragments shade with, the instance table and the chunk's segments (compute passes over the
-/// drawn triangles).
+/// fragments shade with, the instance table, the chunk's segments (compute passes over the
+/// drawn triangles) and a strand or particle set's corners (common/primitives.wgsl).
 pub fn scene_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let all = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
     let read = wgpu::BufferBindingType::Storage { read_only: true };
     let storage = |binding| buffer_entry(binding, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE, read);
     let uniform = |binding| buffer_entry(binding, all, wgpu::BufferBindingType::Uniform);
     let compute = |binding| buffer_entry(binding, wgpu::ShaderStages::COMPUTE, read);
-    vec![uniform(0), storage(1), storage(2), storage(3), uniform(4), storage(5), buffer_entry(6, all, read), storage(7), compute(8)]
+    vec![
+        uniform(0),
+        storage(1),
+        storage(2),
+        storage(3),
+        uniform(4),
+        storage(5),
+        buffer_entry(6, all, read),
+        storage(7),
+        compute(8),
+        storage(9),
+    ]
+}
+
+/// Group 0 of the expansion pass (shaders/expand.wgsl): the scene's bindings with the expanded
+/// corners (binding 9) writable, for a compute pass alone.
+pub fn expand_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    let uniform = |binding| buffer_entry(binding, compute, wgpu::BufferBindingType::Uniform);
+    let storage = |binding| buffer_entry(binding, compute, read);
+    let written = buffer_entry(9, compute, wgpu::BufferBindingType::Storage { read_only: false });
+    vec![uniform(0), storage(1), storage(2), storage(3), uniform(4), storage(5), storage(6), storage(7), written]
 }
 
 /// The prefix sum's group (shaders/scan.wgsl): the data and the block sums, read-write, and

@@ -69,6 +69,9 @@ pub enum Layout {
     Textures(&'static [u32]),
     /// The prefix sum's group (scan.rs): the data and block sums, read-write, and its uniform.
     Scan,
+    /// Group 0 of the expansion of strands and particles (shaders/expand.wgsl): the scene's,
+    /// with the expanded corners writable.
+    Expand,
 }
 
 impl Layout {
@@ -82,6 +85,7 @@ impl Layout {
             Layout::Storage(n) => (0..n).map(bindings::storage_entry).collect(),
             Layout::Textures(at) => at.iter().map(|&b| bindings::float_texture_entry(b)).collect(),
             Layout::Scan => bindings::scan_entries(),
+            Layout::Expand => bindings::expand_entries(),
         }
     }
 
@@ -91,6 +95,7 @@ impl Layout {
             Layout::Targets => "targets",
             Layout::SampleTargets => "sample targets",
             Layout::Scan => "scan",
+            Layout::Expand => "expand",
             Layout::Storage(_) | Layout::Textures(_) => "oit group",
         };
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &self.entries() })
@@ -279,5 +284,7 @@ pub const BLIT: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit", 
 pub const BLIT_SRGB: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit_srgb", &[Layout::Textures(&[0])]);
 pub const SCAN_BLOCKS: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_scan_blocks", &[Layout::Scan]);
 pub const SCAN_ADD: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_add_blocks", &[Layout::Scan]);
+/// Strands and particles facing the eye, before a frame's geometry passes (upload.rs).
+pub const EXPAND: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand", &[Layout::Expand]);
 pub const ENGINE_PIPELINES: &[PipelineSpec] =
-    &[OPAQUE, CENSUS_BLEND, CENSUS_ATOMIC, CENSUS_SAMPLES, BLIT, BLIT_SRGB, SCAN_BLOCKS, SCAN_ADD];
+    &[OPAQUE, CENSUS_BLEND, CENSUS_ATOMIC, CENSUS_SAMPLES, BLIT, BLIT_SRGB, SCAN_BLOCKS, SCAN_ADD, EXPAND];

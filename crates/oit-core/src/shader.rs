@@ -39,6 +39,8 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("SHADING_COST", 0),
     Const::U32("INSTANCED", 1),
     Const::U32("PRIMITIVES", 1),
+    // Whether `expanded` is writable: the expansion pass of strands and particles only.
+    Const::U32("EXPANDING", 0),
 ];
 
 /// What a scene's geometry passes compile for (`//!if` blocks and loop bounds in
@@ -59,7 +61,7 @@ pub struct SceneVariant {
 }
 
 impl SceneVariant {
-    pub fn consts(&self) -> [Const; 6] {
+    pub fn consts(&self) -> [Const; 7] {
         [
             Const::U32("SHADED", self.shaded as u32),
             Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
@@ -67,6 +69,8 @@ impl SceneVariant {
             Const::U32("SHADING_COST", self.shading_cost),
             Const::U32("INSTANCED", self.instanced as u32),
             Const::U32("PRIMITIVES", self.primitives as u32),
+            // Only shaders/expand.wgsl writes the corners (its own //!define).
+            Const::U32("EXPANDING", 0),
         ]
     }
 }
@@ -160,6 +164,7 @@ fn condition(expr: &str, consts: &[Const], path: &str, line: usize) -> bool {
 /// the given ones.
 pub fn compose(path: &str, consts: &[Const]) -> String {
     let mut out = String::new();
+    let consts = &with_defines(path, consts);
     for c in crate::consts::SHARED.iter().chain(consts) {
         match c {
             Const::U32(name, v) => out.push_str(&format!("const {name}: u32 = {v}u;\n")),
@@ -167,6 +172,26 @@ pub fn compose(path: &str, consts: &[Const]) -> String {
         }
     }
     expand(path, consts, &mut out, &mut Vec::new());
+    out
+}
+
+/// `consts` with the values a top-level file sets for itself (`//!define NAME value` lines, u32)
+/// in place of the given ones: what only that file's pipelines compile with.
+fn with_defines(path: &str, consts: &[Const]) -> Vec<Const> {
+    let own: Vec<(&'static str, u32)> = source(path)
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("//!define "))
+        .map(|d| {
+            let (name, value) = d.trim().split_once(' ').unwrap_or_else(|| panic!("{path}: //!define NAME value, got '{d}'"));
+            let value = value.trim().parse().unwrap_or_else(|_| panic!("{path}: //!define {name}: '{value}' is not a u32"));
+            (name, value)
+        })
+        .collect();
+    let name = |c: &Const| match *c {
+        Const::U32(n, _) | Const::F32(n, _) => n,
+    };
+    let mut out: Vec<Const> = consts.iter().copied().filter(|c| !own.iter().any(|(n, _)| *n == name(c))).collect();
+    out.extend(own.iter().map(|&(n, v)| Const::U32(n, v)));
     out
 }
 

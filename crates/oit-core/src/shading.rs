@@ -370,7 +370,8 @@ fn hair(base: DVec4, s: &Surface<'_>, lighting: &Lighting) -> DVec4 {
     for &(l, radiance) in &lighting.lights {
         diffuse += radiance * sine(t.dot(l));
         let h = (l + s.to_eye).normalize_or_zero();
-        highlight += radiance * sine(t.dot(h)).powf(m.shininess as f64);
+        let th = t.dot(h);
+        highlight += radiance * (1.0 - th * th).max(0.0).powf(0.5 * m.shininess as f64);
     }
     (base.truncate() * diffuse + m.specular as f64 * highlight).clamp(DVec3::ZERO, DVec3::ONE).extend(base.w)
 }

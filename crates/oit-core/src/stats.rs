@@ -30,6 +30,9 @@ pub struct Stats {
     /// `scene_bytes` by what uploaded them: meshes (with materials, textures and instance
     /// tables), strand sets, particle sets.
     pub scene_bytes_by_primitive: [u64; 3],
+    /// The part of `scene_bytes` that strand and particle corners take: built on the GPU each
+    /// frame, not uploaded.
+    pub expanded_bytes: u64,
     pub gpu_time_ms: Option<f64>,
     pub pass_times_ms: Vec<(&'static str, f64)>,
     pub overflow_fragments: u64,
@@ -125,6 +128,7 @@ impl Stats {
             ("memory_bytes", Int(Some(self.memory_bytes))),
             ("target_bytes", Int(Some(self.target_bytes))),
             ("scene_bytes", Int(Some(self.scene_bytes))),
+            ("expanded_bytes", Int(Some(self.expanded_bytes))),
             ("scene_bytes_by_primitive", Numbers(primitive_bytes(self.scene_bytes_by_primitive))),
             ("gpu_time_ms", Float(self.gpu_time_ms)),
             ("pass_times_ms", Numbers(summed(&self.pass_times_ms))),

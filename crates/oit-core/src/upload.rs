@@ -40,6 +40,8 @@ pub struct Chunk {
     /// Triangles drawn from it, instances included: what a compute pass over the drawn
     /// triangles dispatches (shaders/common/setup.wgsl).
     pub drawn: u32,
+    /// A strand or particle chunk's group 0 for the expansion pass (`Layout::Expand`).
+    pub expand: Option<wgpu::BindGroup>,
 }
 
 /// The transparent or the opaque meshes, concatenated in submission order and split into
@@ -59,6 +61,8 @@ pub struct Geometry {
     /// Bytes uploaded by what uploaded them (indexed by chunk kind: meshes with the instance
     /// and segment tables, strands, particles).
     pub bytes: [u64; 3],
+    /// The part of `bytes` that the expansion pass writes on the GPU (not uploaded).
+    pub expanded_bytes: u64,
 }
 
 impl Geometry {
@@ -85,6 +89,18 @@ impl Geometry {
                 for i in first..first + count {
                     segments.iter().for_each(|&s| self.draw_segment(pass, s, i..i + 1));
                 }
+            }
+        }
+    }
+
+    /// Builds the corners of every strand and particle chunk under the frame uniform's camera
+    /// (shaders/expand.wgsl), before the passes that draw them.
+    pub fn expand(&self, pass: &mut wgpu::ComputePass<'_>) {
+        for c in &self.chunks {
+            if let Some(group) = &c.expand {
+                pass.set_bind_group(0, group, &[]);
+                let groups = (c.triangles / 2).div_ceil(64);
+                pass.dispatch_workgroups(groups.min(65_535), groups.div_ceil(65_535), 1);
             }
         }
     }
@@ -135,6 +151,10 @@ struct Gather {
     shaded: bool,
     kind: u32,
     material: u32,
+    /// A set's first row of the instance table (0 without instances) and its instance count:
+    /// `expanded` holds its corners once an instance.
+    set_instance: u32,
+    set_instances: u32,
 }
 
 impl Gather {
@@ -150,15 +170,39 @@ impl Gather {
         }
     }
 
-    /// The next chunk after this one, of `kind` with `material`.
+    /// The next chunk after this one, of `kind` with `material`, of the same set.
     fn next(&self, kind: u32, material: u32) -> Gather {
-        Gather { first_triangle: self.first_triangle + self.triangles(), shaded: self.shaded, kind, material, ..Default::default() }
+        Gather {
+            first_triangle: self.first_triangle + self.triangles(),
+            shaded: self.shaded,
+            kind,
+            material,
+            set_instance: self.set_instance,
+            set_instances: self.set_instances,
+            ..Default::default()
+        }
     }
 
-    /// Whether `points` more points and `segments` more segment words fit `max` bytes each.
+    /// Vec4 of `expanded` a point (an instance): two corners and a tangent a strand point, four
+    /// corners a particle (shaders/common/primitives.wgsl).
+    fn expanded_per_point(&self) -> u64 {
+        match self.kind {
+            PRIM_STRANDS => 3,
+            PRIM_PARTICLES => 4,
+            _ => 0,
+        }
+    }
+
+    /// Whether `points` more points and `segments` more segment words fit `max` bytes each,
+    /// their corners too, and one dispatch of the expansion (65,535 groups of 64 in x).
     fn room_points(&self, points: u64, segments: u64, max: u64) -> bool {
         let v = self.vertices() + points;
-        v * 16 <= max && (self.indices.len() as u64 + segments) * 4 <= max && v <= primitive::POINT_MASK as u64
+        let units = if self.kind == PRIM_STRANDS { self.indices.len() as u64 + segments } else { v };
+        v * 16 <= max
+            && units * 4 <= max
+            && v * self.expanded_per_point() * 16 * self.set_instances.max(1) as u64 <= max
+            && units <= 65_535 * 64 * 65_535
+            && v <= primitive::POINT_MASK as u64
     }
 
     /// Points `range` of `m` (one strand, or particles) with their half widths or radii.
@@ -197,6 +241,8 @@ impl Gather {
 /// Where a scene's group 0 comes from: its layout, the frame uniform, the surfaces table.
 struct Shared<'a> {
     layout: &'a wgpu::BindGroupLayout,
+    /// Group 0 of the expansion pass (`Layout::Expand`).
+    expand_layout: &'a wgpu::BindGroupLayout,
     uniform: &'a wgpu::Buffer,
     surfaces: &'a wgpu::Buffer,
     shaded: bool,
@@ -254,7 +300,8 @@ fn upload<'a>(
         unique += tris;
         let mut mine = Vec::new();
         if m.primitive != Primitive::Triangles {
-            cur = upload_set(cur, &mut done, &mut mine, m, mesh as u32, max)?;
+            let first = if shared.instanced { instances.last().expect("pushed above").0 } else { 0 };
+            cur = upload_set(cur, &mut done, &mut mine, m, (mesh as u32, first, list.len() as u32), max)?;
         } else if cur.room(m.positions.len() as u64, tris, max) {
             // The whole mesh: its vertices in order, its indices offset.
             let base = cur.vertices() as u32;
@@ -335,6 +382,7 @@ fn upload<'a>(
     }
     let instance_table = make("instances", bytemuck::cast_slice(&table));
     let mut bytes = [table_bytes, 0, 0];
+    let mut expanded_bytes = 0;
     let chunks = kept
         .iter()
         .enumerate()
@@ -344,7 +392,8 @@ fn upload<'a>(
                 g.positions.len() as u64 * 4 + g.colors.len() as u64 * 16 + g.indices.len() as u64 * 4 + g.attributes.len() as u64 * 16;
             let list = &chunk_segments[k];
             bytes[PRIM_MESH as usize] += list.len() as u64 * segment_bytes;
-            let place = [g.first_triangle, g.triangles(), list.len() as u32, chunk_drawn[k], g.kind, g.material, 0, 0];
+            let points = g.vertices() as u32;
+            let place = [g.first_triangle, g.triangles(), list.len() as u32, chunk_drawn[k], g.kind, g.material, g.set_instance, points];
             let info = gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("chunk"),
                 size: std::mem::size_of_val(&place) as u64,
@@ -357,6 +406,11 @@ fn upload<'a>(
             let idx = make("indices", bytemuck::cast_slice(&g.indices));
             let attr = make("attributes", bytemuck::cast_slice(&g.attributes));
             let seg = make("segments", bytemuck::cast_slice(list));
+            // A set's corners, written by the expansion pass each frame (or 16 bytes unused).
+            let corners = g.vertices() * g.expanded_per_point() * 16 * g.set_instances as u64;
+            let expanded = storage_buffer(&gpu.device, "expanded", corners.max(16), wgpu::BufferUsages::empty());
+            bytes[g.kind as usize] += corners;
+            expanded_bytes += corners;
             let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(label),
                 layout: shared.layout,
@@ -370,18 +424,47 @@ fn upload<'a>(
                     wgpu::BindGroupEntry { binding: 6, resource: shared.surfaces.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 7, resource: instance_table.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 8, resource: seg.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 9, resource: expanded.as_entire_binding() },
                 ],
             });
-            Chunk { group, triangles: g.triangles(), drawn: chunk_drawn[k] }
+            let expand = (corners > 0).then(|| {
+                let entries: Vec<wgpu::BindGroupEntry> = [
+                    (0, shared.uniform),
+                    (1, &pos),
+                    (2, &col),
+                    (3, &idx),
+                    (4, &info),
+                    (5, &attr),
+                    (6, shared.surfaces),
+                    (7, &instance_table),
+                    (9, &expanded),
+                ]
+                .into_iter()
+                .map(|(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
+                .collect();
+                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("expand"),
+                    layout: shared.expand_layout,
+                    entries: &entries,
+                })
+            });
+            Chunk { group, triangles: g.triangles(), drawn: chunk_drawn[k], expand }
         })
         .collect();
-    Ok(Geometry { chunks, triangles: drawn as u32, placements, segments, instances, instanced: shared.instanced, bytes })
+    Ok(Geometry { chunks, triangles: drawn as u32, placements, segments, instances, instanced: shared.instanced, bytes, expanded_bytes })
 }
 
 /// Uploads a strand or particle set, the scene's mesh `material`, into chunks of its own after
 /// `cur` (closed first where it holds anything): whole strands or particles while they fit a
 /// binding. Returns the mesh chunk that follows it; `mine` gets the set's segments.
-fn upload_set(cur: Gather, done: &mut Vec<Gather>, mine: &mut Vec<Segment>, m: &Mesh, material: u32, max: u64) -> Result<Gather> {
+fn upload_set(
+    cur: Gather,
+    done: &mut Vec<Gather>,
+    mine: &mut Vec<Segment>,
+    m: &Mesh,
+    (material, set_instance, set_instances): (u32, u32, u32),
+    max: u64,
+) -> Result<Gather> {
     let kind = m.primitive.kind();
     let mut cur = if cur.vertices() > 0 || !cur.indices.is_empty() {
         let next = cur.next(kind, material);
@@ -390,6 +473,7 @@ fn upload_set(cur: Gather, done: &mut Vec<Gather>, mine: &mut Vec<Segment>, m: &
     } else {
         Gather { kind, material, ..cur }
     };
+    (cur.set_instance, cur.set_instances) = (set_instance, set_instances);
     let start = |mine: &mut Vec<Segment>, done: &Vec<Gather>| mine.push(Segment { chunk: done.len(), lo: 0, hi: 0 });
     start(mine, done);
     let units: Vec<(usize, usize)> = match &m.primitive {
@@ -409,7 +493,10 @@ fn upload_set(cur: Gather, done: &mut Vec<Gather>, mine: &mut Vec<Segment>, m: &
         let segments = if kind == PRIM_STRANDS { points as u64 - 1 } else { 0 };
         if !cur.room_points(points as u64, segments, max) {
             if cur.vertices() == 0 {
-                return Err(OitError::OutOfMemory(format!("a strand of {points} points passes a storage binding ({max} bytes): split it")));
+                return Err(OitError::OutOfMemory(format!(
+                    "a strand of {points} points (or its corners, {set_instances} instances) passes a storage binding ({max} bytes): \
+                     split it or draw fewer instances"
+                )));
             }
             let next = cur.next(kind, material);
             done.push(std::mem::replace(&mut cur, next));
@@ -426,7 +513,8 @@ fn upload_set(cur: Gather, done: &mut Vec<Gather>, mine: &mut Vec<Segment>, m: &
         }
         mine.last_mut().expect("started above").hi = cur.triangles();
     }
-    let next = cur.next(PRIM_MESH, 0);
+    let mut next = cur.next(PRIM_MESH, 0);
+    (next.set_instance, next.set_instances) = (0, 0);
     done.push(cur);
     Ok(next)
 }
@@ -458,7 +546,8 @@ impl GpuScene {
         let buffer = storage_buffer(&gpu.device, "surfaces", table.len() as u64 * 16, wgpu::BufferUsages::empty());
         gpu.queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&table));
         let instanced = scene.instanced();
-        let shared = Shared { layout, uniform, surfaces: &buffer, shaded, instanced };
+        let expand_layout = gpu.cache.layout(&gpu.device, crate::cache::Layout::Expand);
+        let shared = Shared { layout, expand_layout: &expand_layout, uniform, surfaces: &buffer, shaded, instanced };
         let meshes = || scene.placed().enumerate().map(|(i, (m, list))| (i, m, list));
         let mut transparent = upload(gpu, "transparent", meshes().filter(|(_, m, _)| !m.opaque), &shared, max_binding_bytes)?;
         let opaque = upload(gpu, "opaque", meshes().filter(|(_, m, _)| m.opaque), &shared, max_binding_bytes)?;

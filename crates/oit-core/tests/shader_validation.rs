@@ -115,3 +115,15 @@ fn shared_constants_reach_every_shader_with_the_rust_values() {
         }
     }
 }
+
+/// A file's own `//!define` sets a constant for its pipelines alone: the expansion pass writes
+/// the corners that every other shader only reads.
+#[test]
+fn a_define_sets_a_constant_for_its_file_alone() {
+    let variant = variant_consts(SceneVariant { primitives: true, ..Default::default() });
+    let expand = compose("expand.wgsl", &variant);
+    assert!(expand.contains("const EXPANDING: u32 = 1u;") && !expand.contains("const EXPANDING: u32 = 0u;"));
+    assert!(expand.contains("var<storage, read_write> expanded"));
+    let blend = compose("blend.wgsl", &variant);
+    assert!(blend.contains("const EXPANDING: u32 = 0u;") && blend.contains("var<storage, read> expanded"));
+}

@@ -1,7 +1,8 @@
 """`python -m oit bench --strands`: hair as a strand set (ribbons built on the GPU from the
 points) against the same hair as triangle ribbons built on the CPU, at the same look
-(`oit.scenes.hair(primitive=...)`): the bytes each uploads, the time the upload takes, and the
-frame time of the floor and the methods over it, as ratios of strands to ribbons in one run."""
+(`oit.scenes.hair(primitive=...)`): the bytes each uploads (and the strands' GPU bytes with their
+corners), the time the upload takes, and the frame time of the floor and the methods over it,
+as ratios of strands to ribbons in one run, the two rendered in turn."""
 
 from __future__ import annotations
 
@@ -12,59 +13,87 @@ from functools import partial
 
 from .. import scenes as scene_lib
 from .._api import Renderer
-from .harness import QUICK_SIZE, Progress, Result, medians, timed
+from .harness import QUICK_SIZE, Progress, Result, medians
 
 STRAND_METHODS = ("unsorted", "hybrid64", "hybrid", "abuffer")
 STRAND_COUNTS = (6000, 15000)
 STRAND_COLUMNS = [("strands", "{}"), ("method", "{}"), ("ribbons_mib", "{:.2f}"), ("strands_mib", "{:.2f}"),
-                  ("bytes_x", "{:.2f}"), ("ribbons_upload_ms", "{:.1f}"), ("strands_upload_ms", "{:.1f}"),
-                  ("ribbons_wall_ms", "{:.1f}"), ("strands_wall_ms", "{:.1f}"), ("wall_x", "{:.2f}"),
-                  ("ribbons_gpu_ms", "{:.1f}"), ("strands_gpu_ms", "{:.1f}"), ("gpu_x", "{:.2f}")]
+                  ("bytes_x", "{:.2f}"), ("strands_gpu_mib", "{:.2f}"), ("ribbons_upload_ms", "{:.1f}"),
+                  ("strands_upload_ms", "{:.1f}"), ("ribbons_wall_ms", "{:.1f}"), ("strands_wall_ms", "{:.1f}"),
+                  ("wall_x", "{:.2f}"), ("ribbons_gpu_ms", "{:.1f}"), ("strands_gpu_ms", "{:.1f}"), ("gpu_x", "{:.2f}")]
+# Upload time is measured on frames this small, where the frame itself costs next to nothing.
+UPLOAD_SIZE = 16
 
 
 def _upload_ms(renderer: Renderer, build, repeat: int) -> float:
-    """The wall time a first render of a freshly built copy of the scene adds over a render of
-    one already uploaded (the pipelines warm): the upload, median over `repeat` copies."""
-    built = build()
-    _, _, warm = timed(partial(renderer.render, built.scene, built.camera, "unsorted"), repeat)
+    """What the first render of a freshly built copy of the scene costs over its second (the
+    pipelines warm, a frame of UPLOAD_SIZE pixels a side): the upload, median over `repeat`
+    copies, each paired with its own second render."""
+    warm = build()
+    renderer.render(warm.scene, warm.camera, "unsorted")
     extra = []
     for _ in range(repeat):
         copy = build()
         t0 = time.perf_counter()
         renderer.render(copy.scene, copy.camera, "unsorted")
-        extra.append((time.perf_counter() - t0) * 1e3 - statistics.median(warm))
+        t1 = time.perf_counter()
+        renderer.render(copy.scene, copy.camera, "unsorted")
+        extra.append((t1 - t0) * 1e3 - (time.perf_counter() - t1) * 1e3)
     return statistics.median(extra)
+
+
+def _alternating(renderer: Renderer, built: dict, method: str, repeat: int) -> dict[str, tuple[float, float, dict]]:
+    """Each primitive's median GPU and wall time of `method` and its last stats, the two scenes
+    rendered in turn (after a warm-up each), so that drift in the machine's speed falls on both."""
+    times: dict[str, tuple[list[float], list[float]]] = {p: ([], []) for p in built}
+    stats: dict[str, dict] = {}
+    for b in built.values():
+        renderer.render(b.scene, b.camera, method)
+    for _ in range(repeat):
+        for p, b in built.items():
+            t0 = time.perf_counter()
+            frame = renderer.render(b.scene, b.camera, method)
+            times[p][1].append((time.perf_counter() - t0) * 1e3)
+            if frame.stats.get("gpu_time_ms") is not None:
+                times[p][0].append(frame.stats["gpu_time_ms"])
+            stats[p] = frame.stats
+    out = {}
+    for p, (gpu, wall) in times.items():
+        m = medians(gpu, wall)
+        out[p] = (m["gpu_ms"], m["wall_ms"], stats[p])
+    return out
 
 
 def strands_vs_ribbons(counts: tuple[int, ...] = STRAND_COUNTS, methods: tuple[str, ...] = STRAND_METHODS,
                        repeat: int = 5, quick: bool = False, show_progress: bool = True) -> Result:
-    """One row per strand count and method: both primitives' scene bytes, upload time and frame
-    times (median over `repeat` after a warm-up), and strands over ribbons."""
+    """One row per strand count and method: both primitives' uploaded bytes (and the strands'
+    GPU bytes, their corners included), upload time, and frame times (medians over `repeat`,
+    the two rendered in turn), and strands over ribbons."""
     size = QUICK_SIZE if quick else 512
     counts = (300,) if quick else counts
-    renderer = Renderer(size, size)
-    result = Result(rows=[], notes=[f"{size} x {size}; the same polylines, widths and colors drawn both ways"])
-    progress = Progress(len(counts) * (len(methods) + 1) * 2, show_progress)
+    renderer, small = Renderer(size, size), Renderer(UPLOAD_SIZE, UPLOAD_SIZE)
+    result = Result(rows=[], notes=[f"{size} x {size}; the same polylines, widths and colors drawn both ways; "
+                                    f"uploads timed on {UPLOAD_SIZE} x {UPLOAD_SIZE} frames"])
+    progress = Progress(len(counts) * (len(methods) + 2), show_progress)
     for n in counts:
-        row_of = {m: {"strands": n, "method": m, "status": "ok", "message": "", "adapter": renderer.adapter_info["name"]}
-                  for m in methods}
-        for primitive in ("ribbons", "strands"):
-            build = partial(scene_lib.hair, strands=n, primitive=primitive)
-            progress.show(f"hair {n} {primitive} upload")
-            upload = _upload_ms(renderer, build, repeat)
+        built = {p: scene_lib.hair(strands=n, primitive=p) for p in ("ribbons", "strands")}
+        upload = {}
+        for p in built:
+            progress.show(f"hair {n} {p} upload")
+            upload[p] = _upload_ms(small, partial(scene_lib.hair, strands=n, primitive=p), repeat)
             progress.step("upload")
-            built = build()
-            for m in methods:
-                progress.show(f"hair {n} {primitive} {m}")
-                frame, gpu, wall = timed(partial(renderer.render, built.scene, built.camera, m), repeat)
-                t = medians(gpu, wall)
-                row_of[m].update({f"{primitive}_mib": frame.stats["scene_bytes"] / 2**20, f"{primitive}_upload_ms": upload,
-                                  f"{primitive}_wall_ms": t["wall_ms"], f"{primitive}_gpu_ms": t["gpu_ms"]})
-                progress.step(m)
-        for row in row_of.values():
+        for m in methods:
+            progress.show(f"hair {n} {m}")
+            t = _alternating(renderer, built, m, repeat)
+            row = {"strands": n, "method": m, "status": "ok", "message": "", "adapter": renderer.adapter_info["name"]}
+            for p, (gpu, wall, stats) in t.items():
+                uploaded = stats["scene_bytes"] - stats["expanded_bytes"]
+                row.update({f"{p}_mib": uploaded / 2**20, f"{p}_upload_ms": upload[p], f"{p}_wall_ms": wall, f"{p}_gpu_ms": gpu})
+                if p == "strands":
+                    row["strands_gpu_mib"] = stats["scene_bytes"] / 2**20
             row["bytes_x"] = row["ribbons_mib"] / row["strands_mib"]
             row["wall_x"] = row["strands_wall_ms"] / row["ribbons_wall_ms"]
-            ratio = row["strands_gpu_ms"] / row["ribbons_gpu_ms"] if row["ribbons_gpu_ms"] else math.nan
-            row["gpu_x"] = ratio
+            row["gpu_x"] = row["strands_gpu_ms"] / row["ribbons_gpu_ms"] if row["ribbons_gpu_ms"] else math.nan
             result.rows.append(row)
+            progress.step(m)
     return result

@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::{Frame, Renderer, COVERAGE_SAMPLES};
 use crate::antialias;
 use crate::bindings::{COLOR_FORMAT, COUNT_FORMAT};
-use crate::cache::{Draw, Layout, CENSUS_ATOMIC, CENSUS_BLEND, CENSUS_SAMPLES, OPAQUE};
+use crate::cache::{Draw, Layout, CENSUS_ATOMIC, CENSUS_BLEND, CENSUS_SAMPLES, EXPAND, OPAQUE};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::{FrameUniform, GpuLight};
@@ -124,6 +124,7 @@ impl Renderer {
         let gpu = self.gpu.clone();
         let (w, h) = (self.width, self.height);
         let census = info.needs_census(params) || self.census;
+        let expand_times = self.expand_primitives(camera, background)?;
         if self.memory_budget.is_some() {
             // Under a budget no method keeps storage between frames: what the frame allocates
             // is what it reports, and the census runs with the targets alone.
@@ -158,7 +159,11 @@ impl Renderer {
         if self.memory_budget.is_none() {
             self.methods.insert(info.name, method);
         }
-        let (tiles, report, pass_times, arrays) = result?;
+        let (tiles, report, mut pass_times, arrays) = result?;
+        if let (Some(p), Some(mut e)) = (pass_times.as_mut(), expand_times) {
+            e.append(p);
+            *p = e;
+        }
         if let (Some(into), Some(t)) = (&self.into, &self.targets) {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             self.blit(&mut enc, &t.out, &into.color, wgpu::ColorWrites::COLOR, into.encode_srgb);
@@ -177,6 +182,7 @@ impl Renderer {
             target_bytes,
             scene_bytes: gpu_scene.bytes().iter().sum(),
             scene_bytes_by_primitive: gpu_scene.bytes(),
+            expanded_bytes: gpu_scene.transparent.expanded_bytes + gpu_scene.opaque.expanded_bytes,
             gpu_time_ms: pass_times.as_ref().map(|p| p.iter().map(|(_, t)| t).sum()),
             pass_times_ms: pass_times.unwrap_or_default(),
             overflow_fragments: report.overflow_fragments,
@@ -362,6 +368,28 @@ impl Renderer {
     }
 
     /// Writes the frame uniform for `camera` and the screen tile `tile`.
+    /// Builds the strand and particle corners under `camera` (shaders/expand.wgsl), once a
+    /// frame before any pass draws them; nothing where the scene has none.
+    /// Its GPU time is the frame's pass "expand".
+    fn expand_primitives(&mut self, camera: &Camera, bg: [f32; 3]) -> Result<Option<Vec<(&'static str, f64)>>> {
+        let (w, h) = (self.width, self.height);
+        let Some((_, scene)) = self.scene.as_ref().filter(|(_, s)| s.primitives) else { return Ok(None) };
+        self.set_uniform(camera, scene, bg, Tile::frame(w, h));
+        let consts = self.variant(scene).consts();
+        let pipeline = self.gpu.cache.compute(&self.gpu.device, &EXPAND.compute_desc(&consts));
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        self.timer.reset();
+        {
+            let timestamp_writes = self.timer.compute_pass("expand");
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("expand"), timestamp_writes });
+            pass.set_pipeline(&pipeline);
+            scene.transparent.expand(&mut pass);
+            scene.opaque.expand(&mut pass);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.timer.read(&self.gpu)
+    }
+
     pub(super) fn set_uniform(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3], tile: Tile) {
         let lighting = Lighting::new(&self.lights.0, self.lights.1, camera.view_direction());
         let mut lights = [GpuLight::default(); MAX_LIGHTS as usize];
