@@ -300,3 +300,29 @@ def test_scene_files_carry_strands_and_particles(tmp_path, renderer):
     # Peers get triangles: each segment and each particle two.
     drawn = original.drawn_meshes()
     assert [len(m.indices) for m in drawn] == [original.scene.triangle_count - 80, 80]
+
+
+def test_compare_and_render_take_strand_and_point_files(tmp_path):
+    import csv
+    import subprocess
+    import sys
+
+    from files import ply_points
+    from oit.hairfile import write_hair
+
+    rng = np.random.default_rng(11)
+    hair = tmp_path / "model.hair"
+    write_hair(hair, np.cumsum(rng.normal(0, 0.1, (60, 3)), 0).astype(np.float32), [20, 40], widths=0.04)
+    for path in (hair, ply_points(tmp_path / "points.ply")):
+        out = tmp_path / path.stem
+        done = subprocess.run([sys.executable, "-m", "oit", "compare", str(path), "--size", "24", "24", "--views", "1",
+                               "--methods", "abuffer", "unsorted", "--no-plots", "--out", str(out)],
+                              cwd=tmp_path, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        with open(out / "compare.csv") as f:
+            rows = list(csv.DictReader(f))
+        assert {r["method"] for r in rows} == {"abuffer", "unsorted"}
+        done = subprocess.run([sys.executable, "-m", "oit", "render", str(path), "--size", "24", "24", "-o", str(out / "r.png")],
+                              cwd=tmp_path, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        assert (out / "r.png").stat().st_size > 0

@@ -168,11 +168,18 @@ fn renders_only_when_something_changed() {
 #[test]
 fn the_frame_is_the_engines_frame() {
     let h = harness("abuffer");
+    let own = engines_frame(&h, scene());
+    assert_eq!(own.stats.fragments, h.state().frame.as_ref().unwrap().stats.fragments);
+}
+
+/// `data` rendered by a Renderer of its own at the app's camera and frame size, checked equal
+/// to the app's frame.
+fn engines_frame(h: &Harness<'_, ViewerApp>, data: SceneData) -> oit_core::Frame {
     let app = h.state();
     let f = app.frame.as_ref().unwrap();
     let camera = Camera::from_rows(app.camera.rows(f.width as f64 / f.height as f64)).unwrap();
     let mut own_scene = oit_core::Scene::new();
-    scene().meshes.into_iter().for_each(|m| {
+    data.meshes.into_iter().for_each(|m| {
         own_scene.add_mesh(m.mesh);
     });
     let gpu = oit_core::shared_context(None).unwrap();
@@ -180,7 +187,7 @@ fn the_frame_is_the_engines_frame() {
     let own = r.render(&own_scene, &camera, "abuffer", &[], [1.0; 3]).unwrap();
     let diff = own.image.iter().zip(&f.image).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
     assert!(diff < 1e-6, "max difference {diff}");
-    assert_eq!(own.stats.fragments, f.stats.fragments);
+    own
 }
 
 /// The samples box and the coverage checkbox reach the engine: 4 samples with coverage masks
@@ -219,18 +226,7 @@ fn the_viewer_draws_strands_and_particles() {
     data.meshes.push(NamedMesh::new("strands".into(), strands));
     data.meshes.push(NamedMesh::new("particles".into(), particles));
     let h = harness_of("abuffer", data.clone());
-    let app = h.state();
-    let f = app.frame.as_ref().unwrap();
-    let camera = Camera::from_rows(app.camera.rows(f.width as f64 / f.height as f64)).unwrap();
-    let mut own_scene = oit_core::Scene::new();
-    data.meshes.into_iter().for_each(|m| {
-        own_scene.add_mesh(m.mesh);
-    });
-    let gpu = oit_core::shared_context(None).unwrap();
-    let mut r = Renderer::new(gpu, f.width, f.height).unwrap();
-    let own = r.render(&own_scene, &camera, "abuffer", &[], [1.0; 3]).unwrap();
-    let diff = own.image.iter().zip(&f.image).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-    assert!(diff < 1e-6, "max difference {diff}");
+    let own = engines_frame(&h, data);
     assert!(own.stats.scene_bytes_by_primitive[1] > 0 && own.stats.scene_bytes_by_primitive[2] > 0);
-    assert_eq!(app.triangle_count(), 2 + 2 * 6 + 2 * 2);
+    assert_eq!(h.state().triangle_count(), 2 + 2 * 6 + 2 * 2);
 }
