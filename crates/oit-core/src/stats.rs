@@ -81,6 +81,7 @@ pub const SCHEMA: &[StatKey] = &[
     key("memory_bytes", "int", "what the method allocated (oit.memory_bytes gives its formula)"),
     key("target_bytes", "int", "the frame's targets and readbacks as allocated (tile-sized under a small budget)"),
     key("scene_bytes", "int", "the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's"),
+    key("expanded_bytes", "int", "the part of scene_bytes that strands and particles build on the GPU each frame, not uploaded"),
     key(
         "scene_bytes_by_primitive",
         "dict[str, float]",
