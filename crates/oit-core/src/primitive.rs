@@ -1,5 +1,6 @@
-//! Strands and particles: meshes whose triangles the GPU builds in the vertex stage from
-//! points, facing the camera (shaders/common/primitives.wgsl). A strand set is polylines of
+//! Strands and particles: meshes whose triangles the GPU builds from points, facing the
+//! camera: a compute pass writes their corners once a frame (shaders/expand.wgsl) and the
+//! vertex stage pulls them (shaders/common/primitives.wgsl). A strand set is polylines of
 //! points with a width each, drawn as ribbons, two triangles a segment; a particle set is
 //! centers with a radius each, drawn as discs on quads, two triangles a particle, whose alpha
 //! falls off from the center (`Falloff`). The expansion is written once here in float64 for
