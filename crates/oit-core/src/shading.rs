@@ -213,11 +213,13 @@ impl Material {
     /// Whether the material leaves the vertex color as it is and every triangle drawn (today's
     /// unlit meshes): else the scene is drawn with its material table.
     pub fn is_plain(&self) -> bool {
-        self.shading == Shading::Unlit
-            && self.texture.is_none()
-            && self.opacity == 1.0
-            && !self.cull_back_faces
-            && self.falloff == Falloff::None
+        self.is_plain_surface() && self.falloff == Falloff::None
+    }
+
+    /// `is_plain` but for a particle set's falloff, which its primitive carries (scene files
+    /// store it with the set, not with the surface).
+    pub fn is_plain_surface(&self) -> bool {
+        self.shading == Shading::Unlit && self.texture.is_none() && self.opacity == 1.0 && !self.cull_back_faces
     }
 }
 

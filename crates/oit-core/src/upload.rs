@@ -170,15 +170,17 @@ impl Gather {
         }
     }
 
-    /// The next chunk after this one, of `kind` with `material`, of the same set.
+    /// The next chunk after this one, of `kind` with `material`: a set's next chunk keeps its
+    /// instances, a mesh chunk has none of its own.
     fn next(&self, kind: u32, material: u32) -> Gather {
+        let (set_instance, set_instances) = if kind == PRIM_MESH { (0, 0) } else { (self.set_instance, self.set_instances) };
         Gather {
             first_triangle: self.first_triangle + self.triangles(),
             shaded: self.shaded,
             kind,
             material,
-            set_instance: self.set_instance,
-            set_instances: self.set_instances,
+            set_instance,
+            set_instances,
             ..Default::default()
         }
     }
@@ -411,43 +413,30 @@ fn upload<'a>(
             let expanded = storage_buffer(&gpu.device, "expanded", corners.max(16), wgpu::BufferUsages::empty());
             bytes[g.kind as usize] += corners;
             expanded_bytes += corners;
-            let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout: shared.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: shared.uniform.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: pos.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: col.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: idx.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: info.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: attr.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 6, resource: shared.surfaces.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 7, resource: instance_table.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 8, resource: seg.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 9, resource: expanded.as_entire_binding() },
-                ],
-            });
-            let expand = (corners > 0).then(|| {
-                let entries: Vec<wgpu::BindGroupEntry> = [
-                    (0, shared.uniform),
-                    (1, &pos),
-                    (2, &col),
-                    (3, &idx),
-                    (4, &info),
-                    (5, &attr),
-                    (6, shared.surfaces),
-                    (7, &instance_table),
-                    (9, &expanded),
-                ]
-                .into_iter()
-                .map(|(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
-                .collect();
-                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("expand"),
-                    layout: shared.expand_layout,
-                    entries: &entries,
-                })
-            });
+            // One list of the chunk's buffers for its group and, without the segments (8),
+            // for its expansion pass's group (`Layout::Expand`, the corners writable).
+            let buffers = [
+                (0, shared.uniform),
+                (1, &pos),
+                (2, &col),
+                (3, &idx),
+                (4, &info),
+                (5, &attr),
+                (6, shared.surfaces),
+                (7, &instance_table),
+                (8, &seg),
+                (9, &expanded),
+            ];
+            let bind = |layout: &wgpu::BindGroupLayout, label: &str, skip: Option<u32>| {
+                let entries: Vec<wgpu::BindGroupEntry> = buffers
+                    .iter()
+                    .filter(|(binding, _)| Some(*binding) != skip)
+                    .map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
+                    .collect();
+                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+            };
+            let group = bind(shared.layout, label, None);
+            let expand = (corners > 0).then(|| bind(shared.expand_layout, "expand", Some(8)));
             Chunk { group, triangles: g.triangles(), drawn: chunk_drawn[k], expand }
         })
         .collect();
@@ -513,8 +502,7 @@ fn upload_set(
         }
         mine.last_mut().expect("started above").hi = cur.triangles();
     }
-    let mut next = cur.next(PRIM_MESH, 0);
-    (next.set_instance, next.set_instances) = (0, 0);
+    let next = cur.next(PRIM_MESH, 0);
     done.push(cur);
     Ok(next)
 }

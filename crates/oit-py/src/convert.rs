@@ -1,7 +1,7 @@
-//! numpy arrays into the core's types: rows of N values, 4 x 4 matrices, instance lists. Shapes
+//! numpy arrays into the core's types and back: rows of N values, 4 x 4 matrices, instance lists. Shapes
 //! are checked here, where the arrays are taken apart; their values are the core's to check.
 
-use numpy::{PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{IntoPyArray, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -12,6 +12,12 @@ pub(crate) fn rows<T: Copy + numpy::Element, const N: usize>(a: &PyReadonlyArray
     }
     let flat: Vec<T> = a.as_array().iter().copied().collect();
     Ok(flat.chunks_exact(N).map(|c| c.try_into().expect("chunk of N")).collect())
+}
+
+/// Rows of N values as an (n, N) numpy array: the inverse of `rows`.
+pub(crate) fn array<'py, T: numpy::Element + Copy, const N: usize>(py: Python<'py>, v: &[[T; N]]) -> Bound<'py, numpy::PyArray2<T>> {
+    let flat: Vec<T> = v.iter().flatten().copied().collect();
+    numpy::ndarray::Array2::from_shape_vec((v.len(), N), flat).expect("n x N").into_pyarray(py)
 }
 
 pub(crate) fn matrix(m: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<[[f64; 4]; 4]> {

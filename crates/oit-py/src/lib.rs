@@ -15,7 +15,7 @@ mod convert;
 mod load;
 mod primitives;
 
-use convert::{instances, matrix, rows, InstanceArrays};
+use convert::{array, instances, matrix, rows, InstanceArrays};
 
 struct Error(OitError);
 
@@ -188,10 +188,9 @@ impl Scene {
     fn instances<'py>(&self, py: Python<'py>, mesh: i64) -> PyResult<InstanceArrays<'py>> {
         let list = self.inner.instances(self.mesh_index(mesh)?);
         let t: Vec<f64> = list.iter().flat_map(|i| i.transform.transpose().to_cols_array()).collect();
-        let c: Vec<f32> = list.iter().flat_map(|i| i.color).collect();
+        let colors: Vec<[f32; 4]> = list.iter().map(|i| i.color).collect();
         let t = numpy::ndarray::Array3::from_shape_vec((list.len(), 4, 4), t).expect("n x 4 x 4");
-        let c = numpy::ndarray::Array2::from_shape_vec((list.len(), 4), c).expect("n x 4");
-        Ok((t.into_pyarray(py), c.into_pyarray(py)))
+        Ok((t.into_pyarray(py), array(py, &colors)))
     }
 
     /// A directional light travelling along `direction` (world space); returns its index.

@@ -1,10 +1,10 @@
 //! Strand and particle sets from numpy arrays, and any set as the triangles it is drawn as.
 //! Shapes are checked here; values are the core's to check (oit_core::primitive).
 
-use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use crate::convert::{matrix, rows};
+use crate::convert::{array, matrix, rows};
 use crate::Error;
 
 /// The surface words shared by strands and particles.
@@ -57,11 +57,6 @@ pub(crate) type TriangleArrays<'py> = (
     Option<Bound<'py, numpy::PyArray2<f32>>>,
     Option<Bound<'py, numpy::PyArray2<f32>>>,
 );
-
-fn array<'py, T: numpy::Element + Copy, const N: usize>(py: Python<'py>, v: &[[T; N]]) -> Bound<'py, numpy::PyArray2<T>> {
-    let flat: Vec<T> = v.iter().flatten().copied().collect();
-    numpy::ndarray::Array2::from_shape_vec((v.len(), N), flat).expect("n x N").into_pyarray(py)
-}
 
 /// `mesh` as triangles under the camera `view_proj` (strands and particles face it).
 pub(crate) fn to_triangles<'py>(

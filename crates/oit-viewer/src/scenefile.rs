@@ -213,10 +213,7 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
     out.extend(MAGIC);
     let (w, h) = scene.size.unwrap_or((0, 0));
     // A particle set's falloff is in its primitive block, not its surface.
-    let surfaced = |m: &Mesh| {
-        let material = Material { falloff: Falloff::None, ..m.material.clone() };
-        !material.is_plain() || !m.normals.is_empty() || !m.uvs.is_empty()
-    };
+    let surfaced = |m: &Mesh| !m.material.is_plain_surface() || !m.normals.is_empty() || !m.uvs.is_empty();
     let newest = |m: &Mesh| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair;
     let version = if scene.meshes.iter().any(|m| newest(&m.mesh)) {
         VERSION
