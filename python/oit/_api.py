@@ -13,7 +13,21 @@ from typing import Any, TypedDict
 import numpy as np
 
 from . import _oit
-from ._checks import _I64_MAX, _U32_MAX, SHADINGS, _float_array, _instance_colors, _int, _number, _rows, _surface, _transforms, _vector
+from ._checks import (
+    _I64_MAX,
+    _U32_MAX,
+    SHADINGS,
+    _bool,
+    _colors,
+    _float_array,
+    _instance_colors,
+    _int,
+    _number,
+    _rows,
+    _surface,
+    _transforms,
+    _vector,
+)
 from ._load import read
 from ._memory import available_memory
 from ._primitives import PrimitiveMethods
@@ -69,13 +83,7 @@ class Scene(PrimitiveMethods):
                 bad = lo if lo < 0 else hi
                 raise ValueError(f"indices has an entry {bad}; indices must be in [0, {len(pos)})")
         idx = np.ascontiguousarray(idx, dtype=np.uint32)
-        col = _float_array(colors, "colors")
-        if col.shape == (4,):
-            col = col.reshape(1, 4)
-        elif col.ndim != 2 or col.shape[1] != 4:
-            raise ValueError(f"colors must have shape ({len(pos)}, 4) (one RGBA per vertex) or (4,), got {col.shape}")
-        if not isinstance(opaque, (bool, np.bool_)):
-            raise TypeError(f"opaque must be a bool, got {type(opaque).__name__}")
+        col, opaque = _colors(colors, len(pos), "vertex"), _bool(opaque, "opaque")
         surface = _surface(len(pos), normals, uvs, texture, shading, specular, shininess, opacity, two_sided,
                            cull_back_faces)
         if transform is not None:
@@ -83,7 +91,7 @@ class Scene(PrimitiveMethods):
                 raise ValueError(f"transform must have shape (4, 4), got {np.shape(transform)}: "
                                  "add_instances places a mesh more than once")
             surface["transform"] = _transforms(transform, "transform")[0]
-        return self._native.add_mesh(pos, idx, col, bool(opaque), **surface)
+        return self._native.add_mesh(pos, idx, col, opaque, **surface)
 
     def add_instances(self, mesh: int, transforms: Any, colors: Any = None) -> int:
         """Draws mesh `mesh` (the index add_mesh returned) once more under each of `transforms`

@@ -30,6 +30,24 @@ def _rows(a: np.ndarray, cols: int, name: str) -> np.ndarray:
     return a
 
 
+def _bool(value: Any, name: str) -> bool:
+    """A Python or numpy bool (not an int that happens to be 0 or 1)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be a bool, got {type(value).__name__}")
+    return bool(value)
+
+
+def _colors(colors: Any, n: int, what: str) -> np.ndarray:
+    """Straight RGBA as (n, 4) rows or one (4,) for all, as float32 (1, 4) or (n, 4); the
+    values are the core's to check."""
+    col = _float_array(colors, "colors")
+    if col.shape == (4,):
+        return col.reshape(1, 4)
+    if col.ndim != 2 or col.shape[1] != 4:
+        raise ValueError(f"colors must have shape ({n}, 4) (one RGBA per {what}) or (4,), got {col.shape}")
+    return col
+
+
 def _int(value: Any, name: str, what: str = "an int") -> int:
     """A Python or numpy integer (not a bool, not a float that happens to be whole)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
@@ -89,12 +107,8 @@ def _surface(n: int, normals: Any, uvs: Any, texture: Any, shading: str | None, 
     out["shading"] = shading
     for name, v in (("specular", specular), ("shininess", shininess), ("opacity", opacity)):
         out[name] = _number(v, name)
-    if not isinstance(two_sided, (bool, np.bool_)):
-        raise TypeError(f"two_sided must be a bool, got {type(two_sided).__name__}")
-    out["two_sided"] = bool(two_sided)
-    if not isinstance(cull_back_faces, (bool, np.bool_)):
-        raise TypeError(f"cull_back_faces must be a bool, got {type(cull_back_faces).__name__}")
-    out["cull_back_faces"] = bool(cull_back_faces)
+    out["two_sided"] = _bool(two_sided, "two_sided")
+    out["cull_back_faces"] = _bool(cull_back_faces, "cull_back_faces")
     return out
 
 

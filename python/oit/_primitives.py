@@ -8,16 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import _U32_MAX, _float_array, _rows
-
-
-def _colors(colors: Any, n: int, what: str) -> np.ndarray:
-    col = _float_array(colors, "colors")
-    if col.shape == (4,):
-        col = col.reshape(1, 4)
-    elif col.ndim != 2 or col.shape[1] != 4:
-        raise ValueError(f"colors must have shape ({n}, 4) (one RGBA per {what}) or (4,), got {col.shape}")
-    return col
+from ._checks import _U32_MAX, _bool, _colors, _float_array, _rows
 
 
 def _sizes(value: Any, name: str) -> np.ndarray:
@@ -25,12 +16,6 @@ def _sizes(value: Any, name: str) -> np.ndarray:
     if a.ndim > 1:
         raise ValueError(f"{name} must be a number or one per point (n,), got shape {a.shape}")
     return a.reshape(-1)
-
-
-def _opaque(opaque: Any) -> bool:
-    if not isinstance(opaque, (bool, np.bool_)):
-        raise TypeError(f"opaque must be a bool, got {type(opaque).__name__}")
-    return bool(opaque)
 
 
 class PrimitiveMethods:
@@ -63,7 +48,7 @@ class PrimitiveMethods:
                              "counts[i] is the number of points of strand i, at least 2")
         cnt = np.ascontiguousarray(cnt, dtype=np.uint32)
         return self._native.add_strands(pts, cnt, _sizes(width, "width"), _colors(colors, len(pts), "point"),
-                                        _opaque(opaque), shading=shading, specular=float(specular),
+                                        _bool(opaque, "opaque"), shading=shading, specular=float(specular),
                                         shininess=float(shininess), opacity=float(opacity))
 
     def add_particles(self, centers: Any, radius: Any, colors: Any, opaque: bool = False, *,
@@ -78,7 +63,7 @@ class PrimitiveMethods:
         """
         c = _rows(_float_array(centers, "centers"), 3, "centers")
         return self._native.add_particles(c, _sizes(radius, "radius"), _colors(colors, len(c), "particle"),
-                                          _opaque(opaque), falloff=falloff, opacity=float(opacity))
+                                          _bool(opaque, "opaque"), falloff=falloff, opacity=float(opacity))
 
     def primitives(self) -> list[str]:
         """What each mesh is: "triangles", "strands" or "particles"."""

@@ -246,16 +246,9 @@ def hair(strands: int = 6000, segments: int = 16, seed: int = 0, width: float = 
     colors[:, :3] *= np.tile(np.repeat(0.6 + 0.4 * t[0, :, 0], 2), strands)[:, None]  # darker at the root
     eye = np.array([0.0, 0.0, 2.6])
     key = np.array([-0.3, -0.6, -1.0])  # where the key light travels
-    tangent = np.repeat(d / (np.linalg.norm(d, axis=-1, keepdims=True) + 1e-12), 2, axis=1).reshape(-1, 3)
-    p = verts.reshape(-1, 3)
-    half_vector = -key / np.linalg.norm(key) + (eye - p) / np.linalg.norm(eye - p, axis=1, keepdims=True)
-    half_vector /= np.linalg.norm(half_vector, axis=1, keepdims=True)
-    normals = half_vector - np.sum(half_vector * tangent, 1, keepdims=True) * tangent
-    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
     camera = Camera.look_at(eye=tuple(eye), target=(0.0, -0.1, 0.0), fov_y=45.0, near=1.0, far=4.0)
-    mesh = _mesh(p, tris, colors.astype(np.float32), normals=normals.astype(np.float32), specular=0.3, shininess=48.0)
-    built = from_meshes([mesh], camera, (512, 512), {"strands": strands, "primitive": primitive},
-                        lights=[(tuple(key), (1.0, 0.95, 0.9), 0.8)], ambient=(0.35, 0.35, 0.35))
+    meta = {"strands": strands, "primitive": primitive}
+    lights, ambient = [(tuple(key), (1.0, 0.95, 0.9), 0.8)], (0.35, 0.35, 0.35)
     if primitive == "strands":
         # The ribbons' left corners carry each point's color; the width tapers as theirs.
         point_colors = colors.reshape(strands, -1, 2, 4)[:, :, 0].reshape(-1, 4).astype(np.float32)
@@ -263,8 +256,15 @@ def hair(strands: int = 6000, segments: int = 16, seed: int = 0, width: float = 
         set_ = MeshArrays(pts.reshape(-1, 3).astype(np.float32), np.zeros((0, 3), np.uint32), point_colors,
                           surface={"shading": "hair", "specular": 0.3, "shininess": 48.0},
                           primitive={"kind": "strands", "counts": np.full(strands, segments + 1), "widths": widths})
-        built = from_meshes([set_], camera, built.size, built.meta, built.lights, built.ambient)
-    return built
+        return from_meshes([set_], camera, (512, 512), meta, lights, ambient)
+    tangent = np.repeat(d / (np.linalg.norm(d, axis=-1, keepdims=True) + 1e-12), 2, axis=1).reshape(-1, 3)
+    p = verts.reshape(-1, 3)
+    half_vector = -key / np.linalg.norm(key) + (eye - p) / np.linalg.norm(eye - p, axis=1, keepdims=True)
+    half_vector /= np.linalg.norm(half_vector, axis=1, keepdims=True)
+    normals = half_vector - np.sum(half_vector * tangent, 1, keepdims=True) * tangent
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+    mesh = _mesh(p, tris, colors.astype(np.float32), normals=normals.astype(np.float32), specular=0.3, shininess=48.0)
+    return from_meshes([mesh], camera, (512, 512), meta, lights, ambient)
 
 
 def smoke(particles: int = 600, seed: int = 0, alpha: tuple[float, float] = (0.05, 0.25), segments: int = 10,
@@ -299,13 +299,12 @@ def smoke(particles: int = 600, seed: int = 0, alpha: tuple[float, float] = (0.0
     colors[:, :, :3] = np.clip(rgb, 0.0, 1.0)[:, None]
     colors[:, 0, 3] = a  # the rim keeps alpha 0: soft edges
     camera = Camera.look_at(eye=(0.0, 0.0, 3.0), target=(0.1, 0.0, 0.0), fov_y=45.0, near=1.0, far=5.0)
-    built = from_meshes([_mesh(verts.reshape(-1, 3), tris, colors.reshape(-1, 4))], camera, (512, 512),
-                        {"particles": particles, "primitive": primitive})
+    meta = {"particles": particles, "primitive": primitive}
     if primitive == "particles":
         set_ = MeshArrays(center.astype(np.float32), np.zeros((0, 3), np.uint32), colors[:, 0].astype(np.float32),
                           primitive={"kind": "particles", "radii": radius.astype(np.float32), "falloff": "linear"})
-        built = from_meshes([set_], camera, built.size, built.meta)
-    return built
+        return from_meshes([set_], camera, (512, 512), meta)
+    return from_meshes([_mesh(verts.reshape(-1, 3), tris, colors.reshape(-1, 4))], camera, (512, 512), meta)
 
 
 def foliage(leaves: int = 5000, seed: int = 0) -> BuiltScene:
