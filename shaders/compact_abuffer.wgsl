@@ -49,6 +49,7 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
             continue;
         }
 //!endif
+//!if !SETS_ONLY
         let v = indices[3u * t.t + k];
         s.clip[k] = clip_vertex(t, k);
         s.color[k] = placed_color(v, t.inst);
@@ -59,6 +60,7 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
             s.normal[k] = vec4<f32>(placed_normal(a.xyz, t.inst), a.w);
             s.uv[k] = attributes[2u * v + 1u].xy;
         }
+//!endif
     }
     shading[t.prim] = s;
 }

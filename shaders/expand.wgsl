@@ -1,40 +1,52 @@
 // Strands and particles facing the eye, once a frame before its geometry passes
-// (common/primitives.wgsl): one invocation a segment or particle of the chunk, for each
-// instance of its set, writes its corners into `expanded` (compiled with EXPANDING, which makes
-// it writable). A segment writes its first point's corners and tangent, and its strand's last
-// segment its second point's too, so each point is expanded once.
+// (common/primitives.wgsl), an entry point a kind: one invocation a segment or particle of the
+// chunk, for each instance of its set, writes its corners into `expanded` (compiled with
+// EXPANDING, which makes it writable). A segment writes its first point's corners and tangent,
+// and its strand's last segment its second point's too, so each point is expanded once.
 //!define EXPANDING 1
 //!define PRIMITIVES 1
 //!include common/scene.wgsl
 
-@compute @workgroup_size(64)
-fn cs_expand(@builtin(global_invocation_id) gid: vec3<u32>) {
+// The unit (segment or particle) of this invocation; OUTSIDE past the chunk's.
+fn unit_of(gid: vec3<u32>) -> u32 {
     let unit = gid.y * (65535u * 64u) + gid.x;
-    if chunk.triangles == 0u || unit >= chunk.triangles / 2u {
+    return select(OUTSIDE, unit, chunk.triangles != 0u && unit < chunk.triangles / 2u);
+}
+
+@compute @workgroup_size(64)
+fn cs_expand_strands(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let unit = unit_of(gid);
+    if unit == OUTSIDE {
         return;
     }
-    let count = chunk.drawn / chunk.triangles;
-    for (var k = 0u; k < count; k++) {
-        let ii = chunk.set_instance + k;
+    let word = indices[unit];
+    let i = word & POINT_MASK;
+    for (var ii = chunk.set_instance; ii < chunk.set_instance + chunk.drawn / chunk.triangles; ii++) {
         let base = expanded_base(ii);
-        if chunk.kind == PRIM_STRANDS {
-            let word = indices[unit];
-            let i = word & POINT_MASK;
-            let near = strand_point(word, false, ii);
-            expanded[base + 2u * i] = vec4<f32>(near[0], 1.0);
-            expanded[base + 2u * i + 1u] = vec4<f32>(near[1], 1.0);
-            expanded[base + 2u * chunk.set_points + i] = vec4<f32>(near[2], 0.0);
-            if (word & LAST_SEGMENT) != 0u {
-                let far = strand_point(word, true, ii);
-                expanded[base + 2u * i + 2u] = vec4<f32>(far[0], 1.0);
-                expanded[base + 2u * i + 3u] = vec4<f32>(far[1], 1.0);
-                expanded[base + 2u * chunk.set_points + i + 1u] = vec4<f32>(far[2], 0.0);
-            }
-        } else {
-            let c = particle_corners(unit, ii);
-            for (var j = 0u; j < 4u; j++) {
-                expanded[base + 4u * unit + j] = vec4<f32>(c[j], 1.0);
-            }
+        let near = strand_point(word, false, ii);
+        expanded[base + 2u * i] = vec4<f32>(near[0], 1.0);
+        expanded[base + 2u * i + 1u] = vec4<f32>(near[1], 1.0);
+        expanded[base + 2u * chunk.set_points + i] = vec4<f32>(near[2], 0.0);
+        if (word & LAST_SEGMENT) != 0u {
+            let far = strand_point(word, true, ii);
+            expanded[base + 2u * i + 2u] = vec4<f32>(far[0], 1.0);
+            expanded[base + 2u * i + 3u] = vec4<f32>(far[1], 1.0);
+            expanded[base + 2u * chunk.set_points + i + 1u] = vec4<f32>(far[2], 0.0);
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn cs_expand_particles(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let unit = unit_of(gid);
+    if unit == OUTSIDE {
+        return;
+    }
+    for (var ii = chunk.set_instance; ii < chunk.set_instance + chunk.drawn / chunk.triangles; ii++) {
+        let base = expanded_base(ii);
+        let c = particle_corners(unit, ii);
+        for (var j = 0u; j < 4u; j++) {
+            expanded[base + 4u * unit + j] = vec4<f32>(c[j], 1.0);
         }
     }
 }

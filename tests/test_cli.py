@@ -119,6 +119,15 @@ def test_every_subcommand_has_help(capsys):
     assert len(cli.SUBCOMMANDS) == len({name for name, *_ in cli.SUBCOMMANDS})
 
 
+@pytest.mark.parametrize("name", [name for name, *_ in cli.SUBCOMMANDS])
+def test_each_subcommand_prints_its_help(name, capsys):
+    # argparse formats every option's help only here (a stray % in one fails at --help alone).
+    with pytest.raises(SystemExit) as e:
+        cli.main([name, "--help"])
+    assert e.value.code == 0
+    assert f"python -m oit {name}" in capsys.readouterr().out
+
+
 def test_demo_result():
     # The demo's claims: abuffer matches the reference (lit, within docs/shading.md's bound),
     # hybrid is close to it, the blend methods visibly are not.

@@ -24,8 +24,9 @@ def bent_strand(alpha: float = 0.5) -> oit.Scene:
     return s
 
 
-def mixed(seed: int = 0, shading: str = "unlit") -> oit.Scene:
-    """Strands, particles of every falloff and two meshes, crossing in depth (world space)."""
+def mixed(seed: int = 0, shading: str = "unlit", meshes: bool = True) -> oit.Scene:
+    """Strands, particles of every falloff and two meshes (`meshes`), crossing in depth (world
+    space)."""
     rng = np.random.default_rng(seed)
     s = oit.Scene()
     t = np.linspace(0.0, 1.0, 9)
@@ -41,9 +42,11 @@ def mixed(seed: int = 0, shading: str = "unlit") -> oit.Scene:
     for falloff in ("hard", "linear", "gaussian"):
         s.add_particles(rng.uniform(-0.7, 0.7, (6, 3)), rng.uniform(0.1, 0.25, 6), rng.uniform(0.2, 0.9, (6, 4)),
                         falloff=falloff)
-    s.add_mesh(np.array([[-1, -1, -0.2], [1, -1, 0.3], [0, 1, 0.0]], np.float32), np.array([[0, 1, 2]]), [0.1, 0.8, 0.3, 0.45])
-    s.add_mesh(np.array([[-1, 1, -0.6], [1, 1, -0.6], [0, -1, -0.6]], np.float32), np.array([[0, 1, 2]]), [0.7, 0.2, 0.2, 1.0],
-               opaque=True)
+    if meshes:
+        s.add_mesh(np.array([[-1, -1, -0.2], [1, -1, 0.3], [0, 1, 0.0]], np.float32), np.array([[0, 1, 2]]),
+                   [0.1, 0.8, 0.3, 0.45])
+        s.add_mesh(np.array([[-1, 1, -0.6], [1, 1, -0.6], [0, -1, -0.6]], np.float32), np.array([[0, 1, 2]]),
+                   [0.7, 0.2, 0.2, 1.0], opaque=True)
     if shading != "unlit":
         s.add_light((-0.3, -0.5, -1.0), intensity=0.9)
         s.ambient = (0.15, 0.15, 0.15)
@@ -128,6 +131,17 @@ def test_chunks_and_tiles_change_nothing(renderer):
     tiled = oit.Renderer(48, 48, memory_budget=budget).render(scene, PERSPECTIVE, "abuffer")
     assert tiled.stats["tiles"] > 1
     np.testing.assert_array_equal(tiled.image, whole.image)
+
+
+@pytest.mark.parametrize("method", ["abuffer", "compact_abuffer", "unsorted"])
+def test_sets_alone_draw_as_they_do_beside_meshes(renderer, method):
+    # A scene of sets alone compiles without the mesh side (SETS_ONLY); the same sets beside a
+    # mesh that draws nothing (behind the eye) go through the other side: the same picture.
+    alone, beside = mixed(7, "hair", meshes=False), mixed(7, "hair", meshes=False)
+    beside.add_mesh(np.array([[0, 0, 5], [1, 0, 5], [0, 1, 5]], np.float32), np.array([[0, 1, 2]]), [1, 1, 1, 0.5])
+    a, b = (renderer(32, 32).render(s, PERSPECTIVE, method, census=True) for s in (alone, beside))
+    assert a.stats["fragments"] == b.stats["fragments"] > 0
+    np.testing.assert_array_equal(a.image, b.image)
 
 
 @pytest.mark.parametrize("method", [m["name"] for m in oit.methods()])
@@ -230,6 +244,18 @@ def test_hair_and_smoke_built_on_strands_and_particles_look_as_their_triangles(r
         assert fb.stats["scene_bytes"] < fa.stats["scene_bytes"], build.__name__
     with pytest.raises(ValueError, match="primitive must be one of"):
         oit.scenes.hair(strands=10, primitive="cards")
+
+
+def test_unlit_keeps_strand_and_particle_sets(renderer):
+    # scenes.unlit drops the surfaces, not the sets: unlit strands still draw their ribbons.
+    r = renderer(64, 64)
+    for built in (oit.scenes.hair(strands=40, primitive="strands"), oit.scenes.smoke(particles=60, primitive="particles")):
+        plain = oit.scenes.unlit(built)
+        assert plain.scene.primitives() == built.scene.primitives()
+        assert not oit.scenes.is_lit(plain)
+        lit, flat = (r.render(b.scene, b.camera, "abuffer") for b in (built, plain))
+        assert flat.stats["fragments"] == lit.stats["fragments"] > 0
+        assert against_reference(flat, plain.scene, plain.camera, 64) < TOL
 
 
 # ---- files

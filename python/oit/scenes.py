@@ -134,8 +134,11 @@ def is_lit(built: BuiltScene) -> bool:
 
 def unlit(built: BuiltScene) -> BuiltScene:
     """The same meshes with their vertex colors only, no lights: what the peers (pygfx, VTK)
-    draw, and an input whose colors do not vary inside a pixel beyond the vertex colors'."""
-    meshes = [MeshArrays(m.positions, m.indices, m.colors, m.opaque) for m in built.meshes]
+    draw, and an input whose colors do not vary inside a pixel beyond the vertex colors'.
+    Instances stay, and strand and particle sets stay sets (unlit; a particle's falloff, part
+    of its coverage, stays too)."""
+    meshes = [MeshArrays(m.positions, m.indices, m.colors, m.opaque, transforms=m.transforms,
+                         instance_colors=m.instance_colors, primitive=m.primitive) for m in built.meshes]
     return from_meshes(meshes, built.camera, built.size, dict(built.meta))
 
 

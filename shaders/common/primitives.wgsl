@@ -48,19 +48,30 @@ fn expanded_base(ii: u32) -> u32 {
 }
 
 // Corner `vi` of the chunk (corner vi % 3 of local triangle vi / 3) under instance `ii`.
+// Written without a branch on the chunk's kind, so that a strand corner does not also pay a
+// particle's loads where both sides of a branch run (llvmpipe runs a vertex shader's lanes
+// masked): one load of the position and one of the color, their indices chosen by the kind.
 fn corner_of(vi: u32, ii: u32) -> Corner {
     let unit = vi / 6u;
     let c = vi % 6u;
     let far = u32(c == 2u || c == 3u || c == 5u);
     let side = u32(c == 1u || c == 4u || c == 5u);
     let base = expanded_base(ii);
-    if chunk.kind == PRIM_STRANDS {
-        let i = (indices[unit] & POINT_MASK) + far;
-        let tangent = expanded[base + 2u * chunk.set_points + i].xyz;
-        return Corner(expanded[base + 2u * i + side].xyz, placed_color(i, ii), tangent, vec2<f32>(0.0));
+    let strands = chunk.kind == PRIM_STRANDS;
+    // A strand's corner: its point i's side; a particle's: its quad corner.
+    let i = select(unit, (indices[unit] & POINT_MASK) + far, strands);
+    let at = select(base + 4u * unit + 2u * far + side, base + 2u * i + side, strands);
+    var k: Corner;
+    k.world = expanded[at].xyz;
+    k.color = placed_color(i, ii);
+//!if SHADED
+    if strands {
+        k.tangent = expanded[base + 2u * chunk.set_points + i].xyz;
+    } else {
+        k.uv = vec2<f32>(f32(side) * 2.0 - 1.0, f32(far) * 2.0 - 1.0);
     }
-    let uv = vec2<f32>(f32(side) * 2.0 - 1.0, f32(far) * 2.0 - 1.0);
-    return Corner(expanded[base + 4u * unit + 2u * far + side].xyz, placed_color(unit, ii), vec3<f32>(0.0), uv);
+//!endif
+    return k;
 }
 
 // A ribbon corner at point `i` of segment word `word` (`far`: its second point): the point

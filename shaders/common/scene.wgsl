@@ -99,6 +99,10 @@ fn vs_main(
 //!if !INSTANCED
     let ii = 0u;
 //!endif
+//!if SETS_ONLY
+    // No triangle meshes in the scene: every chunk is a strand or particle set.
+    return expanded_vertex(vi, ii);
+//!else
 //!if PRIMITIVES
     if chunk.kind != PRIM_MESH {
         return expanded_vertex(vi, ii);
@@ -121,6 +125,7 @@ fn vs_main(
     }
 //!endif
     return out;
+//!endif
 }
 
 // Whether the triangle of vertex `vi` is counter-clockwise on screen (wgpu's front face), or

@@ -54,12 +54,16 @@ fn drawn_triangle(d: u32) -> Drawn {
 
 // Corner `corner` of a drawn triangle in clip space.
 fn clip_vertex(tri: Drawn, corner: u32) -> vec4<f32> {
+//!if SETS_ONLY
+    return frame.view_proj * vec4<f32>(corner_of(3u * tri.t + corner, tri.inst).world, 1.0);
+//!else
 //!if PRIMITIVES
     if chunk.kind != PRIM_MESH {
         return frame.view_proj * vec4<f32>(corner_of(3u * tri.t + corner, tri.inst).world, 1.0);
     }
 //!endif
     return frame.view_proj * placed(indices[3u * tri.t + corner], tri.inst);
+//!endif
 }
 
 // Inclusive pixel range [lo, hi] whose centers a triangle can cover, clamped to the tile; the

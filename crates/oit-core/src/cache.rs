@@ -284,7 +284,9 @@ pub const BLIT: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit", 
 pub const BLIT_SRGB: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit_srgb", &[Layout::Textures(&[0])]);
 pub const SCAN_BLOCKS: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_scan_blocks", &[Layout::Scan]);
 pub const SCAN_ADD: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_add_blocks", &[Layout::Scan]);
-/// Strands and particles facing the eye, before a frame's geometry passes (upload.rs).
-pub const EXPAND: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand", &[Layout::Expand]);
+/// Strands and particles facing the eye, before a frame's geometry passes (upload.rs), an
+/// entry point a kind.
+pub const EXPAND_STRANDS: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand_strands", &[Layout::Expand]);
+pub const EXPAND_PARTICLES: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand_particles", &[Layout::Expand]);
 pub const ENGINE_PIPELINES: &[PipelineSpec] =
-    &[OPAQUE, CENSUS_BLEND, CENSUS_ATOMIC, CENSUS_SAMPLES, BLIT, BLIT_SRGB, SCAN_BLOCKS, SCAN_ADD, EXPAND];
+    &[OPAQUE, CENSUS_BLEND, CENSUS_ATOMIC, CENSUS_SAMPLES, BLIT, BLIT_SRGB, SCAN_BLOCKS, SCAN_ADD, EXPAND_STRANDS, EXPAND_PARTICLES];

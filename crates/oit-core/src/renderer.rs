@@ -349,7 +349,7 @@ impl Renderer {
     }
 
     /// What `scene`'s passes compile for: its surfaces, its light count (the headlight when it
-    /// has none), the shading-cost knob and whether it has instances.
+    /// has none), the shading-cost knob, whether it has instances, strands or particles, and meshes.
     fn variant(&self, scene: &GpuScene) -> SceneVariant {
         SceneVariant {
             shaded: scene.shaded,
@@ -358,6 +358,7 @@ impl Renderer {
             shading_cost: self.shading_cost,
             instanced: scene.instanced,
             primitives: scene.primitives,
+            sets_only: scene.sets_only,
         }
     }
 }

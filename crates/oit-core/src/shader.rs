@@ -39,6 +39,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("SHADING_COST", 0),
     Const::U32("INSTANCED", 1),
     Const::U32("PRIMITIVES", 1),
+    Const::U32("SETS_ONLY", 0),
     // Whether `expanded` is writable: the expansion pass of strands and particles only.
     Const::U32("EXPANDING", 0),
 ];
@@ -47,7 +48,10 @@ pub const DEFAULT_CONSTS: &[Const] = &[
 /// common/scene.wgsl and common/shading.wgsl): whether any mesh has a surface (normals, UVs
 /// and the material as varyings), the light count, whether any mesh is textured, and the
 /// shading-cost knob's extra light evaluations, and whether any mesh is drawn other than once
-/// in place (instances: the transform, color factor and drawn index from the instance table).
+/// in place (instances: the transform, color factor and drawn index from the instance table),
+/// whether any set is strands or particles (common/primitives.wgsl), and whether every chunk is
+/// one (`sets_only`: no triangle meshes, so corners are pulled from the expansion alone and the
+/// mesh side of the vertex shader and triangle setup is not compiled).
 /// An unlit scene's pipelines carry the vertex color alone, as they did before shading existed,
 /// and a scene without instances no transform.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -58,10 +62,11 @@ pub struct SceneVariant {
     pub shading_cost: u32,
     pub instanced: bool,
     pub primitives: bool,
+    pub sets_only: bool,
 }
 
 impl SceneVariant {
-    pub fn consts(&self) -> [Const; 7] {
+    pub fn consts(&self) -> [Const; 8] {
         [
             Const::U32("SHADED", self.shaded as u32),
             Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
@@ -69,6 +74,7 @@ impl SceneVariant {
             Const::U32("SHADING_COST", self.shading_cost),
             Const::U32("INSTANCED", self.instanced as u32),
             Const::U32("PRIMITIVES", self.primitives as u32),
+            Const::U32("SETS_ONLY", (self.primitives && self.sets_only) as u32),
             // Only shaders/expand.wgsl writes the corners (its own //!define).
             Const::U32("EXPANDING", 0),
         ]
@@ -77,13 +83,14 @@ impl SceneVariant {
 
 /// Scene variants besides the defaults' that tests validate every shader in: unlit, lit
 /// without textures, the shading-cost knob on an unlit scene, an unlit instanced scene, and
-/// unlit strands or particles.
-pub const VALIDATION_VARIANTS: [SceneVariant; 5] = [
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false, primitives: false },
-    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0, instanced: false, primitives: false },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3, instanced: false, primitives: false },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: true, primitives: false },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false, primitives: true },
+/// unlit strands or particles beside meshes, and lit strands or particles alone.
+pub const VALIDATION_VARIANTS: [SceneVariant; 6] = [
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false, primitives: false, sets_only: false },
+    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0, instanced: false, primitives: false, sets_only: false },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3, instanced: false, primitives: false, sets_only: false },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: true, primitives: false, sets_only: false },
+    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false, primitives: true, sets_only: false },
+    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0, instanced: false, primitives: true, sets_only: true },
 ];
 
 /// `DEFAULT_CONSTS` with `variant`'s constants in place of the defaults of the same names.

@@ -38,6 +38,11 @@ impl PassTimer {
         Self { queries, labels: Vec::new(), period_ns: gpu.queue.get_timestamp_period() as f64 }
     }
 
+    /// Whether passes are timed (the adapter offers timestamp queries).
+    pub fn enabled(&self) -> bool {
+        self.queries.is_some()
+    }
+
     /// Forgets the passes recorded so far (a method that renders again starts over).
     pub fn reset(&mut self) {
         self.labels.clear();

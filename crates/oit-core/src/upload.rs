@@ -40,8 +40,9 @@ pub struct Chunk {
     /// Triangles drawn from it, instances included: what a compute pass over the drawn
     /// triangles dispatches (shaders/common/setup.wgsl).
     pub drawn: u32,
-    /// A strand or particle chunk's group 0 for the expansion pass (`Layout::Expand`).
-    pub expand: Option<wgpu::BindGroup>,
+    /// A strand or particle chunk's group 0 for the expansion pass (`Layout::Expand`), and
+    /// whether it holds strands (else particles: each kind has its own entry point).
+    pub expand: Option<(wgpu::BindGroup, bool)>,
 }
 
 /// The transparent or the opaque meshes, concatenated in submission order and split into
@@ -95,9 +96,10 @@ impl Geometry {
 
     /// Builds the corners of every strand and particle chunk under the frame uniform's camera
     /// (shaders/expand.wgsl), before the passes that draw them.
-    pub fn expand(&self, pass: &mut wgpu::ComputePass<'_>) {
+    pub fn expand(&self, pass: &mut wgpu::ComputePass<'_>, pipeline: impl Fn(bool) -> wgpu::ComputePipeline) {
         for c in &self.chunks {
-            if let Some(group) = &c.expand {
+            if let Some((group, strands)) = &c.expand {
+                pass.set_pipeline(&pipeline(*strands));
                 pass.set_bind_group(0, group, &[]);
                 let groups = (c.triangles / 2).div_ceil(64);
                 pass.dispatch_workgroups(groups.min(65_535), groups.div_ceil(65_535), 1);
@@ -132,8 +134,10 @@ pub struct GpuScene {
     pub instanced: bool,
     pub instances: u64,
     /// Whether any set is strands or particles, or any mesh shades as hair (the constant
-    /// PRIMITIVES, which compiles common/primitives.wgsl).
+    /// PRIMITIVES, which compiles common/primitives.wgsl), and whether there are no triangle
+    /// meshes at all, opaque or not (the constant SETS_ONLY).
     pub primitives: bool,
+    pub sets_only: bool,
 }
 
 /// Chunk contents on the host while they are gathered. A chunk of strands or particles
@@ -436,7 +440,7 @@ fn upload<'a>(
                 gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
             };
             let group = bind(shared.layout, label, None);
-            let expand = (corners > 0).then(|| bind(shared.expand_layout, "expand", Some(8)));
+            let expand = (corners > 0).then(|| (bind(shared.expand_layout, "expand", Some(8)), g.kind == PRIM_STRANDS));
             Chunk { group, triangles: g.triangles(), drawn: chunk_drawn[k], expand }
         })
         .collect();
@@ -544,7 +548,8 @@ impl GpuScene {
         }
         let textured = shaded && scene.meshes().iter().any(|m| m.material.texture.is_some());
         let primitives = scene.meshes().iter().any(|m| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair);
-        Ok(Self { transparent, opaque, shaded, textured, instanced, instances: scene.instance_count() as u64, primitives })
+        let sets_only = scene.meshes().iter().all(|m| m.primitive != Primitive::Triangles);
+        Ok(Self { transparent, opaque, shaded, textured, instanced, instances: scene.instance_count() as u64, primitives, sets_only })
     }
 }
 

@@ -84,7 +84,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="instead of the method sweep: the floor and the methods over it against pygfx on the same fixed "
                          "arrays, unlit and lit, as ratios to pygfx in this run, each against its target and against the "
                          f"baseline in {BASELINE.name} (floor.csv, floor.md); exits 1 when a ratio grew by more than "
-                         f"{GROWTH:.0%}")
+                         f"{GROWTH * 100:.0f}%%")
     ap.add_argument("--update-baseline", action="store_true",
                     help="--peers-floor: keep this run's ratios as the new baseline (after a change that is meant to cost "
                          "time); it is the package's file, so run from an editable install (scripts/dev-install.sh) "

@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::{Frame, Renderer, COVERAGE_SAMPLES};
 use crate::antialias;
 use crate::bindings::{COLOR_FORMAT, COUNT_FORMAT};
-use crate::cache::{Draw, Layout, CENSUS_ATOMIC, CENSUS_BLEND, CENSUS_SAMPLES, EXPAND, OPAQUE};
+use crate::cache::{Draw, Layout, CENSUS_ATOMIC, CENSUS_BLEND, CENSUS_SAMPLES, EXPAND_PARTICLES, EXPAND_STRANDS, OPAQUE};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::{FrameUniform, GpuLight};
@@ -45,8 +45,14 @@ enum CensusKind {
 /// vertex shader drops the back faces a material culls (common/scene.wgsl); instanced where the
 /// scene is.
 fn census_pipeline(gpu: &GpuContext, kind: CensusKind, scene: &GpuScene) -> wgpu::RenderPipeline {
-    let variant =
-        SceneVariant { shaded: scene.shaded, instanced: scene.instanced, primitives: scene.primitives, ..Default::default() }.consts();
+    let variant = SceneVariant {
+        shaded: scene.shaded,
+        instanced: scene.instanced,
+        primitives: scene.primitives,
+        sets_only: scene.sets_only,
+        ..Default::default()
+    }
+    .consts();
     let add = wgpu::BlendComponent {
         src_factor: wgpu::BlendFactor::One,
         dst_factor: wgpu::BlendFactor::One,
@@ -367,29 +373,38 @@ impl Renderer {
         })
     }
 
-    /// Writes the frame uniform for `camera` and the screen tile `tile`.
     /// Builds the strand and particle corners under `camera` (shaders/expand.wgsl), once a
     /// frame before any pass draws them; nothing where the scene has none.
-    /// Its GPU time is the frame's pass "expand".
+    /// Its time is the frame's pass "expand": the wall time of its submission, waited for, and
+    /// not timestamps, because on lavapipe a compute pass's timestamp queries make the draws
+    /// after it up to twice as slow (docs/results.md, "Strands against triangle ribbons").
     fn expand_primitives(&mut self, camera: &Camera, bg: [f32; 3]) -> Result<Option<Vec<(&'static str, f64)>>> {
         let (w, h) = (self.width, self.height);
         let Some((_, scene)) = self.scene.as_ref().filter(|(_, s)| s.primitives) else { return Ok(None) };
         self.set_uniform(camera, scene, bg, Tile::frame(w, h));
         let consts = self.variant(scene).consts();
-        let pipeline = self.gpu.cache.compute(&self.gpu.device, &EXPAND.compute_desc(&consts));
+        // Compiled for the kinds the scene has (the cache keeps them).
+        let pipeline = |strands: bool| {
+            let spec = if strands { &EXPAND_STRANDS } else { &EXPAND_PARTICLES };
+            self.gpu.cache.compute(&self.gpu.device, &spec.compute_desc(&consts))
+        };
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.timer.reset();
         {
-            let timestamp_writes = self.timer.compute_pass("expand");
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("expand"), timestamp_writes });
-            pass.set_pipeline(&pipeline);
-            scene.transparent.expand(&mut pass);
-            scene.opaque.expand(&mut pass);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("expand"), timestamp_writes: None });
+            scene.transparent.expand(&mut pass, pipeline);
+            scene.opaque.expand(&mut pass, pipeline);
         }
+        if !self.timer.enabled() {
+            self.gpu.queue.submit([enc.finish()]);
+            return Ok(None);
+        }
+        let start = Instant::now();
         self.gpu.queue.submit([enc.finish()]);
-        self.timer.read(&self.gpu)
+        self.gpu.wait()?;
+        Ok(Some(vec![("expand", start.elapsed().as_secs_f64() * 1e3)]))
     }
 
+    /// Writes the frame uniform for `camera` and the screen tile `tile`.
     pub(super) fn set_uniform(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3], tile: Tile) {
         let lighting = Lighting::new(&self.lights.0, self.lights.1, camera.view_direction());
         let mut lights = [GpuLight::default(); MAX_LIGHTS as usize];
