@@ -144,6 +144,29 @@ def test_sets_alone_draw_as_they_do_beside_meshes(renderer, method):
     np.testing.assert_array_equal(a.image, b.image)
 
 
+@pytest.mark.parametrize("method", ["abuffer", "hybrid", "hybrid64", "compact_abuffer"])
+def test_sets_in_any_order_give_the_same_bits(renderer, method):
+    # The smoke's particles and the hair's strands submitted in another order: the methods that
+    # promise order independence (test_stability.py for triangles) keep it for sets.
+    rng = np.random.default_rng(3)
+    hair, smoke = oit.scenes.hair(strands=120), oit.scenes.smoke(particles=150)
+    (h,), (p,) = hair.meshes, smoke.meshes
+    counts = h.primitive["counts"]
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    order = rng.permutation(len(counts))
+    points = np.concatenate([np.arange(starts[i], starts[i] + counts[i]) for i in order])
+    strands = oit.scenes.MeshArrays(h.positions[points], h.indices, h.colors[points], surface=h.surface,
+                                    primitive={**h.primitive, "counts": counts[order], "widths": h.primitive["widths"][points]})
+    q = rng.permutation(len(p.positions))
+    particles = oit.scenes.MeshArrays(p.positions[q], p.indices, p.colors[q],
+                                      primitive={**p.primitive, "radii": p.primitive["radii"][q]})
+    for (a, b), built in [((h, strands), hair), ((p, particles), smoke)]:
+        frames = [renderer(48, 48).render(oit.scenes.from_meshes([m], built.camera, lights=built.lights,
+                                                                   ambient=built.ambient).scene, built.camera, method)
+                  for m in (a, b)]
+        np.testing.assert_array_equal(frames[0].image, frames[1].image)
+
+
 @pytest.mark.parametrize("method", [m["name"] for m in oit.methods()])
 def test_every_method_renders_strands_and_particles(renderer, method):
     scene = mixed(5, "hair")
@@ -246,6 +269,19 @@ def test_hair_and_smoke_built_on_strands_and_particles_look_as_their_triangles(r
         oit.scenes.hair(strands=10, primitive="cards")
 
 
+def test_peers_get_triangles_that_look_as_the_sets(renderer):
+    # drawn_meshes() gives peers triangles: strand hair lit as the ribbons are (the highlight
+    # baked into the normals), smoke as fans whose rim carries the falloff.
+    r = renderer(64, 64)
+    for build, kinds in [(oit.scenes.hair, ("ribbons", "strands")), (oit.scenes.smoke, ("fans", "particles"))]:
+        a, b = (build(**({"strands": 400} if build is oit.scenes.hair else {"particles": 150}), primitive=k) for k in kinds)
+        peer = oit.scenes.from_meshes(b.drawn_meshes(), b.camera, b.size, lights=b.lights, ambient=b.ambient)
+        assert peer.scene.primitives() == ["triangles"] * len(peer.meshes)
+        assert all(m.surface.get("shading") != "hair" for m in peer.meshes)
+        fa, fb, fp = (r.render(x.scene, x.camera, "abuffer").image for x in (a, b, peer))
+        assert np.abs(fa - fp).mean() < 0.02 and np.abs(fb - fp).mean() < 0.02, build.__name__
+
+
 def test_unlit_keeps_strand_and_particle_sets(renderer):
     # scenes.unlit drops the surfaces, not the sets: unlit strands still draw their ribbons.
     r = renderer(64, 64)
@@ -323,9 +359,9 @@ def test_scene_files_carry_strands_and_particles(tmp_path, renderer):
     a = renderer(48, 48).render(original.scene, camera, "abuffer")
     b = renderer(48, 48).render(again, camera, "abuffer")
     np.testing.assert_array_equal(a.image, b.image)
-    # Peers get triangles: each segment and each particle two.
+    # Peers get triangles: each segment two, each particle a fan.
     drawn = original.drawn_meshes()
-    assert [len(m.indices) for m in drawn] == [original.scene.triangle_count - 80, 80]
+    assert [len(m.indices) for m in drawn] == [original.scene.triangle_count - 80, 40 * oit.scenes.PEER_FAN_SEGMENTS]
 
 
 def test_compare_and_render_take_strand_and_point_files(tmp_path):

@@ -35,10 +35,11 @@ def test_scene_renders_and_its_arrays_are_the_scene(frames, name):
     built, frame = frames[name]
     assert frame.image.shape == (SIZE, SIZE, 4) and np.isfinite(frame.image).all()
     assert frame.stats["fragments"] > 0
-    # The meshes as arrays are exactly what the scene holds, so a peer can draw the same input:
-    # uploaded once each, drawn once per instance.
-    assert sum(len(m.indices) for m in built.drawn_meshes()) == built.scene.triangle_count == built.meta["triangles"]
-    assert sum(len(m.indices) for m in built.meshes) == built.scene.unique_triangle_count
+    # The meshes as arrays are exactly what the scene holds (strand and particle sets as the
+    # triangles drawn of them under the camera): uploaded once each, drawn once per instance.
+    drawn = [p.triangles(built.camera) for m in built.meshes for p in m.placed()]
+    assert sum(len(m.indices) for m in drawn) == built.scene.triangle_count == built.meta["triangles"]
+    assert sum(len(m.triangles(built.camera).indices) for m in built.meshes) == built.scene.unique_triangle_count
     assert built.scene.mesh_count == len(built.meshes)
     assert built.scene.instance_count == len(built.drawn_meshes())
     for m in built.drawn_meshes():
@@ -58,10 +59,13 @@ def test_hair_has_hundreds_of_layers(frames):
 
 def test_smoke_is_many_soft_low_alpha_particles(frames):
     assert max_depth(frames, "smoke") >= 100
-    (mesh,) = frames["smoke"][0].meshes
-    fan = mesh.colors[:, 3].reshape(frames["smoke"][0].meta["particles"], -1)
-    assert (fan[:, 1:] == 0).all(), "alpha falls to 0 at the rim"
-    assert fan[:, 0].min() >= 0.05 and fan[:, 0].max() <= 0.25
+    (particles,) = frames["smoke"][0].meshes
+    assert particles.primitive["kind"] == "particles" and particles.primitive["falloff"] == "linear", \
+        "alpha falls linearly to 0 at the rim"
+    assert particles.colors[:, 3].min() >= 0.05 and particles.colors[:, 3].max() <= 0.25
+    (fans,) = scenes.smoke(primitive="fans").meshes
+    fan = fans.colors[:, 3].reshape(len(particles.positions), -1)
+    assert (fan[:, 1:] == 0).all() and (fan[:, 0] == particles.colors[:, 3]).all()
 
 
 def test_foliage_has_about_45_layers_of_mixed_alpha(frames):

@@ -38,8 +38,9 @@ def random_scene(seed: int, transparent: int) -> tuple[list[MeshData], oit.Camer
 
 
 def smoke(particles: int) -> tuple[list[MeshData], oit.Camera]:
-    """The built-in smoke, thinned: soft billboards whose rims have alpha 0."""
-    built = scene_lib.smoke(particles=particles)
+    """The built-in smoke as triangle fans, thinned: soft billboards whose rims have alpha 0
+    (test_primitives.py reorders particle sets)."""
+    built = scene_lib.smoke(particles=particles, primitive="fans")
     return [MeshData(m.positions, m.indices, m.colors, m.opaque) for m in built.meshes], built.camera
 
 

@@ -120,6 +120,10 @@ def test_every_method_at_256_squared_stays_within_4_mib(hair_scene):
     coverage and, for the exact methods, within float32 rounding of the untiled frame."""
     scene, camera = hair_scene
     budget = 4 * 2 ** 20
+    # Pixels whose center lies on a triangle's edge (the reference's ambiguous mask): moving the
+    # viewport's origin may give the edge to the neighbouring ribbon triangle there.
+    _, on_edge = oit.reference(scene, camera, 256, 256, return_mask=True)
+    assert on_edge.mean() < 0.1
     for name in METHODS:
         if name not in oit.Renderer(1, 1).adapter_info["methods"]:
             continue
@@ -130,7 +134,7 @@ def test_every_method_at_256_squared_stays_within_4_mib(hair_scene):
             assert np.array_equal(tiled.depth_complexity, untiled.depth_complexity), name
         if INFO[name]["error_bound"] == "exact":
             n = max(int(untiled.depth_complexity.max()), 1)
-            assert np.abs(tiled.image - untiled.image).max() <= (n + 2) * 2.0 ** -21, name
+            assert np.abs(tiled.image - untiled.image)[~on_edge].max() <= (n + 2) * 2.0 ** -21, name
 
 
 @pytest.mark.parametrize("name", ["abuffer", "hybrid"])

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +20,20 @@ from ._api import Camera, Scene
 
 __all__ = ["BuiltScene", "MeshArrays", "from_meshes", "is_lit", "unlit", "hair", "smoke", "foliage",
            "dragons", "glass", "stacks", "ALPHA_KINDS", "DRAGON_ALPHAS", "DRAGON_FILE", "shared_data_dir",
-           "default_dragon_path", "SCENES", "SHOWCASE"]
+           "default_dragon_path", "SCENES", "SHOWCASE", "PEER_FAN_SEGMENTS"]
+
+
+# The triangles of a particle's disc for peers (MeshArrays.peer_triangles).
+PEER_FAN_SEGMENTS = 10
+
+
+def _view_direction(camera: Camera) -> np.ndarray:
+    """Where `camera` looks at the center of the picture (unit, world space): the headlight
+    travels this way."""
+    inv = np.linalg.inv(np.asarray(camera.view_proj, np.float64))
+    near, far = (inv @ np.array([0.0, 0.0, z, 1.0]) for z in (0.0, 1.0))
+    d = far[:3] / far[3] - near[:3] / near[3]
+    return d / np.linalg.norm(d)
 
 
 @dataclass
@@ -55,7 +68,7 @@ class MeshArrays:
     def triangles(self, camera: Camera) -> MeshArrays:
         """A strand or particle set as the triangles it is drawn as under `camera`
         (`Scene.to_triangles`: strands keep their "hair" shading with the tangents as normals);
-        a triangle mesh as it is. For peers and files that take only triangles."""
+        a triangle mesh as it is. For files that take only triangles."""
         if self.primitive is None:
             return self
         scene = Scene()
@@ -65,6 +78,54 @@ class MeshArrays:
         if t["normals"] is not None:
             surface["normals"] = t["normals"]
         return MeshArrays(t["positions"], t["indices"], t["colors"], self.opaque, surface)
+
+    def peer_triangles(self, camera: Camera, lights: Sequence[tuple[Any, Any, float]] = ()) -> MeshArrays:
+        """What a peer that draws only Phong-lit or unlit triangles draws for this mesh or set
+        under `camera`: `triangles`, but "hair" strands lit as the ribbons of `hair(primitive=
+        "ribbons")` are (Kajiya-Kay's highlight baked into the normals for the first light, or
+        the headlight, and this eye) and particles as fans of PEER_FAN_SEGMENTS triangles
+        whose rim carries the falloff's value at the rim (exact for "hard", linear across the
+        disc for "linear", for "gaussian" a linear fan to exp(-4.5)). An approximation for
+        peers only: the engine draws the sets themselves."""
+        if self.primitive is None:
+            return self
+        if self.primitive["kind"] == "particles":
+            return self._peer_fans(camera)
+        t = self.triangles(camera)
+        if t.surface.get("shading") != "hair":
+            return t
+        # Towards the eye: the homogeneous eye is inv(view_proj) (0, 0, 1, 0); an orthographic
+        # camera's is at infinity, against the view direction.
+        eye = np.linalg.inv(np.asarray(camera.view_proj, np.float64)) @ np.array([0.0, 0.0, 1.0, 0.0])
+        p = t.positions.astype(np.float64)
+        view = eye[:3] / eye[3] - p if abs(eye[3]) > 1e-12 else np.broadcast_to(-_view_direction(camera), p.shape)
+        view = view / np.maximum(np.linalg.norm(view, axis=1, keepdims=True), 1e-30)
+        travel = np.asarray(lights[0][0], np.float64) if lights else _view_direction(camera)
+        half = -travel / np.linalg.norm(travel) + view
+        half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-30)
+        tangent = np.asarray(t.surface["normals"], np.float64)
+        normals = half - np.sum(half * tangent, 1, keepdims=True) * tangent
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        surface = {k: v for k, v in t.surface.items() if k != "shading"}
+        surface["normals"] = normals.astype(np.float32)
+        return replace(t, surface=surface)
+
+    def _peer_fans(self, camera: Camera) -> MeshArrays:
+        # Six corners a particle (primitive::CORNERS): (-1, -1), (1, -1), (-1, 1) first.
+        quads = self.triangles(camera).positions.astype(np.float64).reshape(-1, 6, 3)
+        right, up = (quads[:, 1] - quads[:, 0]) / 2, (quads[:, 2] - quads[:, 0]) / 2
+        center = quads[:, 0] + right + up
+        angle = 2 * np.pi * np.arange(PEER_FAN_SEGMENTS) / PEER_FAN_SEGMENTS
+        ring = center[:, None] + np.cos(angle)[None, :, None] * right[:, None] + np.sin(angle)[None, :, None] * up[:, None]
+        verts = np.concatenate([center[:, None], ring], 1)
+        rim = {"hard": 1.0, "linear": 0.0, "gaussian": float(np.exp(-4.5))}[self.primitive["falloff"]]
+        colors = np.repeat(np.asarray(self.colors, np.float32)[:, None], PEER_FAN_SEGMENTS + 1, axis=1)
+        colors[:, 1:, 3] *= rim
+        j = np.arange(PEER_FAN_SEGMENTS)
+        fan = np.stack([np.zeros_like(j), 1 + j, 1 + (j + 1) % PEER_FAN_SEGMENTS], 1)
+        tris = (np.arange(len(verts))[:, None, None] * (PEER_FAN_SEGMENTS + 1) + fan[None]).reshape(-1, 3)
+        return MeshArrays(verts.reshape(-1, 3).astype(np.float32), tris.astype(np.uint32), colors.reshape(-1, 4),
+                          self.opaque, dict(self.surface))
 
     def placed(self) -> list[MeshArrays]:
         """The mesh as drawn: one copy per instance, positions and normals carried by its
@@ -103,9 +164,10 @@ class BuiltScene:
         yield self.camera
 
     def drawn_meshes(self) -> list[MeshArrays]:
-        """Every mesh as drawn, each instance a copy (`MeshArrays.placed`), strand and particle
-        sets as their triangles under the scene's camera (`MeshArrays.triangles`)."""
-        return [p.triangles(self.camera) for m in self.meshes for p in m.placed()]
+        """Every mesh as a peer draws it, each instance a copy (`MeshArrays.placed`), strand and
+        particle sets as triangles under the scene's camera and lights
+        (`MeshArrays.peer_triangles`)."""
+        return [p.peer_triangles(self.camera, self.lights) for m in self.meshes for p in m.placed()]
 
 
 def from_meshes(meshes: Sequence[MeshArrays], camera: Camera, size: tuple[int, int] = (512, 512),
@@ -210,7 +272,7 @@ HAIR_PRIMITIVES = ("ribbons", "strands")
 
 
 def hair(strands: int = 6000, segments: int = 16, seed: int = 0, width: float = 0.01,
-         alpha: tuple[float, float] = (0.1, 0.4), primitive: str = "ribbons") -> BuiltScene:
+         alpha: tuple[float, float] = (0.1, 0.4), primitive: str = "strands") -> BuiltScene:
     """Procedural hair: strands grown from a scalp, falling under gravity and converging into
     a tail, alpha in `alpha`. The defaults give several hundred layers at the worst pixel at
     512 x 512; the papers' model has 15,000 strands. Strands vary in hue and darken at the root.
@@ -218,9 +280,10 @@ def hair(strands: int = 6000, segments: int = 16, seed: int = 0, width: float = 
     `primitive="ribbons"`: triangle ribbons facing the camera (+z), built here, lit with a hair
     highlight baked into the normals: each vertex's normal is the key light's half vector with
     the strand tangent T taken out, so Blinn-Phong's N.H is Kajiya-Kay's sin(T, H).
-    `primitive="strands"`: the same polylines as one strand set (`Scene.add_strands`), its
-    ribbons built on the GPU facing the eye and shaded "hair" (Kajiya-Kay from the tangent, for
-    any eye); `drawn_meshes()` gives its triangles under the camera, for peers."""
+    `primitive="strands"` (the default): the same polylines as one strand set
+    (`Scene.add_strands`), its ribbons built on the GPU facing the eye and shaded "hair"
+    (Kajiya-Kay from the tangent, for any eye); `drawn_meshes()` gives its triangles under the
+    camera lit as the ribbons are, for peers."""
     if primitive not in HAIR_PRIMITIVES:
         raise ValueError(f"primitive must be one of {HAIR_PRIMITIVES}, got {primitive!r}")
     rng = np.random.default_rng(seed)
@@ -271,16 +334,16 @@ def hair(strands: int = 6000, segments: int = 16, seed: int = 0, width: float = 
 
 
 def smoke(particles: int = 600, seed: int = 0, alpha: tuple[float, float] = (0.05, 0.25), segments: int = 10,
-          primitive: str = "fans") -> BuiltScene:
+          primitive: str = "particles") -> BuiltScene:
     """A smoke plume of soft particle billboards: each particle is a disc facing the camera,
     with its alpha in `alpha` at the center falling linearly to 0 at the rim. Particles rise
     from an emitter, widen and drift with height, glow orange near the source and turn gray
     above; they are submitted in random (spawn) order.
 
     `primitive="fans"`: each disc a fan of `segments` triangles facing +z, built here (its
-    alpha linear across each triangle). `primitive="particles"`: one particle set
+    alpha linear across each triangle). `primitive="particles"` (the default): one particle set
     (`Scene.add_particles`, falloff "linear"), true discs facing the eye built on the GPU;
-    `drawn_meshes()` gives its quads under the camera, for peers (without the falloff)."""
+    `drawn_meshes()` gives fans of those discs under the camera, for peers."""
     if primitive not in ("fans", "particles"):
         raise ValueError(f"primitive must be 'fans' or 'particles', got {primitive!r}")
     rng = np.random.default_rng(seed)

@@ -26,20 +26,22 @@ UPLOAD_SIZE = 16
 
 
 def _upload_ms(renderer: Renderer, build, repeat: int) -> float:
-    """What the first render of a freshly built copy of the scene costs over its second (the
-    pipelines warm, a frame of UPLOAD_SIZE pixels a side): the upload, median over `repeat`
-    copies, each paired with its own second render."""
+    """What the first render of a freshly built copy of the scene costs over a render of a scene
+    already uploaded (the pipelines warm, a frame of UPLOAD_SIZE pixels a side): the upload,
+    the median of `repeat` first renders less the median of `repeat` second renders (medians of
+    each, not of their differences, which the frame's own noise can make negative)."""
     warm = build()
     renderer.render(warm.scene, warm.camera, "unsorted")
-    extra = []
+    first, again = [], []
     for _ in range(repeat):
         copy = build()
         t0 = time.perf_counter()
         renderer.render(copy.scene, copy.camera, "unsorted")
         t1 = time.perf_counter()
         renderer.render(copy.scene, copy.camera, "unsorted")
-        extra.append((t1 - t0) * 1e3 - (time.perf_counter() - t1) * 1e3)
-    return statistics.median(extra)
+        first.append((t1 - t0) * 1e3)
+        again.append((time.perf_counter() - t1) * 1e3)
+    return statistics.median(first) - statistics.median(again)
 
 
 def _alternating(renderer: Renderer, built: dict, method: str, repeat: int) -> dict[str, tuple[float, float, dict]]:
