@@ -101,7 +101,7 @@ impl Geometry {
             if let Some((group, strands)) = &c.expand {
                 pass.set_pipeline(&pipeline(*strands));
                 pass.set_bind_group(0, group, &[]);
-                let groups = (c.triangles / 2).div_ceil(64);
+                let groups = (c.triangles / 2).div_ceil(256);
                 pass.dispatch_workgroups(groups.min(65_535), groups.div_ceil(65_535), 1);
             }
         }
