@@ -458,4 +458,6 @@ def test_cli_strands_writes_the_strand_table(tmp_path):
     assert [r["method"] for r in rows] == ["unsorted"]
     # Points and a word a segment against two shaded vertices a point and six indices a segment.
     assert float(rows[0]["bytes_x"]) > 3.0
+    # The moving camera builds the corners in its frames; the still one kept them.
+    assert float(rows[0]["moving_wall_ms"]) > 0 and "expand_ms" in rows[0]
     assert (tmp_path / "strands.md").read_text().count("| 300 | unsorted |") == 1

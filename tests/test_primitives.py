@@ -144,6 +144,24 @@ def test_sets_alone_draw_as_they_do_beside_meshes(renderer, method):
     np.testing.assert_array_equal(a.image, b.image)
 
 
+def test_corners_are_built_again_only_when_the_view_changes(renderer):
+    # The expansion runs when the camera (or the scene) changed since the corners were built,
+    # and its absence changes nothing: each frame equals a fresh renderer's.
+    scene = mixed(8, "hair")
+    other = oit.Camera.look_at(eye=(-1.5, 0.8, 3.5), target=(0.0, 0.0, 0.0), fov_y=45.0, near=1.0, far=10.0)
+    r = renderer(40, 40)
+    frames = [r.render(scene, cam, "abuffer") for cam in (PERSPECTIVE, PERSPECTIVE, other, PERSPECTIVE)]
+    expanded = ["expand" in f.stats["pass_times_ms"] for f in frames]
+    if frames[0].stats["pass_times_ms"]:  # the adapter times passes
+        assert expanded == [True, False, True, True]
+    for f, cam in zip(frames, (PERSPECTIVE, PERSPECTIVE, other, PERSPECTIVE)):
+        np.testing.assert_array_equal(f.image, renderer(40, 40).render(scene, cam, "abuffer").image)
+    assert not np.array_equal(frames[0].image, frames[2].image)
+    scene.add_particles(np.zeros((1, 3), np.float32), 0.3, [1.0, 0.0, 0.0, 0.5])  # a changed scene
+    moved = r.render(scene, PERSPECTIVE, "abuffer")
+    np.testing.assert_array_equal(moved.image, renderer(40, 40).render(scene, PERSPECTIVE, "abuffer").image)
+
+
 @pytest.mark.parametrize("method", ["abuffer", "hybrid", "hybrid64", "compact_abuffer"])
 def test_sets_in_any_order_give_the_same_bits(renderer, method):
     # The smoke's particles and the hair's strands submitted in another order: the methods that

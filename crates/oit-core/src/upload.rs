@@ -138,6 +138,9 @@ pub struct GpuScene {
     /// meshes at all, opaque or not (the constant SETS_ONLY).
     pub primitives: bool,
     pub sets_only: bool,
+    /// The matrices (`execute::expansion_view`) the corners in `expanded` were last built
+    /// under; None until the first expansion.
+    pub expanded_view: std::cell::Cell<Option<[u32; 32]>>,
 }
 
 /// Chunk contents on the host while they are gathered. A chunk of strands or particles
@@ -549,7 +552,8 @@ impl GpuScene {
         let textured = shaded && scene.meshes().iter().any(|m| m.material.texture.is_some());
         let primitives = scene.meshes().iter().any(|m| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair);
         let sets_only = scene.meshes().iter().all(|m| m.primitive != Primitive::Triangles);
-        Ok(Self { transparent, opaque, shaded, textured, instanced, instances: scene.instance_count() as u64, primitives, sets_only })
+        let instances = scene.instance_count() as u64;
+        Ok(Self { transparent, opaque, shaded, textured, instanced, instances, primitives, sets_only, expanded_view: Default::default() })
     }
 }
 

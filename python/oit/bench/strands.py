@@ -2,7 +2,9 @@
 points) against the same hair as triangle ribbons built on the CPU, at the same look
 (`oit.scenes.hair(primitive=...)`): the bytes each uploads (and the strands' GPU bytes with their
 corners), the time the upload takes, and the frame time of the floor and the methods over it,
-as ratios of strands to ribbons in one run, the two rendered in turn."""
+as ratios of strands to ribbons in one run, the two rendered in turn; and the strands under a
+camera that moves every frame, which builds their corners every frame (a still camera keeps
+them)."""
 
 from __future__ import annotations
 
@@ -11,8 +13,10 @@ import statistics
 import time
 from functools import partial
 
+import numpy as np
+
 from .. import scenes as scene_lib
-from .._api import Renderer
+from .._api import Camera, Renderer
 from .harness import QUICK_SIZE, Progress, Result, medians
 
 STRAND_METHODS = ("unsorted", "hybrid64", "hybrid", "abuffer")
@@ -20,7 +24,10 @@ STRAND_COUNTS = (6000, 15000)
 STRAND_COLUMNS = [("strands", "{}"), ("method", "{}"), ("ribbons_mib", "{:.2f}"), ("strands_mib", "{:.2f}"),
                   ("bytes_x", "{:.2f}"), ("strands_gpu_mib", "{:.2f}"), ("ribbons_upload_ms", "{:.1f}"),
                   ("strands_upload_ms", "{:.1f}"), ("ribbons_wall_ms", "{:.1f}"), ("strands_wall_ms", "{:.1f}"),
-                  ("wall_x", "{:.2f}"), ("ribbons_gpu_ms", "{:.1f}"), ("strands_gpu_ms", "{:.1f}"), ("gpu_x", "{:.2f}")]
+                  ("wall_x", "{:.2f}"), ("moving_wall_ms", "{:.1f}"), ("moving_x", "{:.2f}"), ("expand_ms", "{:.1f}"),
+                  ("ribbons_gpu_ms", "{:.1f}"), ("strands_gpu_ms", "{:.1f}"), ("gpu_x", "{:.2f}")]
+# How far the camera of the "moving" strands turns each frame.
+TURN_DEGREES = 0.5
 # Upload time is measured on frames this small, where the frame itself costs next to nothing.
 UPLOAD_SIZE = 16
 
@@ -44,17 +51,29 @@ def _upload_ms(renderer: Renderer, build, repeat: int) -> float:
     return statistics.median(first) - statistics.median(again)
 
 
+def _turned(camera: Camera, degrees: float = TURN_DEGREES) -> Camera:
+    """`camera` orbited by `degrees` about the world's y axis (the scene turned the other way)."""
+    a = math.radians(degrees)
+    turn = np.array([[math.cos(a), 0, math.sin(a), 0], [0, 1, 0, 0], [-math.sin(a), 0, math.cos(a), 0], [0, 0, 0, 1]])
+    return Camera(np.asarray(camera.view_proj, np.float64) @ turn)
+
+
 def _alternating(renderer: Renderer, built: dict, method: str, repeat: int) -> dict[str, tuple[float, float, dict]]:
     """Each primitive's median GPU and wall time of `method` and its last stats, the two scenes
-    rendered in turn (after a warm-up each), so that drift in the machine's speed falls on both."""
-    times: dict[str, tuple[list[float], list[float]]] = {p: ([], []) for p in built}
+    rendered in turn (after a warm-up each), so that drift in the machine's speed falls on both;
+    and "moving": the strands under a camera that turns TURN_DEGREES every frame, so that each
+    frame builds its corners again (a still camera keeps them; the CPU ribbons face one camera
+    whatever it does)."""
+    times: dict[str, tuple[list[float], list[float]]] = {p: ([], []) for p in (*built, "moving")}
     stats: dict[str, dict] = {}
     for b in built.values():
         renderer.render(b.scene, b.camera, method)
-    for _ in range(repeat):
-        for p, b in built.items():
+    cameras = (built["strands"].camera, _turned(built["strands"].camera))
+    for i in range(repeat):
+        turns = [(p, b.scene, b.camera) for p, b in built.items()] + [("moving", built["strands"].scene, cameras[i % 2])]
+        for p, scene, camera in turns:
             t0 = time.perf_counter()
-            frame = renderer.render(b.scene, b.camera, method)
+            frame = renderer.render(scene, camera, method)
             times[p][1].append((time.perf_counter() - t0) * 1e3)
             if frame.stats.get("gpu_time_ms") is not None:
                 times[p][0].append(frame.stats["gpu_time_ms"])
@@ -88,6 +107,9 @@ def strands_vs_ribbons(counts: tuple[int, ...] = STRAND_COUNTS, methods: tuple[s
             progress.show(f"hair {n} {m}")
             t = _alternating(renderer, built, m, repeat)
             row = {"strands": n, "method": m, "status": "ok", "message": "", "adapter": renderer.adapter_info["name"]}
+            gpu, wall, stats = t.pop("moving")
+            row.update({"moving_wall_ms": wall, "moving_x": wall / t["ribbons"][1],
+                        "expand_ms": stats["pass_times_ms"].get("expand", math.nan)})
             for p, (gpu, wall, stats) in t.items():
                 uploaded = stats["scene_bytes"] - stats["expanded_bytes"]
                 row.update({f"{p}_mib": uploaded / 2**20, f"{p}_upload_ms": upload[p], f"{p}_wall_ms": wall, f"{p}_gpu_ms": gpu})

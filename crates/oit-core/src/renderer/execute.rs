@@ -374,13 +374,21 @@ impl Renderer {
     }
 
     /// Builds the strand and particle corners under `camera` (shaders/expand.wgsl), once a
-    /// frame before any pass draws them; nothing where the scene has none.
+    /// frame before any pass draws them; nothing where the scene has none, or where the corners
+    /// in `expanded` were built for this scene under the same matrices (a still camera, or
+    /// another method of `oit compare` on the same view: no pass "expand" then).
     /// Its time is the frame's pass "expand": the wall time of its submission, waited for, and
     /// not timestamps, because on lavapipe a compute pass's timestamp queries make the draws
     /// after it up to twice as slow (docs/results.md, "Strands against triangle ribbons").
     fn expand_primitives(&mut self, camera: &Camera, bg: [f32; 3]) -> Result<Option<Vec<(&'static str, f64)>>> {
         let (w, h) = (self.width, self.height);
         let Some((_, scene)) = self.scene.as_ref().filter(|(_, s)| s.primitives) else { return Ok(None) };
+        // The corners depend on the uploaded scene and on the two matrices the uniform carries;
+        // a scene that changes is uploaded again (GpuScene::new, which forgets the view).
+        let view = expansion_view(camera);
+        if scene.expanded_view.get() == Some(view) {
+            return Ok(None);
+        }
         self.set_uniform(camera, scene, bg, Tile::frame(w, h));
         let consts = self.variant(scene).consts();
         // Compiled for the kinds the scene has (the cache keeps them).
@@ -394,6 +402,7 @@ impl Renderer {
             scene.transparent.expand(&mut pass, pipeline);
             scene.opaque.expand(&mut pass, pipeline);
         }
+        scene.expanded_view.set(Some(view));
         if !self.timer.enabled() {
             self.gpu.queue.submit([enc.finish()]);
             return Ok(None);
@@ -525,4 +534,16 @@ impl Renderer {
         }
         self.gpu.queue.submit([enc.finish()]);
     }
+}
+
+/// What the expansion reads of the camera, as the frame uniform carries it: the view-projection
+/// and its inverse, float32 bits (their equality is the corners').
+fn expansion_view(camera: &Camera) -> [u32; 32] {
+    let mut bits = [0u32; 32];
+    let a = camera.matrix_f32().to_cols_array();
+    let b = camera.view_proj.inverse().as_mat4().to_cols_array();
+    for (o, v) in bits.iter_mut().zip(a.iter().chain(&b)) {
+        *o = v.to_bits();
+    }
+    bits
 }
