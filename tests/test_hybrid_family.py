@@ -279,7 +279,9 @@ def test_compact_tail_keeps_eq_12s_words(renderer, k):
     built = stacks(layers=40, alphas="random", size=(8, 6), seed=2)
     frame = renderer(8, 6).render(built.scene, built.camera, "hybrid", k=k, tail="compact")
     assert frame.stats["memory_bytes"] == memory_bytes("hybrid", 8, 6, k=k, tail="compact") == 8 * 6 * (2 * k + 2) * 4 + 8
-    assert memory_bytes("hybrid", 8, 6, k=k) == 8 * 6 * (2 * k + 18) * 4 + 4
+    assert memory_bytes("hybrid", 8, 6, k=k) == 8 * 6 * (2 * k + 18) * 4 + 8
+    exact = renderer(8, 6).render(built.scene, built.camera, "hybrid", k=k, tail="exact")
+    assert exact.stats["memory_bytes"] == memory_bytes("hybrid", 8, 6, k=k)
 
 
 def test_compact_tail_depends_on_order_only_within_its_rounding(renderer):
