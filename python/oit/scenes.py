@@ -27,6 +27,23 @@ __all__ = ["BuiltScene", "MeshArrays", "from_meshes", "is_lit", "unlit", "hair",
 PEER_FAN_SEGMENTS = 10
 
 
+def _fan_indices(fans: int, segments: int) -> np.ndarray:
+    """Triangles of `fans` fans of `segments` each, a fan's centre first, then its ring
+    counter-clockwise: (fans * segments, 3)."""
+    j = np.arange(segments)
+    fan = np.stack([np.zeros(segments, int), 1 + j, 1 + (j + 1) % segments], 1)
+    return (np.arange(fans)[:, None, None] * (segments + 1) + fan[None]).reshape(-1, 3)
+
+
+def _highlight_normals(travel: np.ndarray, view: np.ndarray, tangent: np.ndarray) -> np.ndarray:
+    """Kajiya-Kay's highlight baked into normals: the half vector between the light (travelling
+    along `travel`) and `view` (unit, towards the eye), made perpendicular to the unit tangent."""
+    half = -travel / np.linalg.norm(travel) + view
+    half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-30)
+    normals = half - np.sum(half * tangent, 1, keepdims=True) * tangent
+    return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+
+
 def _view_direction(camera: Camera) -> np.ndarray:
     """Where `camera` looks at the center of the picture (unit, world space): the headlight
     travels this way."""
@@ -101,11 +118,7 @@ class MeshArrays:
         view = eye[:3] / eye[3] - p if abs(eye[3]) > 1e-12 else np.broadcast_to(-_view_direction(camera), p.shape)
         view = view / np.maximum(np.linalg.norm(view, axis=1, keepdims=True), 1e-30)
         travel = np.asarray(lights[0][0], np.float64) if lights else _view_direction(camera)
-        half = -travel / np.linalg.norm(travel) + view
-        half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-30)
-        tangent = np.asarray(t.surface["normals"], np.float64)
-        normals = half - np.sum(half * tangent, 1, keepdims=True) * tangent
-        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        normals = _highlight_normals(travel, view, np.asarray(t.surface["normals"], np.float64))
         surface = {k: v for k, v in t.surface.items() if k != "shading"}
         surface["normals"] = normals.astype(np.float32)
         return replace(t, surface=surface)
@@ -121,9 +134,7 @@ class MeshArrays:
         rim = {"hard": 1.0, "linear": 0.0, "gaussian": float(np.exp(-4.5))}[self.primitive["falloff"]]
         colors = np.repeat(np.asarray(self.colors, np.float32)[:, None], PEER_FAN_SEGMENTS + 1, axis=1)
         colors[:, 1:, 3] *= rim
-        j = np.arange(PEER_FAN_SEGMENTS)
-        fan = np.stack([np.zeros_like(j), 1 + j, 1 + (j + 1) % PEER_FAN_SEGMENTS], 1)
-        tris = (np.arange(len(verts))[:, None, None] * (PEER_FAN_SEGMENTS + 1) + fan[None]).reshape(-1, 3)
+        tris = _fan_indices(len(verts), PEER_FAN_SEGMENTS)
         return MeshArrays(verts.reshape(-1, 3).astype(np.float32), tris.astype(np.uint32), colors.reshape(-1, 4),
                           self.opaque, dict(self.surface))
 
@@ -325,10 +336,7 @@ def hair(strands: int = 6000, segments: int = 16, seed: int = 0, width: float = 
         return from_meshes([set_], camera, (512, 512), meta, lights, ambient)
     tangent = np.repeat(d / (np.linalg.norm(d, axis=-1, keepdims=True) + 1e-12), 2, axis=1).reshape(-1, 3)
     p = verts.reshape(-1, 3)
-    half_vector = -key / np.linalg.norm(key) + (eye - p) / np.linalg.norm(eye - p, axis=1, keepdims=True)
-    half_vector /= np.linalg.norm(half_vector, axis=1, keepdims=True)
-    normals = half_vector - np.sum(half_vector * tangent, 1, keepdims=True) * tangent
-    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+    normals = _highlight_normals(key, (eye - p) / np.linalg.norm(eye - p, axis=1, keepdims=True), tangent)
     mesh = _mesh(p, tris, colors.astype(np.float32), normals=normals.astype(np.float32), specular=0.3, shininess=48.0)
     return from_meshes([mesh], camera, (512, 512), meta, lights, ambient)
 
@@ -355,9 +363,7 @@ def smoke(particles: int = 600, seed: int = 0, alpha: tuple[float, float] = (0.0
     angle = 2 * np.pi * np.arange(segments) / segments + rng.uniform(0, 2 * np.pi, (particles, 1))
     ring = np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], -1) * radius[:, None, None]
     verts = np.concatenate([center[:, None], center[:, None] + ring], 1)  # (particles, 1 + segments, 3)
-    j = np.arange(segments)
-    fan = np.stack([np.zeros(segments, int), 1 + j, 1 + (j + 1) % segments], 1)  # counter-clockwise seen from +z
-    tris = (np.arange(particles)[:, None, None] * (segments + 1) + fan[None]).reshape(-1, 3)
+    tris = _fan_indices(particles, segments)  # counter-clockwise seen from +z
     t = np.clip(h * 1.6, 0.0, 1.0)[:, None]
     rgb = ((1 - t) * np.array([1.0, 0.42, 0.08]) + t * np.array([0.3, 0.3, 0.33])) * rng.uniform(0.75, 1.1, (particles, 1))
     a = rng.uniform(alpha[0], alpha[1], particles)
