@@ -89,6 +89,19 @@ def test_orthographic_camera_in_pixel_units(renderer):
     assert np.abs(frame.image - ref).max() <= 1e-7
 
 
+@pytest.mark.parametrize("camera", [
+    oit.Camera.look_at((1.0, 2.0, 3.0), (0.0, 0.5, -1.0)),
+    oit.Camera.orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0, eye=(2.0, 0.0, 0.0), target=(0.0, 0.0, 0.0)),
+])
+def test_a_cameras_view_direction_is_its_middle_ray(camera):
+    # From the near plane's center to the far plane's, in float64 with numpy.
+    inv = np.linalg.inv(camera.view_proj)
+    near, far = (inv @ np.array([0.0, 0.0, z, 1.0]) for z in (0.0, 1.0))
+    ray = far[:3] / far[3] - near[:3] / near[3]
+    np.testing.assert_allclose(camera.view_direction, ray / np.linalg.norm(ray), rtol=0, atol=1e-12)
+    assert camera.view_direction.dtype == np.float64 and camera.view_direction.shape == (3,)
+
+
 def test_method_table():
     table = {m["name"]: m for m in oit.methods()}
     assert set(METHODS) <= set(table)

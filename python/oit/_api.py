@@ -283,6 +283,12 @@ class Camera:
     def __repr__(self) -> str:
         return f"Camera(view_proj={self.view_proj.tolist()})"
 
+    @property
+    def view_direction(self) -> np.ndarray:
+        """The unit world-space direction the camera looks along at the center of the picture
+        (from the near plane to the far one): the way the headlight travels."""
+        return np.array(_oit.view_direction(self.view_proj), np.float64)
+
     @staticmethod
     def _view(eye: Sequence[float], target: Sequence[float], up: Sequence[float]) -> np.ndarray:
         eye, target, up = (np.asarray(v, dtype=np.float64) for v in (eye, target, up))

@@ -232,6 +232,9 @@ def stats_schema() -> list[tuple[str, str, str]]:
 def constants() -> dict[str, Any]:
     """The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs)."""
 
+def view_direction(view_proj: npt.NDArray[np.float64]) -> tuple[float, float, float]:
+    """The unit world-space direction the camera looks along at the picture's center."""
+
 def reference(
     scene: Scene,
     view_proj: npt.NDArray[np.float64],

@@ -44,15 +44,6 @@ def _highlight_normals(travel: np.ndarray, view: np.ndarray, tangent: np.ndarray
     return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
 
 
-def _view_direction(camera: Camera) -> np.ndarray:
-    """Where `camera` looks at the center of the picture (unit, world space): the headlight
-    travels this way."""
-    inv = np.linalg.inv(np.asarray(camera.view_proj, np.float64))
-    near, far = (inv @ np.array([0.0, 0.0, z, 1.0]) for z in (0.0, 1.0))
-    d = far[:3] / far[3] - near[:3] / near[3]
-    return d / np.linalg.norm(d)
-
-
 @dataclass
 class MeshArrays:
     """One mesh as `Scene.add_mesh` takes it; colors are per vertex, straight linear RGBA."""
@@ -115,9 +106,9 @@ class MeshArrays:
         # camera's is at infinity, against the view direction.
         eye = np.linalg.inv(np.asarray(camera.view_proj, np.float64)) @ np.array([0.0, 0.0, 1.0, 0.0])
         p = t.positions.astype(np.float64)
-        view = eye[:3] / eye[3] - p if abs(eye[3]) > 1e-12 else np.broadcast_to(-_view_direction(camera), p.shape)
+        view = eye[:3] / eye[3] - p if abs(eye[3]) > 1e-12 else np.broadcast_to(-camera.view_direction, p.shape)
         view = view / np.maximum(np.linalg.norm(view, axis=1, keepdims=True), 1e-30)
-        travel = np.asarray(lights[0][0], np.float64) if lights else _view_direction(camera)
+        travel = np.asarray(lights[0][0], np.float64) if lights else camera.view_direction
         normals = _highlight_normals(travel, view, np.asarray(t.surface["normals"], np.float64))
         surface = {k: v for k, v in t.surface.items() if k != "shading"}
         surface["normals"] = normals.astype(np.float32)

@@ -588,12 +588,21 @@ fn reference<'py>(
     Ok((image, amb, dc).into_pyobject(py)?.into_any())
 }
 
+/// The unit world-space direction camera `view_proj` looks along at the picture's center (the
+/// core's `Camera::view_direction`: the headlight and the strands' ribbons use the same).
+#[pyfunction]
+fn view_direction(view_proj: PyReadonlyArray2<'_, f64>) -> PyResult<(f64, f64, f64)> {
+    let camera = oit_core::Camera::from_rows(matrix(&view_proj, "camera matrix")?).map_err(Error::from)?;
+    Ok(camera.view_direction().into())
+}
+
 #[pymodule]
 fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<Renderer>()?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(reference, m)?)?;
+    m.add_function(wrap_pyfunction!(view_direction, m)?)?;
     m.add_function(wrap_pyfunction!(memory_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(constants, m)?)?;
     m.add_function(wrap_pyfunction!(stats_schema, m)?)?;
