@@ -13,7 +13,29 @@
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
+fn node_word(px: u32, i: u32) -> u32 {
+    return 2u * (px * NODES + i);
+}
+
 // Node i of pixel px: its depth's bits at nodes[2 (px NODES + i)], its transmittance's next.
+// The insert pass reads and writes them with atomics, inside the pixel's critical section; the
+// passes after it (READ_NODES: fs_shade, fs_resolve) only read what the insert pass left, which
+// the barrier between passes makes visible, with plain loads (on llvmpipe an atomic load is a
+// scalar operation a lane, a plain one a gather for the whole SIMD group).
+//!if READ_NODES
+@group(2) @binding(0) var<storage, read_write> nodes: array<vec2<u32>>;
+// locks[px]: bits 1.. count pixel px's nodes (common/pixel_lock.wgsl).
+@group(2) @binding(1) var<storage, read_write> locks: array<u32>;
+
+fn entries(px: u32) -> u32 {
+    return locks[px] >> 1u;
+}
+
+// Node i of pixel px as (depth, transmittance), one load.
+fn node(px: u32, i: u32) -> vec2<f32> {
+    return bitcast<vec2<f32>>(nodes[px * NODES + i]);
+}
+//!else
 @group(2) @binding(0) var<storage, read_write> nodes: array<atomic<u32>>;
 
 struct Incoming {
@@ -22,18 +44,16 @@ struct Incoming {
 }
 //!include common/pixel_lock.wgsl
 
-@group(3) @binding(0) var accum_tex: texture_2d<f32>;
-
-fn node_word(px: u32, i: u32) -> u32 {
-    return 2u * (px * NODES + i);
-}
-
 fn node_depth(px: u32, i: u32) -> f32 {
     return bitcast<f32>(atomicLoad(&nodes[node_word(px, i)]));
 }
 
 fn node_trans(px: u32, i: u32) -> f32 {
     return bitcast<f32>(atomicLoad(&nodes[node_word(px, i) + 1u]));
+}
+
+fn node(px: u32, i: u32) -> vec2<f32> {
+    return vec2<f32>(node_depth(px, i), node_trans(px, i));
 }
 
 // The update indexes its arrays only by loop counters with constant bounds, which the
@@ -108,16 +128,22 @@ fn fs_insert(raw: VsOut) {
     }
     with_pixel_lock(pixel_index(in.clip), Incoming(in.clip.z, in.color.a));
 }
+//!endif
 
-// Transmittance in front of depth z: the last step strictly nearer than z (the steps are
-// sorted by depth).
+@group(3) @binding(0) var accum_tex: texture_2d<f32>;
+
+// Transmittance in front of depth z: the last step strictly nearer than z. The steps are
+// sorted by depth, so those nearer than z are a prefix and the walk stops at the first that is
+// not: a fragment loads the nodes in front of it and one more, not the pixel's every node.
 fn vis(px: u32, z: f32) -> f32 {
-    let count = entries(px);
+    let count = min(entries(px), NODES);
     var t = 1.0;
-    for (var i = 0u; i < NODES; i++) {
-        if i < count && node_depth(px, i) < z {
-            t = node_trans(px, i);
+    for (var i = 0u; i < count; i++) {
+        let n = node(px, i);
+        if n.x >= z {
+            break;
         }
+        t = n.y;
     }
     return t;
 }
@@ -139,7 +165,7 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let count = entries(px);
     var t = 1.0;
     if count > 0u {
-        t = node_trans(px, count - 1u);
+        t = node(px, count - 1u).y;
     }
     let c = textureLoad(accum_tex, vec2<i32>(pos.xy), 0).rgb;
     return vec4<f32>(c + t * base.rgb, 1.0 - t * (1.0 - base.a));

@@ -27,6 +27,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("WEIGHT", 10),
     Const::U32("NODES", 8),
     Const::U32("NODES_PLUS_ONE", 9),
+    Const::U32("READ_NODES", 0),
     Const::U32("DUAL", 1),
     Const::U32("SAMPLES", 8),
     Const::U32("LAYERS", 4),

@@ -118,10 +118,12 @@ impl Method for Locked {
         let name = if self.kind == Kind::Adaptive { "adaptive" } else { "mlab" };
         cx.check_per_pixel(&format!("{name} with {param} = {n}"), entry_bytes * n as u64)?;
         let pixels = cx.pixels();
+        // READ_NODES: adaptive's passes after the insert read the nodes with plain loads.
         let consts = match self.kind {
-            Kind::Adaptive => [Const::U32("NODES", n), Const::U32("NODES_PLUS_ONE", n + 1)],
-            Kind::Mlab => [Const::U32("LAYERS", n), Const::U32("LAYERS_PLUS_ONE", n + 1)],
+            Kind::Adaptive => [Const::U32("NODES", n), Const::U32("NODES_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)],
+            Kind::Mlab => [Const::U32("LAYERS", n), Const::U32("LAYERS_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)],
         };
+        let read = [consts[0], consts[1], Const::U32("READ_NODES", 1)];
         let sizes =
             [("locked entries", pixels * entry_bytes * n as u64), ("pixel locks", pixels * LOCK_BYTES), ("lock counts", LOCK_STATS_BYTES)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[]);
@@ -135,9 +137,9 @@ impl Method for Locked {
                 cx.capture(&mut enc, "insert", &cx.capture_pipeline(spec(pipelines, "fs_insert"), &consts), &b.group);
                 let sums = FloatTargets::ensure(&mut self.sums, cx, &[ACCUM_FORMAT], SUMS);
                 let target = blended(ACCUM_FORMAT, ADD);
-                let shade = cx.draw_pipeline(spec(pipelines, "fs_shade"), &consts, vec![target], crate::pipeline::depth_test_only());
+                let shade = cx.draw_pipeline(spec(pipelines, "fs_shade"), &read, vec![target], crate::pipeline::depth_test_only());
                 cx.capture_into(&mut enc, "shade", &shade, &b.group, &sums.attachments(&[wgpu::Color::TRANSPARENT]));
-                let resolve = cx.resolve_pipeline(spec(pipelines, "fs_resolve"), &consts, false);
+                let resolve = cx.resolve_pipeline(spec(pipelines, "fs_resolve"), &read, false);
                 cx.resolve_groups(&mut enc, "composite", &resolve, &[&b.group, &sums.group], false);
                 adaptive_bytes(pixels, n as u64)
             }
