@@ -20,8 +20,8 @@ fn node_word(px: u32, i: u32) -> u32 {
 // Node i of pixel px: its depth's bits at nodes[2 (px NODES + i)], its transmittance's next.
 // The insert pass reads and writes them with atomics, inside the pixel's critical section; the
 // passes after it (READ_NODES: fs_shade, fs_resolve) only read what the insert pass left, which
-// the barrier between passes makes visible, with plain loads (on llvmpipe an atomic load is a
-// scalar operation a lane, a plain one a gather for the whole SIMD group).
+// the barrier between passes makes visible, and so load a node's two words at once, as one
+// plain 8-byte load (docs/results.md: two 4-byte loads, atomic or not, cost the same).
 //!if READ_NODES
 @group(2) @binding(0) var<storage, read_write> nodes: array<vec2<u32>>;
 // locks[px]: bits 1.. count pixel px's nodes (common/pixel_lock.wgsl).

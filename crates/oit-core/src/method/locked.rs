@@ -118,12 +118,10 @@ impl Method for Locked {
         let name = if self.kind == Kind::Adaptive { "adaptive" } else { "mlab" };
         cx.check_per_pixel(&format!("{name} with {param} = {n}"), entry_bytes * n as u64)?;
         let pixels = cx.pixels();
-        // READ_NODES: adaptive's passes after the insert read the nodes with plain loads.
         let consts = match self.kind {
-            Kind::Adaptive => [Const::U32("NODES", n), Const::U32("NODES_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)],
-            Kind::Mlab => [Const::U32("LAYERS", n), Const::U32("LAYERS_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)],
+            Kind::Adaptive => vec![Const::U32("NODES", n), Const::U32("NODES_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)],
+            Kind::Mlab => vec![Const::U32("LAYERS", n), Const::U32("LAYERS_PLUS_ONE", n + 1)],
         };
-        let read = [consts[0], consts[1], Const::U32("READ_NODES", 1)];
         let sizes =
             [("locked entries", pixels * entry_bytes * n as u64), ("pixel locks", pixels * LOCK_BYTES), ("lock counts", LOCK_STATS_BYTES)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[]);
@@ -134,6 +132,8 @@ impl Method for Locked {
         let memory = match self.kind {
             Kind::Adaptive => {
                 let pipelines = ADAPTIVE_PIPELINES;
+                // The passes after the insert only read the nodes (READ_NODES: plain loads).
+                let read = [consts[0], consts[1], Const::U32("READ_NODES", 1)];
                 cx.capture(&mut enc, "insert", &cx.capture_pipeline(spec(pipelines, "fs_insert"), &consts), &b.group);
                 let sums = FloatTargets::ensure(&mut self.sums, cx, &[ACCUM_FORMAT], SUMS);
                 let target = blended(ACCUM_FORMAT, ADD);
