@@ -20,16 +20,15 @@
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
-// Per-pixel accumulator words (mirrors oit_core::method::hybrid::ACCUM_WORDS).
+// Per-pixel accumulator words (mirrors oit_core::method::hybrid::ACCUM_WORDS); the tail's count
+// and sums are in their own words (common/tail_words.wgsl, binding 4).
 const CORE_R: u32 = 0u;      // 3 words: core color, fixed point
-const TAIL_R: u32 = 3u;      // 8 words: tail C * alpha (rgb) and alpha, (lo, hi) pairs
-const TAIL_COUNT: u32 = 11u; // tail fragment count
-const T_CORE: u32 = 12u;     // transmittance behind the core (f32 bits)
-const EVICTED: u32 = 13u;    // nearest key pushed out of the full k-TAB (0: none)
-const QUANT_W: u32 = 14u;    // sum over core fragments of |alpha - q| * T' (fixed point)
-const QUANT_D: u32 = 15u;    // sum over core fragments of |alpha - q| (fixed point)
-const TAIL_LO: u32 = 16u;    // smallest tail color channel (f32 bits, inverted: 0 = none)
-const TAIL_HI: u32 = 17u;    // largest tail color channel (f32 bits)
+const T_CORE: u32 = 3u;      // transmittance behind the core (f32 bits)
+const EVICTED: u32 = 4u;     // nearest key pushed out of the full k-TAB (0: none)
+const QUANT_W: u32 = 5u;     // sum over core fragments of |alpha - q| * T' (fixed point)
+const QUANT_D: u32 = 6u;     // sum over core fragments of |alpha - q| (fixed point)
+const TAIL_LO: u32 = 7u;     // smallest tail color channel (f32 bits, inverted: 0 = none)
+const TAIL_HI: u32 = 8u;     // largest tail color channel (f32 bits)
 const ACCUM_WORDS: u32 = HYBRID_ACCUM_WORDS;
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
@@ -58,7 +57,14 @@ fn vis_store(i: u32, v: f32) {
 //!endif
 // The accumulators; with COMPACT, the census counts, a fragment count a pixel.
 @group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
-@group(2) @binding(4) var<storage, read_write> overflow: atomic<u32>;
+// The tail's count and sums (common/tail_words.wgsl); with COMPACT the slot-offset placeholder
+// (never accessed; TAIL64 is then 0, so that its 4 bytes fit).
+//!if TAIL64
+@group(2) @binding(4) var<storage, read_write> tail_words: array<atomic<u64>>;
+//!else
+@group(2) @binding(4) var<storage, read_write> tail_words: array<atomic<u32>>;
+//!endif
+@group(2) @binding(5) var<storage, read_write> overflow: atomic<u32>;
 // With PER_PIXEL, pixel px owns slots offsets[px] .. offsets[px + 1] (a prefix sum of each
 // pixel's own k, chosen by auto); otherwise K slots a pixel and this binding is unused.
 @group(2) @binding(3) var<storage, read_write> offsets: array<u32>;
@@ -72,6 +78,7 @@ fn slots(px: u32) -> vec2<u32> {
     return vec2<u32>(px * K, K);
 }
 //!include common/fixed.wgsl
+//!include common/tail_words.wgsl
 //!include common/alpha8.wgsl
 
 // The transmittance in front of core slot i of the pixel whose slots start at `base`; with
@@ -122,14 +129,16 @@ fn fs_store(raw: VsOut) {
     let base = sl.x;
     var v = pack_key(in.clip.z, in.color.a);
     if sl.y == 0u {
-        raise_evicted(px, v);
-        return;
+        return; // no slots: everything is tail, and core_bound needs no evicted key
     }
     // Slots only ever grow (atomicMax), so a key not above a full table's last one now will
-    // not be in the final table: record it as evicted without walking the table.
+    // not be in the final table. The evicted key only matters where it equals the final last
+    // slot's (core_bound's split tie), and a key below the last slot now is below it then.
     let last = atomicLoad(&ktab[base + sl.y - 1u]);
     if last != 0u && v <= last {
-        raise_evicted(px, v);
+        if v == last {
+            raise_evicted(px, v);
+        }
         return;
     }
     for (var i = 0u; i < sl.y; i++) {
@@ -254,14 +263,11 @@ fn fs_shade(raw: VsOut) {
         add_fixed32(acc + CORE_R + 2u, in.color.b * p.w);
         return;
     }
-    atomicAdd(&accum[acc + TAIL_COUNT], 1u);
+    add_tail(px, in.color.rgb, in.color.a, TAIL != 0u);
     // The range of the tail's colors bounds what the estimate behind the core can be off by.
     let c = clamp(in.color.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
     atomicMax(&accum[acc + TAIL_LO], ~bitcast<u32>(min(c.r, min(c.g, c.b))));
     atomicMax(&accum[acc + TAIL_HI], bitcast<u32>(max(c.r, max(c.g, c.b))));
-    if TAIL != 0u {
-        add_tail_sums(acc + TAIL_R, in.color.rgb, in.color.a);
-    }
 }
 
 // The same sums by fixed-function blending (oit_core::method::ktab::blend_targets): added
@@ -315,16 +321,21 @@ fn finish(pos: vec4<f32>, core: vec3<f32>, t_core: f32, count: u32, tail: Tail, 
 
 @fragment
 fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
-    let acc = pixel_index(pos) * ACCUM_WORDS;
+    let px = pixel_index(pos);
+    let acc = px * ACCUM_WORDS;
     let core = vec3<f32>(read_fixed32(word(acc + CORE_R)), read_fixed32(word(acc + CORE_R + 1u)), read_fixed32(word(acc + CORE_R + 2u)));
-    let count = word(acc + TAIL_COUNT);
+    let count = tail_count(px);
     var tail = Tail(vec3<f32>(0.0), 1.0);
     if TAIL != 0u {
-        tail = resolve_tail(acc + TAIL_R, count);
+        tail = read_tail(px, count);
     }
     let quant = vec2<f32>(read_fixed32(word(acc + QUANT_W)), read_fixed32(word(acc + QUANT_D)));
     let lo_hi = vec2<f32>(bitcast<f32>(~word(acc + TAIL_LO)), bitcast<f32>(word(acc + TAIL_HI)));
-    return finish(pos, core, bitcast<f32>(word(acc + T_CORE)), count, tail, quant, lo_hi, 0.0);
+    var out = finish(pos, core, bitcast<f32>(word(acc + T_CORE)), count, tail, quant, lo_hi, 0.0);
+    if TAIL != 0u && count >= TAIL_LIMIT {
+        out.bound = max(out.bound, 1.0); // the packed sums may have wrapped: the tail can be anything
+    }
+    return out;
 }
 
 @group(3) @binding(0) var shade_core: texture_2d<f32>;

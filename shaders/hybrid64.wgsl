@@ -3,22 +3,23 @@
 // 8-bit alpha and the shaded color as R11G11B10 unorm — inverted so that a cleared slot is
 // empty and atomicMax keeps the nearest. The atomic bubble (atomicMax returning the old
 // word: SHADER_INT64_ATOMIC_ALL_OPS) inserts a fragment; the word that falls off the last
-// slot is added to the tail sums (fixed point, as in hybrid.wgsl) in the same pass. The
+// slot is added to the tail's words (common/tail_words.wgsl, as in hybrid.wgsl) in the same pass. The
 // resolve composites the sorted core exactly from the words, then the tail (eqs. 7-11).
 // docs/methods.md ("hybrid64").
 //!include common/scene.wgsl
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
-// Per-pixel accumulator words (mirrors oit_core::method::hybrid64::ACCUM_WORDS).
-const TAIL_R: u32 = 0u;      // 8 words: tail C * alpha (rgb) and alpha, (lo, hi) pairs
-const TAIL_COUNT: u32 = 8u;
-const ACCUM_WORDS: u32 = HYBRID64_ACCUM_WORDS;
-
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u64>>;
-@group(2) @binding(1) var<storage, read_write> accum: array<atomic<u32>>;
+// The tail's count and sums, three 64-bit words a pixel. The method needs 64-bit atomic adds,
+// so it runs with TAIL64 only; the pairs of the other branch keep the shader valid without.
+//!if TAIL64
+@group(2) @binding(1) var<storage, read_write> tail_words: array<atomic<u64>>;
+//!else
+@group(2) @binding(1) var<storage, read_write> tail_words: array<atomic<u32>>;
+//!endif
 @group(2) @binding(2) var<storage, read_write> overflow: atomic<u32>;
-//!include common/fixed.wgsl
+//!include common/tail_words.wgsl
 //!include common/alpha8.wgsl
 
 fn pack_word(z: f32, c: vec4<f32>) -> u64 {
@@ -37,10 +38,10 @@ fn unpack_color(word: u64) -> vec4<f32> {
     return vec4<f32>(c, f32(a) / 255.0);
 }
 
-fn add_tail(acc: u32, packed: u64) {
+// A k-TAB word that fell off the table joins the tail.
+fn add_evicted(px: u32, packed: u64) {
     let c = unpack_color(packed);
-    atomicAdd(&accum[acc + TAIL_COUNT], 1u);
-    add_tail_sums(acc + TAIL_R, c.rgb, c.a);
+    add_tail(px, c.rgb, c.a, true);
 }
 
 @fragment @early_depth_test(force)
@@ -64,7 +65,7 @@ fn fs_insert(raw: VsOut) {
         }
     }
     // Quantized like every stored word, so the tail does not depend on arrival order.
-    add_tail(px * ACCUM_WORDS, v);
+    add_evicted(px, v);
 }
 
 @fragment
@@ -87,18 +88,20 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
         drift += ALPHA_8BIT_ERROR;
         t_core *= 1.0 - c.a;
     }
-    let acc = px * ACCUM_WORDS;
-    let count = word(acc + TAIL_COUNT);
+    let count = tail_count(px);
     if count > 0u {
         atomicAdd(&overflow, count);
     }
-    let tail = resolve_tail(acc + TAIL_R, count);
+    let tail = read_tail(px, count);
     let rgb = core + t_core * (tail.color + tail.trans * base.rgb); // eq. 11
     // Core colors quantized to 11/11/10 bits (visibilities sum to at most 1), core alphas as
     // above, at most T_core for what lies behind when there is a tail, and rounding.
     var bound = 1.0 / 2046.0 + alpha_bound + f32(K + count + 2u) * ROUNDING_TERM;
     if count > 0u {
         bound += t_core;
+    }
+    if count >= TAIL_LIMIT {
+        bound = max(bound, 1.0); // the packed sums may have wrapped: the tail can be anything
     }
     return Final(vec4<f32>(rgb, 1.0 - t_core * tail.trans * (1.0 - base.a)), bound);
 }

@@ -163,11 +163,11 @@ def test_shared_buffers_past_the_binding_limit_raise_memory_error(renderer):
 
 @pytest.mark.parametrize("name", sorted({"hybrid", "ktab"} & set(NAMES)))
 def test_hybrid_past_the_binding_limit_goes_in_tiles_that_fit(renderer, name):
-    # W x H x 4 (2k + accumulator words) bytes in one frame would pass one binding with k = 32
+    # W x H x 4 (2k + accumulator and tail words) bytes in one frame would pass one binding with k = 32
     # (the k-TAB alone does): the frame goes in tiles whose buffers each fit.
     limit, top = binding_limit(renderer), largest_texture()
     k = 32
-    per_pixel = 4 * (2 * k + constants()["HYBRID_ACCUM_WORDS"])
+    per_pixel = 4 * (2 * k + constants()["HYBRID_ACCUM_WORDS"] + constants()["HYBRID_TAIL_WORDS"])
     side = int(np.sqrt(limit // (4 * k)))
     if side + 1 > top:
         pytest.skip("the binding limit cannot be passed within the largest texture")

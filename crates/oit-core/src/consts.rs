@@ -10,12 +10,13 @@ pub enum Const {
     F32(&'static str, f32),
 }
 
-/// Words per pixel of hybrid's accumulators: core RGB (3), tail sums as 64-bit pairs (8), tail
-/// count, transmittance behind the core, nearest evicted key, two error-bound sums, and the tail
-/// colors' smallest and largest channel (shaders/hybrid.wgsl).
-pub const HYBRID_ACCUM_WORDS: u32 = 18;
-/// Words per pixel of hybrid64's tail accumulators: the 64-bit sum pairs and a count.
-pub const HYBRID64_ACCUM_WORDS: u32 = 9;
+/// Words per pixel of hybrid's accumulators: core RGB (3), transmittance behind the core,
+/// nearest evicted key, two error-bound sums, and the tail colors' smallest and largest channel
+/// (shaders/hybrid.wgsl).
+pub const HYBRID_ACCUM_WORDS: u32 = 9;
+/// 32-bit words per pixel of hybrid's and hybrid64's tail: its count and sums packed in three
+/// 64-bit words (shaders/common/tail_words.wgsl).
+pub const HYBRID_TAIL_WORDS: u32 = 6;
 /// Words per pixel of the peeling methods' accumulators (shaders/peel.wgsl).
 pub const PEEL_WORDS: u32 = 9;
 /// Fixed-point scale of hybrid's core sums (values in [0, 1], total <= 1): 2^31.
@@ -60,7 +61,7 @@ pub const LOCK_TRIES: u32 = 4096;
 /// shaders compute with).
 pub const SHARED: &[Const] = &[
     Const::U32("HYBRID_ACCUM_WORDS", HYBRID_ACCUM_WORDS),
-    Const::U32("HYBRID64_ACCUM_WORDS", HYBRID64_ACCUM_WORDS),
+    Const::U32("HYBRID_TAIL_WORDS", HYBRID_TAIL_WORDS),
     Const::U32("PEEL_WORDS", PEEL_WORDS),
     Const::F32("CORE_SCALE", CORE_SCALE),
     Const::F32("TAIL_SCALE", TAIL_SCALE),

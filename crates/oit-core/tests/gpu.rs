@@ -114,3 +114,53 @@ fn census_by_blending_counts_what_atomics_count() {
     assert_eq!(exact_atomic.image, exact_blended.image);
     assert_eq!(exact_atomic.depth_complexity, blended.depth_complexity);
 }
+
+/// A device like `shared_context`'s without 64-bit atomics: hybrid's tail words are then pairs
+/// of 32-bit atomics (shaders/common/tail_words.wgsl).
+fn context_without_int64() -> std::sync::Arc<oit_core::GpuContext> {
+    let full = shared_context(None).expect("a GPU adapter (lavapipe in CI)");
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+        backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY),
+        ..wgpu::InstanceDescriptor::new_without_display_handle()
+    });
+    let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+    let adapter = adapters.into_iter().find(|a| a.get_info().name == full.info.name).expect("the shared context's adapter");
+    let int64 = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX | wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS;
+    let features = full.features - int64;
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("oit without int64"),
+        required_features: features,
+        required_limits: adapter.limits(),
+        ..Default::default()
+    }))
+    .expect("a device");
+    std::sync::Arc::new(oit_core::GpuContext::from_device(device, queue, adapter.get_info()))
+}
+
+#[test]
+fn hybrid_tail_words_are_the_same_in_64_bit_atomics_and_32_bit_pairs() {
+    let full = shared_context(None).expect("a GPU adapter (lavapipe in CI)");
+    if !full.features.contains(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS) {
+        eprintln!("skipped: the adapter has no 64-bit atomic adds, so there is nothing to compare the pairs with");
+        return;
+    }
+    // 40 layers of varied colors and alphas: with k = 4 most go to the tail, and their green
+    // sums carry between the packed words many times.
+    let mut scene = Scene::new();
+    for i in 0..40u32 {
+        let f = i as f32;
+        let rgba = [(f * 0.37).fract(), (f * 0.61 + 0.2).fract(), (f * 0.83 + 0.5).fract(), 0.05 + (f * 0.29).fract() * 0.9];
+        scene.add_mesh(quad(0.1 + 0.02 * f, rgba, false));
+    }
+    let mut wide = Renderer::new(full, 8, 8).unwrap();
+    let mut pairs = Renderer::new(context_without_int64(), 8, 8).unwrap();
+    for (method, k) in [("hybrid", 4), ("hybrid", 1), ("ktab", 4)] {
+        let params = [("k".to_string(), oit_core::ParamValue::Int(k))];
+        let a = wide.render(&scene, &identity(), method, &params, [1.0; 3]).unwrap();
+        let b = pairs.render(&scene, &identity(), method, &params, [1.0; 3]).unwrap();
+        assert_eq!(a.stats.overflow_fragments, (40 - k as u64) * 64, "{method} k = {k}");
+        assert_eq!(a.stats.overflow_fragments, b.stats.overflow_fragments, "{method} k = {k}");
+        assert_eq!(a.image, b.image, "{method} k = {k}: the two tails differ");
+        assert_eq!(a.error_bound, b.error_bound, "{method} k = {k}");
+    }
+}

@@ -39,6 +39,19 @@ fn every_shader_validates_in_every_scene_variant() {
     }
 }
 
+/// hybrid's and hybrid64's tail words as 64-bit atomics (TAIL64, set per device) validate as
+/// well as the 32-bit pairs of the defaults.
+#[test]
+fn the_tail_words_validate_as_64_bit_atomics() {
+    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !matches!(c, Const::U32("TAIL64", _))).collect();
+    consts.push(Const::U32("TAIL64", 1));
+    for f in ["hybrid.wgsl", "hybrid64.wgsl"] {
+        let text = compose(f, &consts);
+        assert!(text.contains("array<atomic<u64>>"), "{f} with TAIL64 keeps 32-bit tail words");
+        validate_with(f, &consts);
+    }
+}
+
 #[test]
 fn an_unlit_variant_has_no_shading_varyings() {
     let unlit = compose("blend.wgsl", &variant_consts(SceneVariant::default()));

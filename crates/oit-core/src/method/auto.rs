@@ -42,11 +42,11 @@ pub const INFO: MethodInfo = MethodInfo {
     order: Order::Bitwise,
     antialias_modes: FRAMES,
     memory: Memory::Slots {
-        formula: "2·Σk·4 + W·H·96 + 8 (hybrid with per-pixel slots and the estimate), or the A-buffer's",
+        formula: "2·Σk·4 + W·H·84 + 8 (hybrid with per-pixel slots and the estimate), or the A-buffer's",
         bytes: memory_bytes,
     },
     error_bound: ErrorBound::PerPixel,
-    tiling: Tiling::Storage { per_pixel: 96, per_fragment: 24, per_triangle: 0 },
+    tiling: Tiling::Storage { per_pixel: 84, per_fragment: 24, per_triangle: 0 },
     census: true,
     census_when: never,
     main: None,

@@ -53,7 +53,7 @@ pub const KTAB: MethodInfo = MethodInfo {
 };
 
 const MEMORY: Memory = Memory::Frame {
-    formula: "W·H·(2k + 18)·4 + 8 (tail = 'compact': W·H·(2k + 2)·4 + 8)",
+    formula: "W·H·(2k + 15)·4 + 8 (tail = 'compact': W·H·(2k + 2)·4 + 8)",
     bytes: |px, p| {
         let k = p.int("k") as u64;
         if p.0.get("tail").is_some_and(|t| matches!(t, ParamValue::Str(s) if s == "compact")) {

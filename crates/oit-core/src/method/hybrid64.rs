@@ -26,7 +26,7 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "W·H·(8k + 36) + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) },
+    memory: Memory::Frame { formula: "W·H·(8k + 24) + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) },
     error_bound: ErrorBound::PerPixel,
     tiling: Tiling::Formula,
     census: false,
@@ -41,10 +41,10 @@ const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(3)];
 const PIPELINES: &[PipelineSpec] =
     &[PipelineSpec::geometry("hybrid64.wgsl", "fs_insert", GROUPS), PipelineSpec::fullscreen("hybrid64.wgsl", "fs_resolve", GROUPS)];
 
-/// Words per pixel of the tail accumulators.
-pub const ACCUM_WORDS: u64 = crate::consts::HYBRID64_ACCUM_WORDS as u64;
+/// 32-bit words per pixel of the tail's count and sums (three 64-bit words).
+pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_TAIL_WORDS as u64;
 
-/// Bytes hybrid64 allocates: k 64-bit words and the tail accumulators per pixel, a counter.
+/// Bytes hybrid64 allocates: k 64-bit words and the tail's words per pixel, a counter.
 pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
     pixels * (8 * k + 4 * ACCUM_WORDS) + 4
 }

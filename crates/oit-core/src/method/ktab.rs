@@ -10,19 +10,20 @@ use crate::error::{OitError, Result};
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
 
-/// Words per pixel of the accumulators.
+/// Words per pixel of the accumulators, and of the tail's count and sums (their own binding).
 pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_ACCUM_WORDS as u64;
+pub const TAIL_WORDS: u64 = crate::consts::HYBRID_TAIL_WORDS as u64;
 
 /// Bytes at W x H pixels with core size k: k-TAB and visibility (k words each), the
-/// accumulators, the slot-offset placeholder (a word: every pixel has k slots) and the overflow
-/// counter.
+/// accumulators and tail words, the slot-offset placeholder (a word: every pixel has k slots)
+/// and the overflow counter.
 pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
-    pixels * (2 * k + ACCUM_WORDS) * 4 + 8
+    pixels * (2 * k + ACCUM_WORDS + TAIL_WORDS) * 4 + 8
 }
 
 /// Bytes with tail = "compact" (Eq. 12's 2k + 2 words a pixel): k-TAB and visibility (k words
-/// each) and the tail's RGBA16F sums (2 words), plus the slot-offset placeholder and the
-/// overflow counter.
+/// each) and the tail's RGBA16F sums (2 words), plus the slot-offset placeholder (which also
+/// fills the tail words' binding: this tail has none) and the overflow counter.
 pub fn compact_memory_bytes(pixels: u64, k: u64) -> u64 {
     pixels * (2 * k + COMPACT_TAIL_WORDS) * 4 + 8
 }
@@ -36,9 +37,10 @@ const COMPACT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const COMPACT_BINDINGS: &[u32] = &[4];
 
 /// Bytes with each pixel's own slot count (`slots` in all): k-TAB and visibility (a word
-/// each per slot), the accumulators, the per-pixel offsets (pixels + 1 words) and the counter.
+/// each per slot), the accumulators and tail words, the per-pixel offsets (pixels + 1 words) and
+/// the counter.
 pub fn memory_bytes_per_pixel(pixels: u64, slots: u64) -> u64 {
-    2 * slots * 4 + pixels * ACCUM_WORDS * 4 + (pixels + 1) * 4 + 4
+    2 * slots * 4 + pixels * (ACCUM_WORDS + TAIL_WORDS) * 4 + (pixels + 1) * 4 + 4
 }
 
 /// How many k-TAB slots each pixel gets.
@@ -49,12 +51,14 @@ pub(crate) enum Slots<'s> {
     PerPixel(&'s [u32]),
 }
 
-/// Binding of the per-pixel slot offsets in the group (shaders/hybrid.wgsl).
+/// Bindings of the per-pixel slot offsets and of the tail words in the group (shaders/hybrid.wgsl).
 const OFFSETS: usize = 3;
+const TAIL: usize = 4;
 
 const SHADER: &str = "hybrid.wgsl";
-/// Group 2: k-TAB, core visibility, accumulators, slot offsets, then the overflow counter.
-const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(5)];
+/// Group 2: k-TAB, core visibility, accumulators, slot offsets, tail words, then the overflow
+/// counter.
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(6)];
 
 /// The k-TAB engine's pipelines (hybrid, ktab, auto).
 pub(crate) const PIPELINES: &[PipelineSpec] = &[
@@ -67,14 +71,14 @@ pub(crate) const PIPELINES: &[PipelineSpec] = &[
     PipelineSpec::fullscreen(
         SHADER,
         "fs_final_blend",
-        &[Layout::Scene, Layout::Targets, Layout::Storage(5), Layout::Textures(BLEND_BINDINGS)],
+        &[Layout::Scene, Layout::Targets, Layout::Storage(6), Layout::Textures(BLEND_BINDINGS)],
     ),
     PipelineSpec::fullscreen(SHADER, "fs_clear", GROUPS),
     PipelineSpec::geometry(SHADER, "fs_shade_compact", GROUPS),
     PipelineSpec::fullscreen(
         SHADER,
         "fs_final_compact",
-        &[Layout::Scene, Layout::Targets, Layout::Storage(5), Layout::Textures(COMPACT_BINDINGS)],
+        &[Layout::Scene, Layout::Targets, Layout::Storage(6), Layout::Textures(COMPACT_BINDINGS)],
     ),
 ];
 
@@ -185,6 +189,7 @@ impl KTab {
             ("core visibility", total.max(1) * 4),
             ("hybrid accumulators", pixels * ACCUM_WORDS * 4),
             ("slot offsets", if per_pixel { (pixels + 1) * 4 } else { 4 }),
+            ("hybrid tail words", pixels * TAIL_WORDS * 4),
         ];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[overflow]);
         if let Slots::PerPixel(s) = slots {
@@ -199,6 +204,7 @@ impl KTab {
         let mut enc = cx.encoder();
         enc.clear_buffer(&b.buffers[0], 0, None);
         enc.clear_buffer(&b.buffers[2], 0, None);
+        enc.clear_buffer(&b.buffers[TAIL], 0, None);
         overflow.clear(&mut enc);
         cx.capture(&mut enc, "store", &cx.capture_pipeline(spec(PIPELINES, "fs_store"), &consts), &b.group);
         cx.dispatch(&mut enc, "visibility", &cx.compute_pipeline(spec(PIPELINES, "cs_visibility"), &consts), &b.group);
@@ -255,9 +261,11 @@ impl KTab {
             b.buffers[1].as_entire_binding(),
             counts.as_entire_binding(),
             b.buffers[2].as_entire_binding(),
+            // No tail words: the unused slot offsets fill their binding too (never accessed).
+            b.buffers[2].as_entire_binding(),
             overflow.buffer.as_entire_binding(),
         ];
-        let group = cx.group(Layout::Storage(5), &resources);
+        let group = cx.group(Layout::Storage(6), &resources);
         let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", 0), Const::U32("TAIL", 1), Const::U32("COMPACT", 1)];
         let sums = FloatTargets::ensure(&mut self.compact, cx, &[COMPACT_FORMAT], COMPACT_BINDINGS);
         let shade = cx.draw_pipeline(
