@@ -20,16 +20,19 @@
 //!include common/targets.wgsl
 //!include common/fullscreen.wgsl
 
-// Per-pixel accumulator words (mirrors oit_core::method::hybrid::ACCUM_WORDS); the tail's count
-// and sums are in their own words (common/tail_words.wgsl, binding 4).
-const CORE_R: u32 = 0u;      // 3 words: core color, fixed point
-const T_CORE: u32 = 3u;      // transmittance behind the core (f32 bits)
-const EVICTED: u32 = 4u;     // nearest key pushed out of the full k-TAB (0: none)
-const QUANT_W: u32 = 5u;     // sum over core fragments of |alpha - q| * T' (fixed point)
-const QUANT_D: u32 = 6u;     // sum over core fragments of |alpha - q| (fixed point)
-const TAIL_LO: u32 = 7u;     // smallest tail color channel (f32 bits, inverted: 0 = none)
-const TAIL_HI: u32 = 8u;     // largest tail color channel (f32 bits)
+// Per-pixel accumulator words (mirrors oit_core::method::hybrid::ACCUM_WORDS), kept by
+// atomicMax; the sums are 64-bit words at binding 4.
+const EVICTED: u32 = 0u;     // nearest key pushed out of the full k-TAB (0: none)
+const TAIL_LO: u32 = 1u;     // smallest tail color channel (f32 bits, inverted: 0 = none)
+const TAIL_HI: u32 = 2u;     // largest tail color channel (f32 bits)
 const ACCUM_WORDS: u32 = HYBRID_ACCUM_WORDS;
+// 64-bit words a pixel at binding 4: the tail's three (common/tail_words.wgsl), then the core's
+// three, as (lo, hi) halves of 32-bit fixed-point sums, none of which can carry into the next:
+//   CORE + 0: sum C_r v, sum C_g v; CORE + 1: sum C_b v, sum |alpha - q| T' (error bound);
+//   CORE + 2: sum |alpha - q| (error bound), and T_core as f32 bits (set by cs_visibility).
+// A core and a tail fragment add to their own three words with the same three adds.
+const PIXEL_WORDS: u32 = (HYBRID_TAIL_WORDS + HYBRID_CORE_WORDS) / 2u;
+const CORE: u32 = HYBRID_TAIL_WORDS / 2u;
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u32>>;
 // Transmittance in front of each core slot; with COMPACT as f32 bits in atomic words, the first
@@ -57,8 +60,9 @@ fn vis_store(i: u32, v: f32) {
 //!endif
 // The accumulators; with COMPACT, the census counts, a fragment count a pixel.
 @group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
-// The tail's count and sums (common/tail_words.wgsl); with COMPACT the slot-offset placeholder
-// (never accessed; TAIL64 is then 0, so that its 4 bytes fit).
+// The tail's and the core's sums in 64-bit words (PIXEL_WORDS a pixel, above;
+// common/tail_words.wgsl); with COMPACT the slot-offset placeholder (never accessed; TAIL64 is
+// then 0, so that its 4 bytes fit).
 //!if TAIL64
 @group(2) @binding(4) var<storage, read_write> tail_words: array<atomic<u64>>;
 //!else
@@ -194,7 +198,7 @@ fn cs_visibility(@builtin(global_invocation_id) id: vec3<u32>) {
         t *= 1.0 - key_alpha(atomicLoad(&ktab[base + i]));
     }
     if COMPACT == 0u {
-        atomicStore(&accum[px * ACCUM_WORDS + T_CORE], bitcast<u32>(t));
+        store_hi(px * PIXEL_WORDS + CORE + 2u, bitcast<u32>(t));
     }
 }
 
@@ -252,22 +256,22 @@ fn fs_shade(raw: VsOut) {
         return;
     }
     let px = pixel_index(in.clip);
-    let acc = px * ACCUM_WORDS;
     let p = place(px, in.clip.z, in.color.a);
-    if p.core {
-        // The 8-bit alpha of this key moved every transmittance behind it (error bound).
-        add_fixed32(acc + QUANT_W, p.d * p.vis);
-        add_fixed32(acc + QUANT_D, p.d);
-        add_fixed32(acc + CORE_R, in.color.r * p.w);
-        add_fixed32(acc + CORE_R + 1u, in.color.g * p.w);
-        add_fixed32(acc + CORE_R + 2u, in.color.b * p.w);
-        return;
-    }
-    add_tail(px, in.color.rgb, in.color.a, TAIL != 0u);
+    // Core and tail fragments make the same adds, to their own words (no branch: llvmpipe runs
+    // both sides of one), and the same two atomicMax, a core fragment's with 0 (no change).
+    // A core fragment's 8-bit alpha moved every transmittance behind it (error bound).
+    let rgb = in.color.rgb * p.w;
+    let core = Terms(vec2<u32>(fixed32(rgb.r), fixed32(rgb.g)), vec2<u32>(fixed32(rgb.b), fixed32(p.d * p.vis)),
+                     vec2<u32>(fixed32(p.d), 0u));
+    let tail = tail_terms(in.color.rgb, in.color.a, TAIL != 0u);
+    let w = px * PIXEL_WORDS;
+    add_terms(select(w, w + CORE, p.core),
+              Terms(select(tail.w0, core.w0, p.core), select(tail.w1, core.w1, p.core), select(tail.w2, core.w2, p.core)));
     // The range of the tail's colors bounds what the estimate behind the core can be off by.
     let c = clamp(in.color.rgb, vec3<f32>(0.0), vec3<f32>(1.0));
-    atomicMax(&accum[acc + TAIL_LO], ~bitcast<u32>(min(c.r, min(c.g, c.b))));
-    atomicMax(&accum[acc + TAIL_HI], bitcast<u32>(max(c.r, max(c.g, c.b))));
+    let acc = px * ACCUM_WORDS;
+    atomicMax(&accum[acc + TAIL_LO], select(~bitcast<u32>(min(c.r, min(c.g, c.b))), 0u, p.core));
+    atomicMax(&accum[acc + TAIL_HI], select(bitcast<u32>(max(c.r, max(c.g, c.b))), 0u, p.core));
 }
 
 // The same sums by fixed-function blending (oit_core::method::ktab::blend_targets): added
@@ -323,15 +327,19 @@ fn finish(pos: vec4<f32>, core: vec3<f32>, t_core: f32, count: u32, tail: Tail, 
 fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
     let px = pixel_index(pos);
     let acc = px * ACCUM_WORDS;
-    let core = vec3<f32>(read_fixed32(word(acc + CORE_R)), read_fixed32(word(acc + CORE_R + 1u)), read_fixed32(word(acc + CORE_R + 2u)));
-    let count = tail_count(px);
+    let w = px * PIXEL_WORDS;
+    let c0 = tail_word(w + CORE);
+    let c1 = tail_word(w + CORE + 1u);
+    let c2 = tail_word(w + CORE + 2u);
+    let core = vec3<f32>(read_fixed32(c0.x), read_fixed32(c0.y), read_fixed32(c1.x));
+    let count = tail_count(w);
     var tail = Tail(vec3<f32>(0.0), 1.0);
     if TAIL != 0u {
-        tail = read_tail(px, count);
+        tail = read_tail(w, count);
     }
-    let quant = vec2<f32>(read_fixed32(word(acc + QUANT_W)), read_fixed32(word(acc + QUANT_D)));
+    let quant = vec2<f32>(read_fixed32(c1.y), read_fixed32(c2.x));
     let lo_hi = vec2<f32>(bitcast<f32>(~word(acc + TAIL_LO)), bitcast<f32>(word(acc + TAIL_HI)));
-    var out = finish(pos, core, bitcast<f32>(word(acc + T_CORE)), count, tail, quant, lo_hi, 0.0);
+    var out = finish(pos, core, bitcast<f32>(c2.y), count, tail, quant, lo_hi, 0.0);
     if TAIL != 0u && count >= TAIL_LIMIT {
         out.bound = max(out.bound, 1.0); // the packed sums may have wrapped: the tail can be anything
     }
@@ -355,7 +363,7 @@ fn fs_final_blend(@builtin(position) pos: vec4<f32>) -> Final {
         tail = tail_from_sums(sums.rgb, sums.a, count);
     }
     let lo_hi = vec2<f32>(1.0 - textureLoad(shade_low, at, 0).r, quant.a);
-    let t_core = bitcast<f32>(word(pixel_index(pos) * ACCUM_WORDS + T_CORE));
+    let t_core = bitcast<f32>(tail_word(pixel_index(pos) * PIXEL_WORDS + CORE + 2u).y);
     // Float sums of count terms in [0, 1] in any order: each within count * 2^-24 of its value
     // relative to the sum; eqs. 7-10 move the tail by at most 3 such relative errors.
     let rounding = 3.0 * f32(count) * 5.96e-8 * t_core;

@@ -22,6 +22,9 @@
 //!include common/tail_words.wgsl
 //!include common/alpha8.wgsl
 
+// 64-bit words a pixel: the tail's three.
+const TAIL_WORDS: u32 = HYBRID_TAIL_WORDS / 2u;
+
 fn pack_word(z: f32, c: vec4<f32>) -> u64 {
     let d = min(u32(z * DEPTH_SCALE), DEPTH_MAX);
     let a = alpha_8bit(c.a);
@@ -41,7 +44,7 @@ fn unpack_color(word: u64) -> vec4<f32> {
 // A k-TAB word that fell off the table joins the tail.
 fn add_evicted(px: u32, packed: u64) {
     let c = unpack_color(packed);
-    add_tail(px, c.rgb, c.a, true);
+    add_terms(px * TAIL_WORDS, tail_terms(c.rgb, c.a, true));
 }
 
 @fragment @early_depth_test(force)
@@ -88,11 +91,11 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
         drift += ALPHA_8BIT_ERROR;
         t_core *= 1.0 - c.a;
     }
-    let count = tail_count(px);
+    let count = tail_count(px * TAIL_WORDS);
     if count > 0u {
         atomicAdd(&overflow, count);
     }
-    let tail = read_tail(px, count);
+    let tail = read_tail(px * TAIL_WORDS, count);
     let rgb = core + t_core * (tail.color + tail.trans * base.rgb); // eq. 11
     // Core colors quantized to 11/11/10 bits (visibilities sum to at most 1), core alphas as
     // above, at most T_core for what lies behind when there is a tail, and rounding.

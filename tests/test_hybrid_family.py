@@ -279,7 +279,7 @@ def test_compact_tail_keeps_eq_12s_words(renderer, k):
     built = stacks(layers=40, alphas="random", size=(8, 6), seed=2)
     frame = renderer(8, 6).render(built.scene, built.camera, "hybrid", k=k, tail="compact")
     # Per pixel Eq. 12's 2k + 2 words; per frame the slot-offset placeholder (4 bytes, which also
-    # fills the unused tail words' binding) and the overflow counter (4).
+    # fills the unused sums' binding) and the overflow counter (4).
     assert frame.stats["memory_bytes"] == memory_bytes("hybrid", 8, 6, k=k, tail="compact") == 8 * 6 * (2 * k + 2) * 4 + 8
     # The exact tail: k-TAB and visibility, 9 accumulator words and 6 tail words a pixel.
     assert memory_bytes("hybrid", 8, 6, k=k) == 8 * 6 * (2 * k + 15) * 4 + 8

@@ -167,7 +167,7 @@ def test_hybrid_past_the_binding_limit_goes_in_tiles_that_fit(renderer, name):
     # (the k-TAB alone does): the frame goes in tiles whose buffers each fit.
     limit, top = binding_limit(renderer), largest_texture()
     k = 32
-    per_pixel = 4 * (2 * k + constants()["HYBRID_ACCUM_WORDS"] + constants()["HYBRID_TAIL_WORDS"])
+    per_pixel = 4 * (2 * k + sum(constants()[w] for w in ("HYBRID_ACCUM_WORDS", "HYBRID_TAIL_WORDS", "HYBRID_CORE_WORDS")))
     side = int(np.sqrt(limit // (4 * k)))
     if side + 1 > top:
         pytest.skip("the binding limit cannot be passed within the largest texture")

@@ -92,7 +92,7 @@ def test_memory_bytes_refuses_what_it_cannot_answer():
         oit.memory_bytes("hybrid", 4, 4, slots=3)
     with pytest.raises(TypeError, match="width must be an int"):
         oit.memory_bytes("hybrid", 4.0, 4)
-    words = oit.constants()["HYBRID_ACCUM_WORDS"] + oit.constants()["HYBRID_TAIL_WORDS"]
+    words = sum(oit.constants()[w] for w in ("HYBRID_ACCUM_WORDS", "HYBRID_TAIL_WORDS", "HYBRID_CORE_WORDS"))
     assert oit.memory_bytes("hybrid", 10, 10, k=4) == 100 * (2 * 4 + words) * 4 + 8
     assert oit.memory_bytes("abuffer", 10, 10) is None
 

@@ -14,7 +14,8 @@
 // (lo, hi) pair of 32-bit atomics with the carry between them taken from the value atomicAdd
 // returns: the same integers at two adds a word.
 // The including shader declares them, `tail_words: array<atomic<u64>>` with TAIL64 and
-// `array<atomic<u32>>` without.
+// `array<atomic<u32>>` without, and says where a pixel's words start (hybrid64: three a pixel;
+// hybrid: six, its core's sums in three more words with the same adds, add_terms).
 
 // The tail of hybrid transparency (Maule et al. 2013, eqs. 7-10): its premultiplied color
 // C_tail * alpha_tail and its transmittance T_tail = (1 - alpha_avg)^count.
@@ -51,6 +52,11 @@ fn tail_word(i: u32) -> vec2<u32> {
     let x = atomicLoad(&tail_words[i]);
     return vec2<u32>(u32(x & 0xfffffffflu), u32(x >> 32u));
 }
+
+// Sets word i to (0, hi), before any add to it.
+fn store_hi(i: u32, hi: u32) {
+    atomicStore(&tail_words[i], u64(hi) << 32u);
+}
 //!else
 // The same add on the pair (2i, 2i + 1). The terms below leave room in both halves for the
 // carries: `lo + carry` and `hi + carry` never pass 2^32 - 1 (see tail_terms).
@@ -65,6 +71,10 @@ fn add_tail_word(i: u32, v: vec2<u32>, carry: u32) -> u32 {
 fn tail_word(i: u32) -> vec2<u32> {
     return vec2<u32>(atomicLoad(&tail_words[2u * i]), atomicLoad(&tail_words[2u * i + 1u]));
 }
+
+fn store_hi(i: u32, hi: u32) {
+    atomicStore(&tail_words[2u * i + 1u], hi);
+}
 //!endif
 
 // Fixed point at TAIL_SCALE of a value in [0, 1], as the unpacked sums rounded it.
@@ -72,13 +82,18 @@ fn tail_fixed(v: f32) -> u32 {
     return u32(round(clamp(v, 0.0, 1.0) * TAIL_SCALE));
 }
 
-// Adds a fragment of color rgb and alpha a to pixel px's tail (with sums = false, only to its
-// count: ktab counts what it drops).
-fn add_tail(px: u32, rgb: vec3<f32>, a: f32, sums: bool) {
-    let w = px * 3u;
+// What one fragment adds to three consecutive words, each as (lo, hi).
+struct Terms {
+    w0: vec2<u32>,
+    w1: vec2<u32>,
+    w2: vec2<u32>,
+}
+
+// A fragment of color rgb and alpha a in the tail's words (with sums = false, only its count:
+// ktab counts what it drops).
+fn tail_terms(rgb: vec3<f32>, a: f32, sums: bool) -> Terms {
     if !sums {
-        add_tail_word(w, vec2<u32>(1u, 0u), 0u);
-        return;
+        return Terms(vec2<u32>(1u, 0u), vec2<u32>(0u), vec2<u32>(0u));
     }
     let q = tail_fixed(a);
     let r = tail_fixed(rgb.r * a);
@@ -87,9 +102,16 @@ fn add_tail(px: u32, rgb: vec3<f32>, a: f32, sums: bool) {
     // Each term is at most 2^24: word 0's lo is 1 | q << 22 (bit 0 free of q), its hi q >> 10;
     // word 1's lo is r, its hi g's low 22 bits over 10 free bits; word 2's lo g >> 22 (at most 4)
     // under b << 20, its hi b >> 12. No half is near 2^32 - 1, so adding a carry cannot wrap it.
-    add_tail_word(w, vec2<u32>(1u | (q << 22u), q >> 10u), 0u);
-    let carry = add_tail_word(w + 1u, vec2<u32>(r, (g & 0x3fffffu) << 10u), 0u);
-    add_tail_word(w + 2u, vec2<u32>((g >> 22u) | (b << 20u), b >> 12u), carry);
+    return Terms(vec2<u32>(1u | (q << 22u), q >> 10u), vec2<u32>(r, (g & 0x3fffffu) << 10u),
+                 vec2<u32>((g >> 22u) | (b << 20u), b >> 12u));
+}
+
+// Adds `t` to words w, w + 1 and w + 2: word w + 1's carry out of bit 63 goes into word w + 2
+// with its own add.
+fn add_terms(w: u32, t: Terms) {
+    add_tail_word(w, t.w0, 0u);
+    let carry = add_tail_word(w + 1u, t.w1, 0u);
+    add_tail_word(w + 2u, t.w2, carry);
 }
 
 // A 42-bit sum (lo, hi) as the unpacked pairs read it.
@@ -97,16 +119,16 @@ fn tail_sum(v: vec2<u32>) -> f32 {
     return (f32(v.y) * 4294967296.0 + f32(v.x)) / TAIL_SCALE;
 }
 
-// Pixel px's tail count.
-fn tail_count(px: u32) -> u32 {
-    return tail_word(px * 3u).x & 0x3fffffu;
+// The tail count of the pixel whose tail words start at w.
+fn tail_count(w: u32) -> u32 {
+    return tail_word(w).x & 0x3fffffu;
 }
 
-// Pixel px's tail (eqs. 7-10) from its words, over `count` fragments.
-fn read_tail(px: u32, count: u32) -> Tail {
-    let w0 = tail_word(px * 3u);
-    let w1 = tail_word(px * 3u + 1u);
-    let w2 = tail_word(px * 3u + 2u);
+// The tail (eqs. 7-10) from the words starting at w, over `count` fragments.
+fn read_tail(w: u32, count: u32) -> Tail {
+    let w0 = tail_word(w);
+    let w1 = tail_word(w + 1u);
+    let w2 = tail_word(w + 2u);
     let sum_a = vec2<u32>((w0.x >> 22u) | (w0.y << 10u), w0.y >> 22u);
     let sum_r = vec2<u32>(w1.x, w1.y & 0x3ffu);
     let sum_g = vec2<u32>((w1.y >> 10u) | (w2.x << 22u), (w2.x & 0xfffffu) >> 10u);

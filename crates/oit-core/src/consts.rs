@@ -10,13 +10,15 @@ pub enum Const {
     F32(&'static str, f32),
 }
 
-/// Words per pixel of hybrid's accumulators: core RGB (3), transmittance behind the core,
-/// nearest evicted key, two error-bound sums, and the tail colors' smallest and largest channel
-/// (shaders/hybrid.wgsl).
-pub const HYBRID_ACCUM_WORDS: u32 = 9;
+/// Words per pixel of hybrid's accumulators, kept by atomicMax: the nearest evicted key and the
+/// tail colors' smallest and largest channel (shaders/hybrid.wgsl).
+pub const HYBRID_ACCUM_WORDS: u32 = 3;
 /// 32-bit words per pixel of hybrid's and hybrid64's tail: its count and sums packed in three
 /// 64-bit words (shaders/common/tail_words.wgsl).
 pub const HYBRID_TAIL_WORDS: u32 = 6;
+/// 32-bit words per pixel of hybrid's core sums, two error-bound sums and T_core, in three 64-bit
+/// words beside the tail's (shaders/hybrid.wgsl).
+pub const HYBRID_CORE_WORDS: u32 = 6;
 /// Words per pixel of the peeling methods' accumulators (shaders/peel.wgsl).
 pub const PEEL_WORDS: u32 = 9;
 /// Fixed-point scale of hybrid's core sums (values in [0, 1], total <= 1): 2^31.
@@ -62,6 +64,7 @@ pub const LOCK_TRIES: u32 = 4096;
 pub const SHARED: &[Const] = &[
     Const::U32("HYBRID_ACCUM_WORDS", HYBRID_ACCUM_WORDS),
     Const::U32("HYBRID_TAIL_WORDS", HYBRID_TAIL_WORDS),
+    Const::U32("HYBRID_CORE_WORDS", HYBRID_CORE_WORDS),
     Const::U32("PEEL_WORDS", PEEL_WORDS),
     Const::F32("CORE_SCALE", CORE_SCALE),
     Const::F32("TAIL_SCALE", TAIL_SCALE),

@@ -10,12 +10,13 @@ use crate::error::{OitError, Result};
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
 
-/// Words per pixel of the accumulators, and of the tail's count and sums (their own binding).
+/// Words per pixel of the accumulators, and of the sums (their own binding: the tail's count
+/// and sums, the core's sums and T_core, in 64-bit words).
 pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_ACCUM_WORDS as u64;
-pub const TAIL_WORDS: u64 = crate::consts::HYBRID_TAIL_WORDS as u64;
+pub const TAIL_WORDS: u64 = (crate::consts::HYBRID_TAIL_WORDS + crate::consts::HYBRID_CORE_WORDS) as u64;
 
 /// Bytes at W x H pixels with core size k: k-TAB and visibility (k words each), the
-/// accumulators and tail words, the slot-offset placeholder (a word: every pixel has k slots)
+/// accumulators and sums, the slot-offset placeholder (a word: every pixel has k slots)
 /// and the overflow counter.
 pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
     pixels * (2 * k + ACCUM_WORDS + TAIL_WORDS) * 4 + 8
@@ -37,7 +38,7 @@ const COMPACT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const COMPACT_BINDINGS: &[u32] = &[4];
 
 /// Bytes with each pixel's own slot count (`slots` in all): k-TAB and visibility (a word
-/// each per slot), the accumulators and tail words, the per-pixel offsets (pixels + 1 words) and
+/// each per slot), the accumulators and sums, the per-pixel offsets (pixels + 1 words) and
 /// the counter.
 pub fn memory_bytes_per_pixel(pixels: u64, slots: u64) -> u64 {
     2 * slots * 4 + pixels * (ACCUM_WORDS + TAIL_WORDS) * 4 + (pixels + 1) * 4 + 4
@@ -51,12 +52,12 @@ pub(crate) enum Slots<'s> {
     PerPixel(&'s [u32]),
 }
 
-/// Bindings of the per-pixel slot offsets and of the tail words in the group (shaders/hybrid.wgsl).
+/// Bindings of the per-pixel slot offsets and of the sums in the group (shaders/hybrid.wgsl).
 const OFFSETS: usize = 3;
 const TAIL: usize = 4;
 
 const SHADER: &str = "hybrid.wgsl";
-/// Group 2: k-TAB, core visibility, accumulators, slot offsets, tail words, then the overflow
+/// Group 2: k-TAB, core visibility, accumulators, slot offsets, sums, then the overflow
 /// counter.
 const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(6)];
 
@@ -149,11 +150,11 @@ impl KTab {
         let pixels = cx.pixels();
         match slots {
             Slots::Uniform(k) => {
-                cx.check_per_pixel(&format!("{name} with k = {k}"), 4 * (*k as u64).max(ACCUM_WORDS))?;
+                cx.check_per_pixel(&format!("{name} with k = {k}"), 4 * (*k as u64).max(ACCUM_WORDS).max(TAIL_WORDS))?;
                 Ok((pixels * *k as u64, false))
             }
             Slots::PerPixel(s) => {
-                cx.check_per_pixel(&format!("{name}'s accumulators"), 4 * ACCUM_WORDS)?;
+                cx.check_per_pixel(&format!("{name}'s accumulators"), 4 * ACCUM_WORDS.max(TAIL_WORDS))?;
                 let total: u64 = s.iter().map(|&k| k as u64).sum();
                 if total * 4 > cx.limits.max_binding_bytes {
                     return Err(OitError::OutOfMemory(format!(
@@ -189,7 +190,7 @@ impl KTab {
             ("core visibility", total.max(1) * 4),
             ("hybrid accumulators", pixels * ACCUM_WORDS * 4),
             ("slot offsets", if per_pixel { (pixels + 1) * 4 } else { 4 }),
-            ("hybrid tail words", pixels * TAIL_WORDS * 4),
+            ("hybrid sums", pixels * TAIL_WORDS * 4),
         ];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[overflow]);
         if let Slots::PerPixel(s) = slots {
@@ -261,7 +262,7 @@ impl KTab {
             b.buffers[1].as_entire_binding(),
             counts.as_entire_binding(),
             b.buffers[2].as_entire_binding(),
-            // No tail words: the unused slot offsets fill their binding too (never accessed).
+            // No sums: the unused slot offsets fill their binding too (never accessed).
             b.buffers[2].as_entire_binding(),
             overflow.buffer.as_entire_binding(),
         ];
