@@ -81,7 +81,8 @@ def hybrid_memory() -> tuple[str, str]:
         rows.append(f"k={k}: paper {paper} B, tail=compact {compact} B, tail=exact {exact / 1024:.0f} KiB")
     return ("; ".join(rows) + " at 64² (compact: the paper's 2k + 2 words a pixel, plus 8 bytes a frame for the overflow "
             "counter and a slot-offset placeholder; exact and blend keep 15 words instead of 2: the tail count and fixed-point sums "
-            "packed in three 64-bit words, the core's fixed-point sums and the error-bound terms; rule: tail=compact's words a pixel equal to Eq. 12)"), HOLDS if ok else FAILS
+            "packed in three 64-bit words, the core's fixed-point sums and the error-bound terms; rule: tail=compact's words a "
+            "pixel equal to Eq. 12)"), HOLDS if ok else FAILS
 
 
 def hybrid_two_passes() -> tuple[str, str]:
