@@ -36,25 +36,38 @@ fn node(px: u32, i: u32) -> vec2<f32> {
     return bitcast<vec2<f32>>(nodes[px * NODES + i]);
 }
 //!else
+// The same two words, as one 64-bit atomic a node where the device has 64-bit atomic loads
+// and stores (ATOMIC64; depth in the low half, so the memory is the plain reads' layout), else as
+// two 32-bit atomics.
+//!if ATOMIC64
+@group(2) @binding(0) var<storage, read_write> nodes: array<atomic<u64>>;
+
+fn node(px: u32, i: u32) -> vec2<f32> {
+    let x = atomicLoad(&nodes[px * NODES + i]);
+    return vec2<f32>(bitcast<f32>(u32(x & 0xfffffffflu)), bitcast<f32>(u32(x >> 32u)));
+}
+
+fn store_node(px: u32, i: u32, depth: f32, trans: f32) {
+    atomicStore(&nodes[px * NODES + i], u64(bitcast<u32>(depth)) | (u64(bitcast<u32>(trans)) << 32u));
+}
+//!else
 @group(2) @binding(0) var<storage, read_write> nodes: array<atomic<u32>>;
+
+fn node(px: u32, i: u32) -> vec2<f32> {
+    return vec2<f32>(bitcast<f32>(atomicLoad(&nodes[node_word(px, i)])), bitcast<f32>(atomicLoad(&nodes[node_word(px, i) + 1u])));
+}
+
+fn store_node(px: u32, i: u32, depth: f32, trans: f32) {
+    atomicStore(&nodes[node_word(px, i)], bitcast<u32>(depth));
+    atomicStore(&nodes[node_word(px, i) + 1u], bitcast<u32>(trans));
+}
+//!endif
 
 struct Incoming {
     depth: f32,
     alpha: f32,
 }
 //!include common/pixel_lock.wgsl
-
-fn node_depth(px: u32, i: u32) -> f32 {
-    return bitcast<f32>(atomicLoad(&nodes[node_word(px, i)]));
-}
-
-fn node_trans(px: u32, i: u32) -> f32 {
-    return bitcast<f32>(atomicLoad(&nodes[node_word(px, i) + 1u]));
-}
-
-fn node(px: u32, i: u32) -> vec2<f32> {
-    return vec2<f32>(node_depth(px, i), node_trans(px, i));
-}
 
 // The update indexes its arrays only by loop counters with constant bounds, which the
 // compiler unrolls into registers: a dynamically indexed private array is a gather per lane
@@ -71,8 +84,9 @@ fn critical(px: u32, count: u32, f: Incoming) -> u32 {
         d[i] = 0.0;
         t[i] = 0.0;
         if i < count {
-            d[i] = node_depth(px, i);
-            t[i] = node_trans(px, i);
+            let n = node(px, i);
+            d[i] = n.x;
+            t[i] = n.y;
             if d[i] <= f.depth {
                 p = i + 1u;
                 front = t[i];
@@ -113,8 +127,7 @@ fn critical(px: u32, count: u32, f: Incoming) -> u32 {
     }
     for (var i = 0u; i < NODES; i++) {
         if i >= first && i < n {
-            atomicStore(&nodes[node_word(px, i)], bitcast<u32>(nd[i]));
-            atomicStore(&nodes[node_word(px, i) + 1u], bitcast<u32>(nt[i]));
+            store_node(px, i, nd[i], nt[i]);
         }
     }
     return n;

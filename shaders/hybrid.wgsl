@@ -61,9 +61,9 @@ fn vis_store(i: u32, v: f32) {
 // The accumulators; with COMPACT, the census counts, a fragment count a pixel.
 @group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
 // The tail's and the core's sums in 64-bit words (PIXEL_WORDS a pixel, above;
-// common/tail_words.wgsl); with COMPACT the slot-offset placeholder (never accessed; TAIL64 is
+// common/tail_words.wgsl); with COMPACT the slot-offset placeholder (never accessed; ATOMIC64 is
 // then 0, so that its 4 bytes fit).
-//!if TAIL64
+//!if ATOMIC64
 @group(2) @binding(4) var<storage, read_write> tail_words: array<atomic<u64>>;
 //!else
 @group(2) @binding(4) var<storage, read_write> tail_words: array<atomic<u32>>;

@@ -12,8 +12,8 @@
 
 @group(2) @binding(0) var<storage, read_write> ktab: array<atomic<u64>>;
 // The tail's count and sums, three 64-bit words a pixel. The method needs 64-bit atomic adds,
-// so it runs with TAIL64 only; the pairs of the other branch keep the shader valid without.
-//!if TAIL64
+// so it runs with ATOMIC64 only; the pairs of the other branch keep the shader valid without.
+//!if ATOMIC64
 @group(2) @binding(1) var<storage, read_write> tail_words: array<atomic<u64>>;
 //!else
 @group(2) @binding(1) var<storage, read_write> tail_words: array<atomic<u32>>;

@@ -10,10 +10,10 @@
 // add. Each term is at most 2^24 (TAIL_SCALE), so every field is exact while a pixel's tail has
 // fewer than TAIL_LIMIT = 2^18 fragments; the count itself holds up to 2^22 - 1, so fs_final can
 // tell a pixel past that (docs/methods.md, "hybrid").
-// With TAIL64 the words are 64-bit atomics (SHADER_INT64_ATOMIC_ALL_OPS). Without, each is a
+// With ATOMIC64 the words are 64-bit atomics (SHADER_INT64_ATOMIC_ALL_OPS). Without, each is a
 // (lo, hi) pair of 32-bit atomics with the carry between them taken from the value atomicAdd
 // returns: the same integers at two adds a word.
-// The including shader declares them, `tail_words: array<atomic<u64>>` with TAIL64 and
+// The including shader declares them, `tail_words: array<atomic<u64>>` with ATOMIC64 and
 // `array<atomic<u32>>` without, and says where a pixel's words start (hybrid64: three a pixel;
 // hybrid: six, its core's sums in three more words with the same adds, add_terms).
 
@@ -39,7 +39,7 @@ fn tail_from_sums(sum_c: vec3<f32>, sum_a: f32, count: u32) -> Tail {
 
 const TAIL_LIMIT: u32 = 262144u; // 2^18
 
-//!if TAIL64
+//!if ATOMIC64
 // Adds the 64-bit value v = (lo, hi) plus `carry` to word i; returns 1 when the word wrapped
 // past 2^64 (the carry into the next word).
 fn add_tail_word(i: u32, v: vec2<u32>, carry: u32) -> u32 {

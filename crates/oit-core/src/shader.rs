@@ -20,9 +20,10 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     // Whether the device honours @early_depth_test(force) (set by `module`): validated with
     // the shaders' own opaque-depth test.
     Const::U32("EARLY_DEPTH", 0),
-    // Whether the device has 64-bit atomic adds (set by `module`): hybrid's tail words are
-    // then 64-bit atomics, else pairs of 32-bit ones (shaders/common/tail_words.wgsl).
-    Const::U32("TAIL64", 0),
+    // Whether the device has 64-bit atomic adds, loads and stores (set by `module`): hybrid's
+    // tail words are then 64-bit atomics, else pairs of 32-bit ones (shaders/common/tail_words.wgsl),
+    // and adaptive's insert reads and writes a node with one atomic, else two.
+    Const::U32("ATOMIC64", 0),
     Const::U32("K", 8),
     Const::U32("PER_PIXEL", 0),
     Const::U32("TAIL", 1),
@@ -223,8 +224,8 @@ pub(crate) fn module(device: &wgpu::Device, path: &str, consts: &[Const]) -> wgp
     // hybrid's compact tail has no tail words: its binding holds a 4-byte placeholder, which the
     // 32-bit pairs' declaration accepts (a 64-bit array would need 8 bytes).
     let compact = consts.iter().any(|c| matches!(c, Const::U32("COMPACT", 1)));
-    let tail64 = device.features().contains(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS) && !compact;
-    all.push(Const::U32("TAIL64", tail64 as u32));
+    let atomic64 = device.features().contains(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS) && !compact;
+    all.push(Const::U32("ATOMIC64", atomic64 as u32));
     let mut text = compose(path, &all);
     if !early {
         text = text.replace(EARLY_DEPTH_TEST, "");

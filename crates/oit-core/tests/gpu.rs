@@ -115,8 +115,8 @@ fn census_by_blending_counts_what_atomics_count() {
     assert_eq!(exact_atomic.depth_complexity, blended.depth_complexity);
 }
 
-/// A device like `shared_context`'s without 64-bit atomics: hybrid's tail words are then pairs
-/// of 32-bit atomics (shaders/common/tail_words.wgsl).
+/// A device like `shared_context`'s without 64-bit atomics: hybrid's tail words and adaptive's
+/// nodes are then pairs of 32-bit atomics (shaders/common/tail_words.wgsl, shaders/adaptive.wgsl).
 fn context_without_int64() -> std::sync::Arc<oit_core::GpuContext> {
     let full = shared_context(None).expect("a GPU adapter (lavapipe in CI)");
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
@@ -138,7 +138,7 @@ fn context_without_int64() -> std::sync::Arc<oit_core::GpuContext> {
 }
 
 #[test]
-fn hybrid_tail_words_are_the_same_in_64_bit_atomics_and_32_bit_pairs() {
+fn words_are_the_same_in_64_bit_atomics_and_32_bit_pairs() {
     let full = shared_context(None).expect("a GPU adapter (lavapipe in CI)");
     if !full.features.contains(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS) {
         eprintln!("skipped: the adapter has no 64-bit atomic adds, so there is nothing to compare the pairs with");
@@ -162,5 +162,13 @@ fn hybrid_tail_words_are_the_same_in_64_bit_atomics_and_32_bit_pairs() {
         assert_eq!(a.stats.overflow_fragments, b.stats.overflow_fragments, "{method} k = {k}");
         assert_eq!(a.image, b.image, "{method} k = {k}: the two tails differ");
         assert_eq!(a.error_bound, b.error_bound, "{method} k = {k}");
+    }
+    // adaptive's insert reads and writes a node as one 64-bit atomic or as two 32-bit ones.
+    for nodes in [4, 8] {
+        let params = [("nodes".to_string(), oit_core::ParamValue::Int(nodes))];
+        let a = wide.render(&scene, &identity(), "adaptive", &params, [1.0; 3]).unwrap();
+        let b = pairs.render(&scene, &identity(), "adaptive", &params, [1.0; 3]).unwrap();
+        assert_eq!(a.stats.overflow_fragments, 0, "adaptive, {nodes} nodes: lock failures");
+        assert_eq!(a.image, b.image, "adaptive, {nodes} nodes: the two node forms differ");
     }
 }

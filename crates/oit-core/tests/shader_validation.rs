@@ -39,15 +39,15 @@ fn every_shader_validates_in_every_scene_variant() {
     }
 }
 
-/// hybrid's and hybrid64's tail words as 64-bit atomics (TAIL64, set per device) validate as
-/// well as the 32-bit pairs of the defaults.
+/// hybrid's and hybrid64's tail words and adaptive's insert nodes as 64-bit atomics (ATOMIC64,
+/// set per device) validate as well as the 32-bit pairs of the defaults.
 #[test]
-fn the_tail_words_validate_as_64_bit_atomics() {
-    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !matches!(c, Const::U32("TAIL64", _))).collect();
-    consts.push(Const::U32("TAIL64", 1));
-    for f in ["hybrid.wgsl", "hybrid64.wgsl"] {
+fn the_64_bit_atomic_variants_validate() {
+    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !matches!(c, Const::U32("ATOMIC64", _))).collect();
+    consts.push(Const::U32("ATOMIC64", 1));
+    for f in ["hybrid.wgsl", "hybrid64.wgsl", "adaptive.wgsl"] {
         let text = compose(f, &consts);
-        assert!(text.contains("array<atomic<u64>>"), "{f} with TAIL64 keeps 32-bit tail words");
+        assert!(text.contains("array<atomic<u64>>"), "{f} with ATOMIC64 keeps 32-bit words");
         validate_with(f, &consts);
     }
 }
