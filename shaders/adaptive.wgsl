@@ -146,19 +146,20 @@ fn fs_insert(raw: VsOut) {
 @group(3) @binding(0) var accum_tex: texture_2d<f32>;
 
 // Transmittance in front of depth z: the last step strictly nearer than z. The steps are
-// sorted by depth, so those nearer than z are a prefix and the walk stops at the first that is
-// not: a fragment loads the nodes in front of it and one more, not the pixel's every node.
+// sorted by depth, so those nearer than z are a prefix, found by a binary search: at most
+// log2(NODES) + 1 depth loads and one node load, where a walk along the prefix took as many
+// steps as the deepest lane of a SIMD group needed (up to NODES loads on deep pixels).
 fn vis(px: u32, z: f32) -> f32 {
-    let count = min(entries(px), NODES);
-    var t = 1.0;
-    for (var i = 0u; i < count; i++) {
-        let n = node(px, i);
-        if n.x >= z {
-            break;
-        }
-        t = n.y;
+    var lo = 0u;
+    var hi = min(entries(px), NODES);
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if node(px, mid).x < z { lo = mid + 1u; } else { hi = mid; }
     }
-    return t;
+    if lo == 0u {
+        return 1.0;
+    }
+    return node(px, lo - 1u).y;
 }
 
 @fragment @early_depth_test(force)
