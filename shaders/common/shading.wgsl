@@ -83,6 +83,7 @@ fn shade(in: VsOut) -> vec4<f32> {
         return vec4<f32>(hair(base.rgb, normalize(in.normal), v, m0) + extra, base.a);
     }
 //!endif
+//!if PHONG
     var n = normalize(in.normal);
     if (flags & TWO_SIDED) != 0u && dot(n, v) < 0.0 {
         n = -n;
@@ -99,6 +100,10 @@ fn shade(in: VsOut) -> vec4<f32> {
     }
     let rgb = clamp(base.rgb * diffuse + m0.x * highlight, vec3<f32>(0.0), vec3<f32>(1.0));
     return vec4<f32>(rgb + extra, base.a);
+//!else
+    // No surface of the scene shades flat or smooth (PHONG = 0): never reached.
+    return vec4<f32>(base.rgb + extra, base.a);
+//!endif
 }
 
 // The fragment with its shaded alpha (the same bits as shade()'s) and its vertex RGB: for

@@ -359,6 +359,7 @@ impl Renderer {
             instanced: scene.instanced,
             primitives: scene.primitives,
             sets_only: scene.sets_only,
+            phong: scene.phong,
         }
     }
 }

@@ -45,6 +45,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("INSTANCED", 1),
     Const::U32("PRIMITIVES", 1),
     Const::U32("SETS_ONLY", 0),
+    Const::U32("PHONG", 1),
     // Whether `expanded` is writable: the expansion pass of strands and particles only.
     Const::U32("EXPANDING", 0),
 ];
@@ -68,10 +69,14 @@ pub struct SceneVariant {
     pub instanced: bool,
     pub primitives: bool,
     pub sets_only: bool,
+    /// Whether any surface shades flat or smooth (Blinn-Phong): without one, a shaded scene
+    /// (strands shaded as hair, say) compiles without the light loop that llvmpipe would run,
+    /// masked, for every fragment.
+    pub phong: bool,
 }
 
 impl SceneVariant {
-    pub fn consts(&self) -> [Const; 8] {
+    pub fn consts(&self) -> [Const; 9] {
         [
             Const::U32("SHADED", self.shaded as u32),
             Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
@@ -80,6 +85,7 @@ impl SceneVariant {
             Const::U32("INSTANCED", self.instanced as u32),
             Const::U32("PRIMITIVES", self.primitives as u32),
             Const::U32("SETS_ONLY", (self.primitives && self.sets_only) as u32),
+            Const::U32("PHONG", (self.shaded && self.phong) as u32),
             // Only shaders/expand.wgsl writes the corners (its own //!define).
             Const::U32("EXPANDING", 0),
         ]
@@ -88,14 +94,69 @@ impl SceneVariant {
 
 /// Scene variants besides the defaults' that tests validate every shader in: unlit, lit
 /// without textures, the shading-cost knob on an unlit scene, an unlit instanced scene, and
-/// unlit strands or particles beside meshes, and lit strands or particles alone.
+/// unlit strands or particles beside meshes, and lit strands or particles alone (shaded as hair,
+/// without the Blinn-Phong code).
 pub const VALIDATION_VARIANTS: [SceneVariant; 6] = [
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false, primitives: false, sets_only: false },
-    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0, instanced: false, primitives: false, sets_only: false },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 3, instanced: false, primitives: false, sets_only: false },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: true, primitives: false, sets_only: false },
-    SceneVariant { shaded: false, lights: 0, textured: false, shading_cost: 0, instanced: false, primitives: true, sets_only: false },
-    SceneVariant { shaded: true, lights: 1, textured: false, shading_cost: 0, instanced: false, primitives: true, sets_only: true },
+    SceneVariant {
+        shaded: false,
+        lights: 0,
+        textured: false,
+        shading_cost: 0,
+        instanced: false,
+        primitives: false,
+        sets_only: false,
+        phong: true,
+    },
+    SceneVariant {
+        shaded: true,
+        lights: 1,
+        textured: false,
+        shading_cost: 0,
+        instanced: false,
+        primitives: false,
+        sets_only: false,
+        phong: true,
+    },
+    SceneVariant {
+        shaded: false,
+        lights: 0,
+        textured: false,
+        shading_cost: 3,
+        instanced: false,
+        primitives: false,
+        sets_only: false,
+        phong: true,
+    },
+    SceneVariant {
+        shaded: false,
+        lights: 0,
+        textured: false,
+        shading_cost: 0,
+        instanced: true,
+        primitives: false,
+        sets_only: false,
+        phong: true,
+    },
+    SceneVariant {
+        shaded: false,
+        lights: 0,
+        textured: false,
+        shading_cost: 0,
+        instanced: false,
+        primitives: true,
+        sets_only: false,
+        phong: true,
+    },
+    SceneVariant {
+        shaded: true,
+        lights: 1,
+        textured: false,
+        shading_cost: 0,
+        instanced: false,
+        primitives: true,
+        sets_only: true,
+        phong: false,
+    },
 ];
 
 /// `DEFAULT_CONSTS` with `variant`'s constants in place of the defaults of the same names.

@@ -138,6 +138,8 @@ pub struct GpuScene {
     /// meshes at all, opaque or not (the constant SETS_ONLY).
     pub primitives: bool,
     pub sets_only: bool,
+    /// Whether any surface, opaque or not, shades flat or smooth (the constant PHONG).
+    pub phong: bool,
     /// The matrices (`execute::expansion_view`) the corners in `expanded` were last built
     /// under; None until the first expansion.
     pub expanded_view: std::cell::Cell<Option<[u32; 32]>>,
@@ -552,8 +554,20 @@ impl GpuScene {
         let textured = shaded && scene.meshes().iter().any(|m| m.material.texture.is_some());
         let primitives = scene.meshes().iter().any(|m| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair);
         let sets_only = scene.meshes().iter().all(|m| m.primitive != Primitive::Triangles);
+        let phong = scene.meshes().iter().any(|m| matches!(m.material.shading, Shading::Flat | Shading::Smooth));
         let instances = scene.instance_count() as u64;
-        Ok(Self { transparent, opaque, shaded, textured, instanced, instances, primitives, sets_only, expanded_view: Default::default() })
+        Ok(Self {
+            transparent,
+            opaque,
+            shaded,
+            textured,
+            instanced,
+            instances,
+            primitives,
+            sets_only,
+            phong,
+            expanded_view: Default::default(),
+        })
     }
 }
 

@@ -63,6 +63,17 @@ fn an_unlit_variant_has_no_shading_varyings() {
 }
 
 #[test]
+fn strands_shaded_as_hair_alone_compile_without_the_blinn_phong_loop() {
+    let hair = SceneVariant { shaded: true, lights: 1, primitives: true, sets_only: true, ..Default::default() };
+    let phong = SceneVariant { phong: true, ..hair };
+    let without = compose("blend.wgsl", &variant_consts(hair));
+    let with = compose("blend.wgsl", &variant_consts(phong));
+    assert!(without.contains("fn hair("), "the hair shading is missing");
+    assert!(!without.contains("dot(n, h)"), "a scene without flat or smooth surfaces kept the Blinn-Phong loop");
+    assert!(with.contains("dot(n, h)"), "a scene with flat or smooth surfaces lost the Blinn-Phong loop");
+}
+
+#[test]
 #[should_panic(expected = "no u32 constant NOT_A_CONSTANT")]
 fn an_if_on_an_unknown_constant_is_refused() {
     oit_core::shader::expand_text("t.wgsl", "//!if NOT_A_CONSTANT\nx\n//!endif\n", &[]);
