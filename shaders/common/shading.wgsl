@@ -60,7 +60,7 @@ fn surface_base(in: VsOut, m0: vec4<f32>) -> vec4<f32> {
     }
 //!endif
     base.a = base.a * m0.z;
-//!if PRIMITIVES
+//!if FALLOFF
     base.a = base.a * falloff((bitcast<u32>(m0.w) & FALLOFF_MASK) >> FALLOFF_SHIFT, in.uv);
 //!endif
     return base;

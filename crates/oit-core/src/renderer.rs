@@ -360,6 +360,7 @@ impl Renderer {
             primitives: scene.primitives,
             sets_only: scene.sets_only,
             phong: scene.phong,
+            falloff: scene.falloff,
         }
     }
 }

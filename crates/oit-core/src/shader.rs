@@ -46,6 +46,7 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("PRIMITIVES", 1),
     Const::U32("SETS_ONLY", 0),
     Const::U32("PHONG", 1),
+    Const::U32("FALLOFF", 1),
     // Whether `expanded` is writable: the expansion pass of strands and particles only.
     Const::U32("EXPANDING", 0),
 ];
@@ -73,10 +74,13 @@ pub struct SceneVariant {
     /// (strands shaded as hair, say) compiles without the light loop that llvmpipe would run,
     /// masked, for every fragment.
     pub phong: bool,
+    /// Whether any particle set fades its alpha towards its rim (a falloff): without one, the
+    /// falloff's code is not compiled.
+    pub falloff: bool,
 }
 
 impl SceneVariant {
-    pub fn consts(&self) -> [Const; 9] {
+    pub fn consts(&self) -> [Const; 10] {
         [
             Const::U32("SHADED", self.shaded as u32),
             Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
@@ -86,6 +90,7 @@ impl SceneVariant {
             Const::U32("PRIMITIVES", self.primitives as u32),
             Const::U32("SETS_ONLY", (self.primitives && self.sets_only) as u32),
             Const::U32("PHONG", (self.shaded && self.phong) as u32),
+            Const::U32("FALLOFF", (self.shaded && self.primitives && self.falloff) as u32),
             // Only shaders/expand.wgsl writes the corners (its own //!define).
             Const::U32("EXPANDING", 0),
         ]
@@ -106,6 +111,7 @@ pub const VALIDATION_VARIANTS: [SceneVariant; 6] = [
         primitives: false,
         sets_only: false,
         phong: true,
+        falloff: true,
     },
     SceneVariant {
         shaded: true,
@@ -116,6 +122,7 @@ pub const VALIDATION_VARIANTS: [SceneVariant; 6] = [
         primitives: false,
         sets_only: false,
         phong: true,
+        falloff: true,
     },
     SceneVariant {
         shaded: false,
@@ -126,6 +133,7 @@ pub const VALIDATION_VARIANTS: [SceneVariant; 6] = [
         primitives: false,
         sets_only: false,
         phong: true,
+        falloff: true,
     },
     SceneVariant {
         shaded: false,
@@ -136,6 +144,7 @@ pub const VALIDATION_VARIANTS: [SceneVariant; 6] = [
         primitives: false,
         sets_only: false,
         phong: true,
+        falloff: true,
     },
     SceneVariant {
         shaded: false,
@@ -146,6 +155,7 @@ pub const VALIDATION_VARIANTS: [SceneVariant; 6] = [
         primitives: true,
         sets_only: false,
         phong: true,
+        falloff: true,
     },
     SceneVariant {
         shaded: true,
@@ -156,6 +166,7 @@ pub const VALIDATION_VARIANTS: [SceneVariant; 6] = [
         primitives: true,
         sets_only: true,
         phong: false,
+        falloff: false,
     },
 ];
 

@@ -138,8 +138,10 @@ pub struct GpuScene {
     /// meshes at all, opaque or not (the constant SETS_ONLY).
     pub primitives: bool,
     pub sets_only: bool,
-    /// Whether any surface, opaque or not, shades flat or smooth (the constant PHONG).
+    /// Whether any surface, opaque or not, shades flat or smooth (the constant PHONG), and
+    /// whether any has a falloff (FALLOFF).
     pub phong: bool,
+    pub falloff: bool,
     /// The matrices (`execute::expansion_view`) the corners in `expanded` were last built
     /// under; None until the first expansion.
     pub expanded_view: std::cell::Cell<Option<[u32; 32]>>,
@@ -555,6 +557,7 @@ impl GpuScene {
         let primitives = scene.meshes().iter().any(|m| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair);
         let sets_only = scene.meshes().iter().all(|m| m.primitive != Primitive::Triangles);
         let phong = scene.meshes().iter().any(|m| matches!(m.material.shading, Shading::Flat | Shading::Smooth));
+        let falloff = scene.meshes().iter().any(|m| m.material.falloff != crate::shading::Falloff::None);
         let instances = scene.instance_count() as u64;
         Ok(Self {
             transparent,
@@ -566,6 +569,7 @@ impl GpuScene {
             primitives,
             sets_only,
             phong,
+            falloff,
             expanded_view: Default::default(),
         })
     }

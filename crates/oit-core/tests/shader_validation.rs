@@ -63,7 +63,7 @@ fn an_unlit_variant_has_no_shading_varyings() {
 }
 
 #[test]
-fn strands_shaded_as_hair_alone_compile_without_the_blinn_phong_loop() {
+fn strands_shaded_as_hair_alone_compile_without_the_blinn_phong_loop_or_a_falloff() {
     let hair = SceneVariant { shaded: true, lights: 1, primitives: true, sets_only: true, ..Default::default() };
     let phong = SceneVariant { phong: true, ..hair };
     let without = compose("blend.wgsl", &variant_consts(hair));
@@ -71,6 +71,10 @@ fn strands_shaded_as_hair_alone_compile_without_the_blinn_phong_loop() {
     assert!(without.contains("fn hair("), "the hair shading is missing");
     assert!(!without.contains("dot(n, h)"), "a scene without flat or smooth surfaces kept the Blinn-Phong loop");
     assert!(with.contains("dot(n, h)"), "a scene with flat or smooth surfaces lost the Blinn-Phong loop");
+    // Nor with a particle falloff, where no set has one.
+    let falloff = compose("blend.wgsl", &variant_consts(SceneVariant { falloff: true, ..hair }));
+    assert!(!without.contains("* falloff("), "a scene without a falloff kept its code");
+    assert!(falloff.contains("* falloff("), "a scene with a falloff lost its code");
 }
 
 #[test]
