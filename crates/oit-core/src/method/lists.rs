@@ -351,12 +351,14 @@ impl ListMethod {
             4 * self.pool.state_len().max(1),
         )?;
         // A tile of a larger frame gets a pool of its counted fragments, so that tiles planned
-        // within a memory budget stay in it; a whole frame keeps the pool it has while it fits.
+        // within a memory budget stay in it; a whole frame keeps the pool it has, grown to the
+        // census's count where that is more (a first frame, or a moving camera, renders once,
+        // not again after an overflow). Where nodes are not fragments (pall's are its triangles'
+        // bounds) the capture's own count still regrows the pool below.
         let tiled = !tile.is_whole();
-        let initial = match (tiled, self.pool.capacity) {
-            (true, _) => cx.fragments.clamp(1, self.pool.max_nodes()),
-            (false, 0) => pixels.min(self.pool.max_nodes()),
-            (false, c) => c,
+        let initial = match tiled {
+            true => cx.fragments.clamp(1, self.pool.max_nodes()),
+            false => self.pool.capacity.max(cx.fragments).clamp(1, self.pool.max_nodes()),
         };
         let costs = self.step_costs(cx);
         let budget = if self.sweeps.is_some() { step_budget(cx.gpu, costs)? } else { 1 };
