@@ -61,8 +61,8 @@ fn vis_store(i: u32, v: f32) {
 // The accumulators; with COMPACT, the census counts, a fragment count a pixel.
 @group(2) @binding(2) var<storage, read_write> accum: array<atomic<u32>>;
 // The tail's and the core's sums in 64-bit words (PIXEL_WORDS a pixel, above;
-// common/tail_words.wgsl); with COMPACT the slot-offset placeholder (never accessed; ATOMIC64 is
-// then 0, so that its 4 bytes fit).
+// common/tail_words.wgsl); with COMPACT the slot-offset placeholder (never accessed; the
+// compact pipelines set ATOMIC64 to 0, so that its 4 bytes fit).
 //!if ATOMIC64
 @group(2) @binding(4) var<storage, read_write> tail_words: array<atomic<u64>>;
 //!else
@@ -340,8 +340,8 @@ fn fs_final(@builtin(position) pos: vec4<f32>) -> Final {
     let quant = vec2<f32>(read_fixed32(c1.y), read_fixed32(c2.x));
     let lo_hi = vec2<f32>(bitcast<f32>(~word(acc + TAIL_LO)), bitcast<f32>(word(acc + TAIL_HI)));
     var out = finish(pos, core, bitcast<f32>(c2.y), count, tail, quant, lo_hi, 0.0);
-    if TAIL != 0u && count >= TAIL_LIMIT {
-        out.bound = max(out.bound, 1.0); // the packed sums may have wrapped: the tail can be anything
+    if TAIL != 0u {
+        out.bound = tail_bound(out.bound, count);
     }
     return out;
 }

@@ -103,8 +103,6 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
     if count > 0u {
         bound += t_core;
     }
-    if count >= TAIL_LIMIT {
-        bound = max(bound, 1.0); // the packed sums may have wrapped: the tail can be anything
-    }
+    bound = tail_bound(bound, count);
     return Final(vec4<f32>(rgb, 1.0 - t_core * tail.trans * (1.0 - base.a)), bound);
 }

@@ -39,6 +39,12 @@ fn tail_from_sums(sum_c: vec3<f32>, sum_a: f32, count: u32) -> Tail {
 
 const TAIL_LIMIT: u32 = 262144u; // 2^18
 
+// A pixel's error bound, 1 where its tail passed TAIL_LIMIT: the packed sums may have wrapped,
+// so the tail can be anything.
+fn tail_bound(bound: f32, count: u32) -> f32 {
+    return select(bound, max(bound, 1.0), count >= TAIL_LIMIT);
+}
+
 //!if ATOMIC64
 // Adds the 64-bit value v = (lo, hi) plus `carry` to word i; returns 1 when the word wrapped
 // past 2^64 (the carry into the next word).

@@ -20,7 +20,8 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     // Whether the device honours @early_depth_test(force) (set by `module`): validated with
     // the shaders' own opaque-depth test.
     Const::U32("EARLY_DEPTH", 0),
-    // Whether the device has 64-bit atomic adds, loads and stores (set by `module`): hybrid's
+    // Whether the device has 64-bit atomic adds, loads and stores (set by `module` where the
+    // pipeline's constants do not say): hybrid's
     // tail words are then 64-bit atomics, else pairs of 32-bit ones (shaders/common/tail_words.wgsl),
     // and adaptive's insert reads and writes a node with one atomic, else two.
     Const::U32("ATOMIC64", 0),
@@ -246,11 +247,11 @@ pub(crate) fn module(device: &wgpu::Device, path: &str, consts: &[Const]) -> wgp
     let early = device.features().contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
     let mut all = consts.to_vec();
     all.push(Const::U32("EARLY_DEPTH", early as u32));
-    // hybrid's compact tail has no tail words: its binding holds a 4-byte placeholder, which the
-    // 32-bit pairs' declaration accepts (a 64-bit array would need 8 bytes).
-    let compact = consts.iter().any(|c| matches!(c, Const::U32("COMPACT", 1)));
-    let atomic64 = device.features().contains(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS) && !compact;
-    all.push(Const::U32("ATOMIC64", atomic64 as u32));
+    // The device's 64-bit atomics, unless the pipeline asks for the 32-bit form itself.
+    if !consts.iter().any(|c| matches!(c, Const::U32("ATOMIC64", _))) {
+        let atomic64 = device.features().contains(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS);
+        all.push(Const::U32("ATOMIC64", atomic64 as u32));
+    }
     let mut text = compose(path, &all);
     if !early {
         text = text.replace(EARLY_DEPTH_TEST, "");

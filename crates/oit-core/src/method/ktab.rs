@@ -13,18 +13,18 @@ use crate::shader::Const;
 /// Words per pixel of the accumulators, and of the sums (their own binding: the tail's count
 /// and sums, the core's sums and T_core, in 64-bit words).
 pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_ACCUM_WORDS as u64;
-pub const TAIL_WORDS: u64 = (crate::consts::HYBRID_TAIL_WORDS + crate::consts::HYBRID_CORE_WORDS) as u64;
+pub const SUM_WORDS: u64 = (crate::consts::HYBRID_TAIL_WORDS + crate::consts::HYBRID_CORE_WORDS) as u64;
 
 /// Bytes at W x H pixels with core size k: k-TAB and visibility (k words each), the
 /// accumulators and sums, the slot-offset placeholder (a word: every pixel has k slots)
 /// and the overflow counter.
 pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
-    pixels * (2 * k + ACCUM_WORDS + TAIL_WORDS) * 4 + 8
+    pixels * (2 * k + ACCUM_WORDS + SUM_WORDS) * 4 + 8
 }
 
 /// Bytes with tail = "compact" (Eq. 12's 2k + 2 words a pixel): k-TAB and visibility (k words
 /// each) and the tail's RGBA16F sums (2 words), plus the slot-offset placeholder (which also
-/// fills the tail words' binding: this tail has none) and the overflow counter.
+/// fills the sums' binding: this tail has none) and the overflow counter.
 pub fn compact_memory_bytes(pixels: u64, k: u64) -> u64 {
     pixels * (2 * k + COMPACT_TAIL_WORDS) * 4 + 8
 }
@@ -41,7 +41,7 @@ const COMPACT_BINDINGS: &[u32] = &[4];
 /// each per slot), the accumulators and sums, the per-pixel offsets (pixels + 1 words) and
 /// the counter.
 pub fn memory_bytes_per_pixel(pixels: u64, slots: u64) -> u64 {
-    2 * slots * 4 + pixels * (ACCUM_WORDS + TAIL_WORDS) * 4 + (pixels + 1) * 4 + 4
+    2 * slots * 4 + pixels * (ACCUM_WORDS + SUM_WORDS) * 4 + (pixels + 1) * 4 + 4
 }
 
 /// How many k-TAB slots each pixel gets.
@@ -54,7 +54,7 @@ pub(crate) enum Slots<'s> {
 
 /// Bindings of the per-pixel slot offsets and of the sums in the group (shaders/hybrid.wgsl).
 const OFFSETS: usize = 3;
-const TAIL: usize = 4;
+const SUMS: usize = 4;
 
 const SHADER: &str = "hybrid.wgsl";
 /// Group 2: k-TAB, core visibility, accumulators, slot offsets, sums, then the overflow
@@ -150,11 +150,11 @@ impl KTab {
         let pixels = cx.pixels();
         match slots {
             Slots::Uniform(k) => {
-                cx.check_per_pixel(&format!("{name} with k = {k}"), 4 * (*k as u64).max(ACCUM_WORDS).max(TAIL_WORDS))?;
+                cx.check_per_pixel(&format!("{name} with k = {k}"), 4 * (*k as u64).max(ACCUM_WORDS).max(SUM_WORDS))?;
                 Ok((pixels * *k as u64, false))
             }
             Slots::PerPixel(s) => {
-                cx.check_per_pixel(&format!("{name}'s accumulators"), 4 * ACCUM_WORDS.max(TAIL_WORDS))?;
+                cx.check_per_pixel(&format!("{name}'s accumulators"), 4 * ACCUM_WORDS.max(SUM_WORDS))?;
                 let total: u64 = s.iter().map(|&k| k as u64).sum();
                 if total * 4 > cx.limits.max_binding_bytes {
                     return Err(OitError::OutOfMemory(format!(
@@ -190,7 +190,7 @@ impl KTab {
             ("core visibility", total.max(1) * 4),
             ("hybrid accumulators", pixels * ACCUM_WORDS * 4),
             ("slot offsets", if per_pixel { (pixels + 1) * 4 } else { 4 }),
-            ("hybrid sums", pixels * TAIL_WORDS * 4),
+            ("hybrid sums", pixels * SUM_WORDS * 4),
         ];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[overflow]);
         if let Slots::PerPixel(s) = slots {
@@ -205,7 +205,7 @@ impl KTab {
         let mut enc = cx.encoder();
         enc.clear_buffer(&b.buffers[0], 0, None);
         enc.clear_buffer(&b.buffers[2], 0, None);
-        enc.clear_buffer(&b.buffers[TAIL], 0, None);
+        enc.clear_buffer(&b.buffers[SUMS], 0, None);
         overflow.clear(&mut enc);
         cx.capture(&mut enc, "store", &cx.capture_pipeline(spec(PIPELINES, "fs_store"), &consts), &b.group);
         cx.dispatch(&mut enc, "visibility", &cx.compute_pipeline(spec(PIPELINES, "cs_visibility"), &consts), &b.group);
@@ -267,7 +267,10 @@ impl KTab {
             overflow.buffer.as_entire_binding(),
         ];
         let group = cx.group(Layout::Storage(6), &resources);
-        let consts = [Const::U32("K", k), Const::U32("PER_PIXEL", 0), Const::U32("TAIL", 1), Const::U32("COMPACT", 1)];
+        // ATOMIC64 0: the sums' binding holds the 4-byte slot-offset placeholder, which the 32-bit
+        // pairs' declaration accepts (a 64-bit array would need 8 bytes); nothing reads it.
+        let consts =
+            [Const::U32("K", k), Const::U32("PER_PIXEL", 0), Const::U32("TAIL", 1), Const::U32("COMPACT", 1), Const::U32("ATOMIC64", 0)];
         let sums = FloatTargets::ensure(&mut self.compact, cx, &[COMPACT_FORMAT], COMPACT_BINDINGS);
         let shade = cx.draw_pipeline(
             spec(PIPELINES, "fs_shade_compact"),

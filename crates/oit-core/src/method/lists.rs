@@ -356,10 +356,7 @@ impl ListMethod {
         // not again after an overflow). Where nodes are not fragments (pall's are its triangles'
         // bounds) the capture's own count still regrows the pool below.
         let tiled = !tile.is_whole();
-        let initial = match tiled {
-            true => cx.fragments.clamp(1, self.pool.max_nodes()),
-            false => self.pool.capacity.max(cx.fragments).clamp(1, self.pool.max_nodes()),
-        };
+        let initial = if tiled { cx.fragments } else { self.pool.capacity.max(cx.fragments) }.clamp(1, self.pool.max_nodes());
         let costs = self.step_costs(cx);
         let budget = if self.sweeps.is_some() { step_budget(cx.gpu, costs)? } else { 1 };
         let sweeps = if self.sweeps.is_some() { resolve_dispatches(cx.max_depth_complexity as u64, costs, budget) } else { [0; 3] };
