@@ -25,6 +25,9 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     // tail words are then 64-bit atomics, else pairs of 32-bit ones (shaders/common/tail_words.wgsl),
     // and adaptive's insert reads and writes a node with one atomic, else two.
     Const::U32("ATOMIC64", 0),
+    // Whether the device has 64-bit integers (set by `module` where the pipeline's constants do
+    // not say): the sorted resolve's keys are then one 64-bit word each (shaders/common/sweep.wgsl).
+    Const::U32("INT64", 0),
     Const::U32("K", 8),
     Const::U32("PER_PIXEL", 0),
     Const::U32("TAIL", 1),
@@ -251,6 +254,9 @@ pub(crate) fn module(device: &wgpu::Device, path: &str, consts: &[Const]) -> wgp
     if !consts.iter().any(|c| matches!(c, Const::U32("ATOMIC64", _))) {
         let atomic64 = device.features().contains(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS);
         all.push(Const::U32("ATOMIC64", atomic64 as u32));
+    }
+    if !consts.iter().any(|c| matches!(c, Const::U32("INT64", _))) {
+        all.push(Const::U32("INT64", device.features().contains(wgpu::Features::SHADER_INT64) as u32));
     }
     let mut text = compose(path, &all);
     if !early {

@@ -52,6 +52,19 @@ fn the_64_bit_atomic_variants_validate() {
     }
 }
 
+/// The sorted resolve's keys as 64-bit words (INT64, set per device) validate as well as the
+/// pairs of 32-bit words of the defaults.
+#[test]
+fn the_64_bit_sort_keys_validate() {
+    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !matches!(c, Const::U32("INT64", _))).collect();
+    consts.push(Const::U32("INT64", 1));
+    for f in ["abuffer.wgsl", "sbuffer.wgsl", "pall.wgsl", "abuffer_coverage.wgsl"] {
+        let text = compose(f, &consts);
+        assert!(text.contains("alias Entry = u64;"), "{f} with INT64 keeps keys of two words");
+        validate_with(f, &consts);
+    }
+}
+
 #[test]
 fn an_unlit_variant_has_no_shading_varyings() {
     let unlit = compose("blend.wgsl", &variant_consts(SceneVariant::default()));
