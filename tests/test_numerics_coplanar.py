@@ -31,6 +31,7 @@ from numerics import (
     params_for,
     tolerance,
 )
+from oit import geometry
 from scenes import IDENTITY, MeshData, build_scene, layer, random_meshes
 
 SIZE = (16, 16)
@@ -163,3 +164,39 @@ def test_exact_methods_agree_on_coplanar_triangles(renderer, name):
     meshes = SCENES["triangles-equal"]()
     a, b = render(renderer, meshes, EXACT[0]).image, render(renderer, meshes, name).image
     assert np.abs(a - b).max() <= 2 * tolerance(name, 8)
+
+
+def _deep_tied_stacks():
+    """Two stacks side by side in one frame, so that the sorted resolve's runs hold more than
+    one block (its keys are then sorted by depth and link, and equal depths put in the tie rule's
+    order afterwards): on the left seven layers (six tied), within one block of eight, on the
+    right 22 (twelve tied, at two depths). The left half's pixels are the ones a frame with
+    only them would sort by the whole order at once."""
+    rng = np.random.default_rng(3)
+    colors = [(*rng.uniform(0, 1, 3), a) for a in rng.uniform(0.1, 0.6, 16)]
+    left = [(0.5, c) for c in colors[:6]] + [(0.3, colors[6])]
+    right = [(0.5, c) for c in colors[6:12]] + [(0.7, c) for c in colors[10:16]]
+    right += [(0.05 + 0.04 * i, colors[i]) for i in range(10)]
+    return left, right
+
+
+def _half(z, rgba, x):
+    positions, indices = geometry.quad((x, 0.0, z), 1.0)
+    return MeshData(positions, indices, np.tile(np.asarray(rgba, dtype=np.float32), (4, 1)))
+
+
+@pytest.mark.parametrize("name", [n for n in EXACT if n not in SUBMISSION_TIES])
+def test_ties_in_runs_longer_than_one_block(renderer, name):
+    # The exact methods' runs past eight entries sort by depth and link and then order equal
+    # depths by the tie rule; a frame whose runs are long sorts even a shallow pixel that way.
+    left, right = _deep_tied_stacks()
+    meshes = [_half(z, c, -0.5) for z, c in left] + [_half(z, c, 0.5) for z, c in right]
+    frames = [render(renderer, m, name) for m in shuffles(meshes, 6)]
+    first = frames[0]
+    assert first.stats["max_depth_complexity"] == len(right)
+    for i, f in enumerate(frames[1:], 1):
+        assert np.array_equal(f.image, first.image), f"shuffle {i}"
+    for stack, (row, col) in ((left, (8, 4)), (right, (8, 12))):
+        z, rgb, a = layer_arrays(stack)
+        want = expected(name, z, rgb, a, BG, **params_for(name))
+        assert np.abs(first.image[row, col] - want).max() <= tolerance(name, len(stack)), (name, row, col)

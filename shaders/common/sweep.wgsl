@@ -192,6 +192,10 @@ fn entry_link(e: Entry) -> u32 {
 }
 //!endif
 
+fn same_depth(a: Entry, b: Entry) -> bool {
+    return entry_depth(a) == entry_depth(b);
+}
+
 // frag_less's order: the keys', loading both nodes for equal depths. Counts each comparison in
 // `steps` as one with the loads (a lane without the tie loads nothing, but llvmpipe's loop
 // limiter cannot tell).
@@ -229,6 +233,10 @@ fn entry_link(e: Entry) -> u32 {
 
 fn entry_frag(e: Entry, px: u32) -> Frag {
     return e;
+}
+
+fn same_depth(a: Entry, b: Entry) -> bool {
+    return a.depth == b.depth;
 }
 //!endif
 
@@ -273,7 +281,10 @@ fn before(a: Entry, b: Entry, px: u32, steps: ptr<function, u32>, whole: bool) -
 // otherwise in the keys' order: blocks of BLOCK by insertion, then merged bottom-up from one
 // half of the array into the other (O(n log n), where insertion alone takes O(n^2) on the deep
 // pixels that set a SIMD group's pace), and order_ties finishes. Returns the steps taken.
-fn sort_keys(run: ptr<function, Run>, n: u32, px: u32) -> u32 {
+// `tie` is set when two sorted entries are at one depth (in the keys' order, where frag_less
+// still has to order them): found as the last merge level writes the entries, or, when one
+// block holds the run, by a walk over it.
+fn sort_keys(run: ptr<function, Run>, n: u32, px: u32, tie: ptr<function, bool>) -> u32 {
     if RUN == BLOCK {
         return insertion_sort(run, 0u, n, px, true);
     }
@@ -281,9 +292,19 @@ fn sort_keys(run: ptr<function, Run>, n: u32, px: u32) -> u32 {
     for (var lo = 0u; lo < n; lo += BLOCK) {
         steps += 1u + insertion_sort(run, lo, min(lo + BLOCK, n), px, false);
     }
+    // One block: the walk (no lane of a SIMD group whose runs are all longer enters it).
+    var prev = (*run).entries[0];
+    for (var k = 1u; k < select(0u, n, n <= BLOCK); k++) {
+        let e = (*run).entries[k];
+        *tie = *tie || same_depth(e, prev);
+        prev = e;
+    }
+    steps += n;
     var src = 0u;
     for (var width = BLOCK; width < n; width *= 2u) {
         let dst = RUN - src;
+        // The last level (one pair) leaves its own answer.
+        *tie = false;
         for (var lo = 0u; lo < n; lo += 2u * width) {
             let mid = min(lo + width, n);
             let hi = min(lo + 2u * width, n);
@@ -291,7 +312,10 @@ fn sort_keys(run: ptr<function, Run>, n: u32, px: u32) -> u32 {
             var b = mid;
             for (var k = lo; k < hi; k++) {
                 let take_b = b < hi && (a >= mid || key_less((*run).entries[src + b], (*run).entries[src + a]));
-                (*run).entries[dst + k] = (*run).entries[select(src + a, src + b, take_b)];
+                let e = (*run).entries[select(src + a, src + b, take_b)];
+                *tie = *tie || (k > lo && same_depth(e, prev));
+                prev = e;
+                (*run).entries[dst + k] = e;
                 a += select(1u, 0u, take_b);
                 b += select(0u, 1u, take_b);
             }
@@ -353,10 +377,14 @@ fn load_run(link: u32, px: u32, run: ptr<function, Run>, steps: ptr<function, u3
         at = w.next;
         n++;
     }
-    var sorting = sort_keys(run, n, px);
+    var tie = false;
+    var sorting = sort_keys(run, n, px, &tie);
 //!if KEYED
+    // Only runs with equal depths (rare) walk their entries again: a SIMD group without one
+    // leaves the loop at once, where its body (two node loads, frag_less) would otherwise run
+    // masked for every entry.
     if RUN > BLOCK {
-        sorting += order_ties(run, n, px);
+        sorting += order_ties(run, select(0u, n, tie), px);
     }
 //!endif
     (*run).n = n;
