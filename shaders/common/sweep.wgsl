@@ -299,7 +299,7 @@ fn sort_keys(run: ptr<function, Run>, n: u32, px: u32, tie: ptr<function, bool>)
         *tie = *tie || same_depth(e, prev);
         prev = e;
     }
-    steps += n;
+    steps += 1u + select(0u, n, n <= BLOCK);
     var src = 0u;
     for (var width = BLOCK; width < n; width *= 2u) {
         let dst = RUN - src;

@@ -56,12 +56,13 @@ impl StepCosts {
     }
 
     /// Steps of sweep.wgsl's `sort_keys` on n entries: the blocks' insertion sorts (at most
-    /// (BLOCK - 1)(BLOCK + 2) / 2 a block), then each merge level (a step a pair, an entry
-    /// and the level) and the copy back when the levels end in the upper half.
+    /// (BLOCK - 1)(BLOCK + 2) / 2 a block), the walk that looks for equal depths in a run of one
+    /// block, then each merge level (a step a pair, an entry and the level) and the copy back
+    /// when the levels end in the upper half.
     fn sort_keys(n: u64) -> u64 {
         let blocks = n.div_ceil(BLOCK);
         let full = (BLOCK - 1) * (BLOCK + 2) / 2;
-        let mut steps = blocks * (1 + full);
+        let mut steps = blocks * (1 + full) + 1 + if n <= BLOCK { n } else { 0 };
         let (mut width, mut levels) = (BLOCK, 0);
         while width < n {
             steps += n + n.div_ceil(2 * width) + 1;
@@ -163,15 +164,16 @@ mod tests {
 
     #[test]
     fn the_local_sort_counts_its_blocks_levels_and_copy() {
-        // 8 entries: one block of at most 35 shifts, no merge.
-        assert_eq!(StepCosts::sort_keys(8), 36);
-        // 20 entries: 3 blocks, then levels of width 8 (2 pairs) and 16 (1 pair), ending in
-        // the lower half (no copy).
-        assert_eq!(StepCosts::sort_keys(20), 3 * 36 + (20 + 2 + 1) + (20 + 1 + 1));
+        // 8 entries: one block of at most 35 shifts, no merge; the walk for equal depths (a
+        // step, and one an entry).
+        assert_eq!(StepCosts::sort_keys(8), 36 + 1 + 8);
+        // 20 entries: 3 blocks, a step for the walk no lane enters, then levels of width 8
+        // (2 pairs) and 16 (1 pair), ending in the lower half (no copy).
+        assert_eq!(StepCosts::sort_keys(20), 3 * 36 + 1 + (20 + 2 + 1) + (20 + 1 + 1));
         // 128 entries: 16 blocks, 4 levels (8, 16, 32, 64), no copy.
-        assert_eq!(StepCosts::sort_keys(128), 16 * 36 + (128 + 8 + 1) + (128 + 4 + 1) + (128 + 2 + 1) + (128 + 1 + 1));
+        assert_eq!(StepCosts::sort_keys(128), 16 * 36 + 1 + (128 + 8 + 1) + (128 + 4 + 1) + (128 + 2 + 1) + (128 + 1 + 1));
         // 64: 3 levels, so the result is copied back.
-        assert_eq!(StepCosts::sort_keys(64), 8 * 36 + (64 + 4 + 1) + (64 + 2 + 1) + (64 + 1 + 1) + 64);
+        assert_eq!(StepCosts::sort_keys(64), 8 * 36 + 1 + (64 + 4 + 1) + (64 + 2 + 1) + (64 + 1 + 1) + 64);
     }
 
     #[test]
