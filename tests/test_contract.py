@@ -189,6 +189,51 @@ def test_the_census_runs_where_the_method_needs_it_or_the_caller_asks(renderer, 
         assert plain.depth_complexity is None
 
 
+@pytest.mark.parametrize("method", ["abuffer", "compact_abuffer"])
+def test_a_capture_that_counts_replaces_the_census_after_the_first_frame(method):
+    """abuffer and compact_abuffer count each pixel's fragments in their own capture once an
+    earlier frame sized their pool: the frame then runs no census, and reports the counts the
+    census gives, with the same image. A frame that asks for the census, or that has a budget,
+    runs it."""
+    r = oit.Renderer(24, 16)
+    scene = build_scene([layer(z, (0.5, 0.5, 0.5, 0.5)) for z in (0.2, 0.4, 0.6)]
+                        + [layer(0.3, (0.2, 0.9, 0.1, 0.7), size=1.0)])
+    first = r.render(scene, IDENTITY, method=method)
+    again = r.render(scene, IDENTITY, method=method)
+    asked = r.render(scene, IDENTITY, method=method, census=True)
+    assert first.stats["extra"]["counted_in_capture"] == 0.0
+    assert again.stats["extra"]["counted_in_capture"] == 1.0
+    assert asked.stats["extra"]["counted_in_capture"] == 0.0
+    for f in (again, asked):
+        assert np.array_equal(f.image, first.image)
+        assert np.array_equal(f.depth_complexity, first.depth_complexity)
+        assert f.stats["census"]
+        for key in ("fragments", "max_depth_complexity", "memory_bytes"):
+            assert f.stats[key] == first.stats[key], key
+    assert first.stats["max_depth_complexity"] == 4 and first.depth_complexity.min() == 3
+    # More fragments than the pool held: it grows to the count and the capture runs again.
+    deeper = build_scene([layer(z, (0.5, 0.5, 0.5, 0.5)) for z in np.linspace(0.1, 0.9, 12)])
+    grown = r.render(deeper, IDENTITY, method=method)
+    assert grown.stats["extra"]["counted_in_capture"] == 1.0 and grown.stats["extra"]["pool_regrown"] == 1.0
+    assert grown.stats["fragments"] == 12 * 24 * 16 and (grown.depth_complexity == 12).all()
+    fresh = oit.Renderer(24, 16).render(deeper, IDENTITY, method=method)
+    assert np.array_equal(grown.image, fresh.image)
+
+
+@pytest.mark.parametrize("method", ["abuffer", "compact_abuffer"])
+def test_a_count_past_the_largest_pool_falls_back_to_the_census_and_tiles(method):
+    # 768-byte bindings hold at most 128 nodes of either method's pool; a first frame of 3
+    # layers (48 fragments) sizes the pool, the next has 9 (144): its capture counts more than
+    # any pool holds, and the frame is planned again from the census, in tiles.
+    r = oit.Renderer(4, 4, max_binding_bytes=768)
+    r.render(build_scene([layer(0.1 * (i + 1), (1, 0, 0, 0.5)) for i in range(3)]), IDENTITY, method=method)
+    scene = build_scene([layer(0.1 * (i + 1), (0.1 * i, 0.5, 1 - 0.1 * i, 0.3)) for i in range(9)])
+    tiled = r.render(scene, IDENTITY, method=method)
+    assert tiled.stats["tiles"] > 1 and tiled.stats["extra"]["counted_in_capture"] == 0.0
+    assert tiled.stats["fragments"] == 144 and (tiled.depth_complexity == 9).all()
+    assert np.array_equal(tiled.image, oit.Renderer(4, 4).render(scene, IDENTITY, method=method).image)
+
+
 def test_census_must_be_a_bool(renderer):
     with pytest.raises(TypeError, match="census must be True or False"):
         renderer(4, 4).render(oit.Scene(), IDENTITY, method="unsorted", census=1)

@@ -17,6 +17,8 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("FRAG_STEPS", 0),
     Const::U32("SHADE_STEPS", 0),
     Const::U32("KEYED", 1),
+    // Whether a list capture counts its own fragments per pixel (shaders/common/pool.wgsl).
+    Const::U32("COUNTING", 0),
     // Whether the device honours @early_depth_test(force) (set by `module`): validated with
     // the shaders' own opaque-depth test.
     Const::U32("EARLY_DEPTH", 0),

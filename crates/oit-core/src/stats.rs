@@ -184,6 +184,7 @@ pub const EXTRAS: &[(&str, Merge)] = &[
     ("pool_regrown", Merge::Sum),
     ("resolve_sweeps", Merge::Max),
     ("pool_nodes", Merge::Sum),
+    ("counted_in_capture", Merge::Max),
     ("auto_k", Merge::Max),
     ("auto_mean_k", Merge::Mean),
     ("auto_slots", Merge::Sum),

@@ -23,9 +23,10 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: &[AntialiasMode::Frames, AntialiasMode::Coverage],
-    memory: Memory::Scene { formula: "24 B/fragment + 68 B/pixel (the node pool grows with the scene)" },
+    memory: Memory::Scene { formula: "24 B/fragment + 80 B/pixel (the node pool grows with the scene)" },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
+    // A pixel's sweep words and the count its capture keeps where it runs without a census.
+    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES + 4, per_fragment: 24, per_triangle: 0 },
     census: true,
     census_when: never,
     main: None,
@@ -51,6 +52,7 @@ impl ABuffer {
                 samples: 1,
                 shades_at_resolve: false,
                 aux: Aux::None,
+                counts_in_capture: true,
             },
         );
         Self { lists, coverage: None }
@@ -72,6 +74,7 @@ impl Method for ABuffer {
                             samples: c.samples,
                             shades_at_resolve: false,
                             aux: Aux::None,
+                            counts_in_capture: false,
                         },
                     )
                 });
@@ -79,5 +82,9 @@ impl Method for ABuffer {
             }
             None => self.lists.render(cx),
         }
+    }
+
+    fn counts_in_capture(&self) -> bool {
+        self.lists.counts_in_capture()
     }
 }

@@ -24,9 +24,10 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { formula: "12 B/fragment + 68 B/pixel + 176 B/triangle" },
+    memory: Memory::Scene { formula: "12 B/fragment + 80 B/pixel + 176 B/triangle" },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 12, per_triangle: 176 },
+    // A pixel's sweep words and the count its capture keeps where it runs without a census.
+    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES + 4, per_fragment: 12, per_triangle: 176 },
     census: true,
     census_when: never,
     main: None,
@@ -42,6 +43,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 samples: 1,
                 shades_at_resolve: true,
                 aux: Aux::PerTriangle(std::mem::size_of::<PrimShading>() as u64),
+                counts_in_capture: true,
             },
         )))
     },
@@ -52,5 +54,9 @@ struct Compact(ListMethod);
 impl Method for Compact {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         self.0.render(cx)
+    }
+
+    fn counts_in_capture(&self) -> bool {
+        self.0.counts_in_capture()
     }
 }

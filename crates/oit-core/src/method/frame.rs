@@ -385,8 +385,18 @@ pub struct MethodReport {
     /// The tile needed this many times the nodes its pool can hold: nothing was rendered, and
     /// the renderer plans smaller tiles.
     pub pool_short: Option<f64>,
+    /// Each pixel's transparent fragments (row-major), where the method counted them in its own
+    /// capture in place of the census (`Method::counts_in_capture`).
+    pub counts: Option<Vec<u32>>,
 }
 
 pub(crate) trait Method: Send {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport>;
+
+    /// Whether the next whole, one-sample frame can go without the census because the method
+    /// counts each pixel's fragments in its own capture and reports them
+    /// (`MethodReport::counts`). Only a method whose `MethodInfo::census` is set asks this.
+    fn counts_in_capture(&self) -> bool {
+        false
+    }
 }

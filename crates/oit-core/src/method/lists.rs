@@ -69,12 +69,17 @@ pub(crate) struct NodePool {
     pub aux: wgpu::Buffer,
     aux_kind: Aux,
     aux_len: u64,
+    /// Binding 8: each pixel's fragments, where the capture counts them itself (`counting`),
+    /// with its readback; a placeholder otherwise.
+    counts: wgpu::Buffer,
+    counts_readback: Option<wgpu::Buffer>,
+    counting: bool,
     pub layout: wgpu::BindGroupLayout,
     pub group: Option<wgpu::BindGroup>,
 }
 
 impl NodePool {
-    pub fn new(gpu: &GpuContext, limits: &Limits, node_bytes: u64, state_words: u64, aux_kind: Aux) -> Self {
+    pub fn new(gpu: &GpuContext, limits: &Limits, node_bytes: u64, state_words: u64, aux_kind: Aux, counting: bool) -> Self {
         let d = &gpu.device;
         let layout = gpu.cache.layout(d, POOL_LAYOUT);
         let alloc = storage_buffer(d, "alloc", ALLOC_BYTES, wgpu::BufferUsages::COPY_SRC);
@@ -104,6 +109,9 @@ impl NodePool {
             aux: storage_buffer(d, "list aux", 4, wgpu::BufferUsages::empty()),
             aux_kind,
             aux_len: 0,
+            counts: storage_buffer(d, "capture counts", 4, wgpu::BufferUsages::empty()),
+            counts_readback: None,
+            counting,
             layout,
             group: None,
         }
@@ -126,8 +134,14 @@ impl NodePool {
         self.state_words + 2 * (self.state_words > 0) as u64
     }
 
+    /// Bytes a pixel keeps: its head, sweep state and list entries, and its count where the
+    /// capture counts.
+    pub fn pixel_bytes(&self) -> u64 {
+        4 * (1 + self.state_len() + self.counting as u64)
+    }
+
     pub fn bytes(&self) -> u64 {
-        self.capacity * self.node_bytes + self.pixels * 4 * (1 + self.state_len()) + self.aux_len + ALLOC_BYTES + LIST_ARGS_BYTES
+        self.capacity * self.node_bytes + self.pixels * self.pixel_bytes() + self.aux_len + ALLOC_BYTES + LIST_ARGS_BYTES
     }
 
     /// Makes room for `nodes` nodes, `pixels` heads and `triangles` per-triangle records,
@@ -148,6 +162,15 @@ impl NodePool {
         if pixels != self.pixels {
             self.heads = storage_buffer(d, "heads", pixels * 4, wgpu::BufferUsages::empty());
             self.state = storage_buffer(d, "sweep state", pixels * 4 * self.state_len(), wgpu::BufferUsages::empty());
+            if self.counting {
+                self.counts = storage_buffer(d, "capture counts", pixels * 4, wgpu::BufferUsages::COPY_SRC);
+                self.counts_readback = Some(d.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("capture counts readback"),
+                    size: (pixels * 4).max(4),
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }));
+            }
             self.pixels = pixels;
             changed = true;
         }
@@ -190,6 +213,7 @@ impl NodePool {
             );
             entries.push(wgpu::BindGroupEntry { binding: 2 + POOL_BINDINGS as u32, resource: self.state.as_entire_binding() });
             entries.push(wgpu::BindGroupEntry { binding: 3 + POOL_BINDINGS as u32, resource: self.aux.as_entire_binding() });
+            entries.push(wgpu::BindGroupEntry { binding: 4 + POOL_BINDINGS as u32, resource: self.counts.as_entire_binding() });
             self.group =
                 Some(d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("node pool"), layout: &self.layout, entries: &entries }));
         }
@@ -206,6 +230,24 @@ impl NodePool {
 
     pub fn copy_count(&self, enc: &mut wgpu::CommandEncoder) {
         enc.copy_buffer_to_buffer(&self.alloc, 0, &self.alloc_readback, 0, ALLOC_BYTES);
+    }
+
+    /// Records the zeroing of the capture's per-pixel counts.
+    fn clear_counts(&self, enc: &mut wgpu::CommandEncoder) {
+        enc.clear_buffer(&self.counts, 0, None);
+    }
+
+    /// Records the copy of the capture's per-pixel counts to their readback.
+    fn copy_counts(&self, enc: &mut wgpu::CommandEncoder) {
+        if let Some(r) = &self.counts_readback {
+            enc.copy_buffer_to_buffer(&self.counts, 0, r, 0, self.pixels * 4);
+        }
+    }
+
+    /// The capture's per-pixel counts, row-major in the tile (after `copy_counts` ran).
+    fn read_counts(&self, gpu: &GpuContext) -> Result<Vec<u32>> {
+        let r = self.counts_readback.as_ref().expect("a counting pool has its readback once reserved");
+        Ok(bytemuck::pod_collect_to_vec(&read_buffer(gpu, r, self.pixels * 4)?))
     }
 
     /// The allocator after the last capture: nodes asked for (may exceed the capacity) and
@@ -230,16 +272,6 @@ pub(crate) struct ListMethod {
     shades_at_resolve: bool,
 }
 
-struct Pipelines {
-    allocate: Option<wgpu::ComputePipeline>,
-    count: Option<wgpu::RenderPipeline>,
-    capture: wgpu::RenderPipeline,
-    /// The sorted resolve: the pixel lists and their workgroups, the first dispatch, then the
-    /// deeper pixels' runs, merges and composite.
-    sweep: Option<[wgpu::ComputePipeline; 6]>,
-    resolve: wgpu::RenderPipeline,
-}
-
 /// The storage layout of a list method.
 pub(crate) struct ListLayout {
     /// The pipelines of its shader (list_pipelines.rs).
@@ -255,6 +287,9 @@ pub(crate) struct ListLayout {
     pub shades_at_resolve: bool,
     /// What binding 7 holds, and so which passes run before capture.
     pub aux: Aux,
+    /// Whether the capture can count each pixel's fragments itself (its nodes are its
+    /// fragments), so that a frame after the first needs no census (`ListMethod::counts_in_capture`).
+    pub counts_in_capture: bool,
 }
 
 /// Loop iterations llvmpipe allows one shader invocation (all loops together); past them
@@ -272,7 +307,7 @@ impl ListMethod {
         Self {
             pipelines: layout.pipelines,
             consts: Vec::new(),
-            pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.aux),
+            pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.aux, layout.counts_in_capture),
             sweeps: (layout.state_words > 0).then_some(layout.samples),
             shades_at_resolve: layout.shades_at_resolve,
             aux: layout.aux,
@@ -285,20 +320,28 @@ impl ListMethod {
         self.consts = consts;
     }
 
-    /// This frame's pipelines, from the device's cache.
-    /// What a step of the sorted resolve costs in this frame.
-    fn step_costs(&self, cx: &FrameCtx<'_>) -> StepCosts {
+    /// Whether this frame can go without the census: the capture counts each pixel's fragments
+    /// itself, and an earlier frame sized the pool (a pool that proves too small grows to the
+    /// count, and the capture runs again). The renderer then takes the frame's counts from the
+    /// method's report.
+    pub fn counts_in_capture(&self) -> bool {
+        self.pool.counting && self.pool.capacity > 0
+    }
+
+    /// What a step of the sorted resolve costs in a frame whose deepest pixel has `deepest`
+    /// fragments.
+    fn step_costs(&self, cx: &FrameCtx<'_>, deepest: u32) -> StepCosts {
         // Shading at composite (compact_abuffer's frag_shaded): shading.wgsl's `shade` (its
         // light loop, the shading-cost loop, and a margin for its other loops, each of which
         // llvmpipe's limiter counts once even when skipped). Its nodes' fragments and tie keys
         // read the triangle's record, which costs no loop: runs stay keyed.
         let shade = if self.shades_at_resolve { 4 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64 } else { 0 };
         let frag = 0;
-        let run = (cx.max_depth_complexity as u64).min(RUN as u64);
+        let run = (deepest as u64).min(RUN as u64);
         StepCosts { samples: self.sweeps.unwrap_or(1) as u64, frag, shade, run }
     }
 
-    fn pipelines(&self, cx: &FrameCtx<'_>, run: u32, costs: StepCosts, budget: u64) -> Pipelines {
+    fn consts_for(&self, run: u32, costs: StepCosts, budget: u64, counting: bool) -> Vec<Const> {
         let mut consts = self.pool.consts().to_vec();
         consts.push(Const::U32("BATCH", BATCH));
         consts.push(Const::U32("RUN", run));
@@ -306,15 +349,28 @@ impl ListMethod {
         consts.push(Const::U32("FRAG_STEPS", costs.frag as u32));
         consts.push(Const::U32("SHADE_STEPS", costs.shade as u32));
         consts.push(Const::U32("KEYED", costs.keyed() as u32));
+        consts.push(Const::U32("COUNTING", counting as u32));
         consts.extend(self.consts.iter().copied());
+        consts
+    }
+
+    /// The capture's pipelines: the pass before it that binding 7 may need, and the capture.
+    fn capture_pipelines(&self, cx: &FrameCtx<'_>, consts: &[Const]) -> CapturePipelines {
         let at = |entry| spec(self.pipelines, entry);
-        let compute = |entry| cx.compute_pipeline(at(entry), &consts);
-        Pipelines {
-            allocate: matches!(self.aux, Aux::PerTriangle(_)).then(|| compute("cs_allocate")),
-            count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(at("fs_count"), &consts)),
-            capture: cx.capture_pipeline(at("fs_capture"), &consts),
-            sweep: self.sweeps.map(|_| SWEEPS.map(compute)),
-            resolve: cx.resolve_pipeline(at("fs_resolve"), &consts, false),
+        CapturePipelines {
+            allocate: matches!(self.aux, Aux::PerTriangle(_)).then(|| cx.compute_pipeline(at("cs_allocate"), consts)),
+            count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(at("fs_count"), consts)),
+            capture: cx.capture_pipeline(at("fs_capture"), consts),
+        }
+    }
+
+    /// The resolve's pipelines: the sorted resolve's sweeps, where the method has them, and the
+    /// full-screen pass.
+    fn resolve_pipelines(&self, cx: &FrameCtx<'_>, consts: &[Const]) -> ResolvePipelines {
+        let at = |entry| spec(self.pipelines, entry);
+        ResolvePipelines {
+            sweep: self.sweeps.map(|_| SWEEPS.map(|entry| cx.compute_pipeline(at(entry), consts))),
+            resolve: cx.resolve_pipeline(at("fs_resolve"), consts, false),
         }
     }
 
@@ -343,13 +399,119 @@ impl ListMethod {
         enc.copy_buffer_to_buffer(&self.pool.aux, pixels * 4, &self.pool.alloc, 0, 4);
     }
 
+    /// Records the per-frame reset and the capture: the pass binding 7 needs, then the
+    /// geometry into the pool (counting each pixel's fragments where `counting`), and the copy
+    /// of the allocator (and the counts) to their readbacks.
+    fn record_capture(&self, cx: &mut FrameCtx<'_>, enc: &mut wgpu::CommandEncoder, p: &CapturePipelines, pixels: u64, counting: bool) {
+        let group = self.pool.group.as_ref().expect("reserved");
+        self.pool.clear(cx.gpu, enc);
+        if counting {
+            self.pool.clear_counts(enc);
+        }
+        let triangles = cx.scene.transparent.triangles as u64;
+        if let (Some(allocate), true) = (&p.allocate, triangles > 0) {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("list allocate"),
+                timestamp_writes: cx.timer.compute_pass("allocate"),
+            });
+            pass.set_pipeline(allocate);
+            pass.set_bind_group(1, cx.targets_group(), &[]);
+            pass.set_bind_group(2, group, &[]);
+            // One invocation a drawn triangle, chunk after chunk (shaders/common/setup.wgsl).
+            for chunk in &cx.scene.transparent.chunks {
+                pass.set_bind_group(0, &chunk.group, &[]);
+                let groups = chunk.drawn.div_ceil(64);
+                pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+            }
+        }
+        if let (Some(count), Some((_, scan))) = (&p.count, &self.scan) {
+            self.count_and_scan(cx, enc, count, scan, pixels);
+        }
+        cx.capture(enc, "capture", &p.capture, group);
+        self.pool.copy_count(enc);
+        if counting {
+            self.pool.copy_counts(enc);
+        }
+    }
+
+    /// Records the resolve: the sorted resolve's dispatches (`sweeps` of each deep phase) where
+    /// the method has them, then the full-screen pass.
+    fn record_resolve(&self, cx: &mut FrameCtx<'_>, enc: &mut wgpu::CommandEncoder, p: &ResolvePipelines, sweeps: [u32; 3]) {
+        let group = self.pool.group.as_ref().expect("reserved");
+        if let Some([active, groups, sort, phases @ ..]) = &p.sweep {
+            // Each phase runs over a list of the pixels with work in it: cs_active lists
+            // those with fragments, cs_sort the deep ones; cs_groups sizes the dispatches.
+            let (alloc, args) = (&self.pool.alloc, &self.pool.list_args);
+            {
+                let timestamp_writes = cx.timer.compute_pass("pixel lists");
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pixel lists"), timestamp_writes });
+                cx.bind_dispatch(&mut pass, active, group);
+                cx.bind_dispatch_with(&mut pass, groups, group, Dispatch::One);
+            }
+            enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);
+            cx.dispatch_with(enc, "sort", sort, group, Dispatch::Indirect(args, 0));
+            if sweeps.iter().any(|&n| n > 0) {
+                cx.dispatch_with(enc, "deep list", groups, group, Dispatch::One);
+                enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);
+            }
+            for ((label, pipeline), n) in ["runs", "merge", "composite"].into_iter().zip(phases).zip(sweeps) {
+                if n > 0 {
+                    let timestamp_writes = cx.timer.compute_pass(label);
+                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
+                    for _ in 0..n {
+                        cx.bind_dispatch_with(&mut pass, pipeline, group, Dispatch::Indirect(args, 12));
+                    }
+                }
+            }
+        }
+        cx.resolve(enc, "resolve", &p.resolve, group, false);
+    }
+
+    /// The resolve's plan for a deepest pixel of `deepest` fragments: its constants, and the
+    /// dispatches of each deep phase.
+    fn resolve_plan(&self, cx: &FrameCtx<'_>, deepest: u32, counting: bool) -> Result<(Vec<Const>, [u32; 3])> {
+        let costs = self.step_costs(cx, deepest);
+        let budget = if self.sweeps.is_some() { step_budget(cx.gpu, costs)? } else { 1 };
+        let sweeps = if self.sweeps.is_some() { resolve_dispatches(deepest as u64, costs, budget) } else { [0; 3] };
+        Ok((self.consts_for(run_length(deepest as u64), costs, budget, counting), sweeps))
+    }
+
+    /// The report of a frame whose capture asked for `count` nodes.
+    fn report(
+        &mut self,
+        cx: &FrameCtx<'_>,
+        count: u64,
+        regrown: f64,
+        sweeps: Option<[u32; 3]>,
+        counts: Option<Vec<u32>>,
+    ) -> Result<MethodReport> {
+        let memory = self.pool.bytes() + self.scan.as_ref().map_or(0, |(_, s)| s.bytes);
+        // Shrink for the next frame when this one used little of the pool.
+        if count < self.pool.capacity / 4 {
+            let triangles = cx.scene.transparent.triangles as u64;
+            self.pool.reserve(cx.gpu, count, cx.pixels(), triangles, !cx.tile.is_whole())?;
+        }
+        let mut extra = vec![
+            ("pool_regrown", regrown),
+            ("resolve_sweeps", sweeps.map_or(1.0, |s| 1.0 + s.iter().sum::<u32>() as f64)),
+            ("pool_nodes", count as f64),
+        ];
+        if self.pool.counting {
+            extra.push(("counted_in_capture", counts.is_some() as u32 as f64));
+        }
+        Ok(MethodReport { memory_bytes: memory, extra, counts, ..Default::default() })
+    }
+
     pub fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
         let tile = cx.tile;
         let pixels = cx.pixels();
         cx.check_per_pixel(
             &format!("{} (its per-pixel heads and sweep state)", self.pipelines[0].shader.trim_end_matches(".wgsl")),
-            4 * self.pool.state_len().max(1),
+            self.pool.pixel_bytes(),
         )?;
+        // Without a census (`counts_in_capture`) the capture counts each pixel's fragments
+        // itself: the host reads them back before it plans the resolve.
+        let counting = cx.depth_complexity.is_empty() && self.counts_in_capture() && tile.is_whole();
         // A tile of a larger frame gets a pool of its counted fragments, so that tiles planned
         // within a memory budget stay in it; a whole frame keeps the pool it has, grown to the
         // census's count where that is more (a first frame, or a moving camera, renders once,
@@ -357,69 +519,50 @@ impl ListMethod {
         // bounds) the capture's own count still regrows the pool below.
         let tiled = !tile.is_whole();
         let initial = if tiled { cx.fragments } else { self.pool.capacity.max(cx.fragments) }.clamp(1, self.pool.max_nodes());
-        let costs = self.step_costs(cx);
-        let budget = if self.sweeps.is_some() { step_budget(cx.gpu, costs)? } else { 1 };
-        let sweeps = if self.sweeps.is_some() { resolve_dispatches(cx.max_depth_complexity as u64, costs, budget) } else { [0; 3] };
         let triangles = cx.scene.transparent.triangles as u64;
         self.pool.reserve(cx.gpu, initial, pixels, triangles, tiled)?;
         if self.aux == Aux::PixelOffsets && self.scan.as_ref().is_none_or(|(p, _)| *p != pixels) {
             self.scan = Some((pixels, Scan::new(cx.gpu, &self.pool.aux, pixels + 1)));
         }
         let mut regrown = 0.0;
-        let targets_group = cx.targets_group();
         loop {
             cx.timer.reset();
-            let p = self.pipelines(cx, run_length(cx.max_depth_complexity as u64), costs, budget);
-            let group = self.pool.group.as_ref().expect("reserved above");
             let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-            self.pool.clear(cx.gpu, &mut enc);
-            if let (Some(allocate), true) = (&p.allocate, triangles > 0) {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("list allocate"),
-                    timestamp_writes: cx.timer.compute_pass("allocate"),
-                });
-                pass.set_pipeline(allocate);
-                pass.set_bind_group(1, targets_group, &[]);
-                pass.set_bind_group(2, group, &[]);
-                // One invocation a drawn triangle, chunk after chunk (shaders/common/setup.wgsl).
-                for chunk in &cx.scene.transparent.chunks {
-                    pass.set_bind_group(0, &chunk.group, &[]);
-                    let groups = chunk.drawn.div_ceil(64);
-                    pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
-                }
-            }
-            if let (Some(count), Some((_, scan))) = (&p.count, &self.scan) {
-                self.count_and_scan(cx, &mut enc, count, scan, pixels);
-            }
-            cx.capture(&mut enc, "capture", &p.capture, group);
-            self.pool.copy_count(&mut enc);
-            if let Some([active, groups, sort, phases @ ..]) = &p.sweep {
-                // Each phase runs over a list of the pixels with work in it: cs_active lists
-                // those with fragments, cs_sort the deep ones; cs_groups sizes the dispatches.
-                let (alloc, args) = (&self.pool.alloc, &self.pool.list_args);
-                {
-                    let timestamp_writes = cx.timer.compute_pass("pixel lists");
-                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pixel lists"), timestamp_writes });
-                    cx.bind_dispatch(&mut pass, active, group);
-                    cx.bind_dispatch_with(&mut pass, groups, group, Dispatch::One);
-                }
-                enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);
-                cx.dispatch_with(&mut enc, "sort", sort, group, Dispatch::Indirect(args, 0));
-                if sweeps.iter().any(|&n| n > 0) {
-                    cx.dispatch_with(&mut enc, "deep list", groups, group, Dispatch::One);
-                    enc.copy_buffer_to_buffer(alloc, Alloc::GROUPS_OFFSET, args, 0, LIST_ARGS_BYTES);
-                }
-                for ((label, pipeline), n) in ["runs", "merge", "composite"].into_iter().zip(phases).zip(sweeps) {
-                    if n > 0 {
-                        let timestamp_writes = cx.timer.compute_pass(label);
-                        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
-                        for _ in 0..n {
-                            cx.bind_dispatch_with(&mut pass, pipeline, group, Dispatch::Indirect(args, 12));
-                        }
+            let (counts, sweeps) = if counting {
+                // The capture alone, with the largest run in its constants (they do not change
+                // its code, and so its pipeline stays the same from frame to frame); then the
+                // counts plan the resolve.
+                let capture = self.capture_pipelines(cx, &self.consts_for(RUN, StepCosts::default(), 1, true));
+                self.record_capture(cx, &mut enc, &capture, pixels, true);
+                cx.gpu.queue.submit([enc.finish()]);
+                let alloc = self.pool.read_alloc(cx.gpu)?;
+                if alloc.count as u64 > self.pool.capacity {
+                    if alloc.count as u64 > self.pool.max_nodes() {
+                        // More than one pool holds: the renderer plans tiles from a census.
+                        return Ok(MethodReport {
+                            pool_short: Some(alloc.count as f64 / self.pool.max_nodes() as f64),
+                            ..Default::default()
+                        });
                     }
+                    self.pool.reserve(cx.gpu, alloc.count as u64, pixels, triangles, tiled)?;
+                    regrown += 1.0;
+                    continue;
                 }
-            }
-            cx.resolve(&mut enc, "resolve", &p.resolve, group, false);
+                let counts = self.pool.read_counts(cx.gpu)?;
+                let deepest = counts.iter().copied().max().unwrap_or(0);
+                let (consts, sweeps) = self.resolve_plan(cx, deepest, true)?;
+                let p = self.resolve_pipelines(cx, &consts);
+                enc = cx.gpu.device.create_command_encoder(&Default::default());
+                self.record_resolve(cx, &mut enc, &p, sweeps);
+                (Some(counts), sweeps)
+            } else {
+                let (consts, sweeps) = self.resolve_plan(cx, cx.max_depth_complexity, false)?;
+                let capture = self.capture_pipelines(cx, &consts);
+                self.record_capture(cx, &mut enc, &capture, pixels, false);
+                let p = self.resolve_pipelines(cx, &consts);
+                self.record_resolve(cx, &mut enc, &p, sweeps);
+                (None, sweeps)
+            };
             cx.gpu.queue.submit([enc.finish()]);
             let alloc = self.pool.read_alloc(cx.gpu)?;
             if alloc.escaped > 0 {
@@ -430,18 +573,9 @@ impl ListMethod {
                 )));
             }
             let count = alloc.count as u64;
+            let sweeps = self.sweeps.is_some().then_some(sweeps);
             if count <= self.pool.capacity {
-                let memory = self.pool.bytes() + self.scan.as_ref().map_or(0, |(_, s)| s.bytes);
-                // Shrink for the next frame when this one used little of the pool.
-                if count < self.pool.capacity / 4 {
-                    self.pool.reserve(cx.gpu, count, pixels, triangles, tiled)?;
-                }
-                let extra = vec![
-                    ("pool_regrown", regrown),
-                    ("resolve_sweeps", if p.sweep.is_some() { 1.0 + sweeps.iter().sum::<u32>() as f64 } else { 1.0 }),
-                    ("pool_nodes", count as f64),
-                ];
-                return Ok(MethodReport { memory_bytes: memory, extra, ..Default::default() });
+                return self.report(cx, count, regrown, sweeps, counts);
             }
             if count > self.pool.max_nodes() && cx.tile.pixels() > 1 {
                 // More nodes than the census planned for (pall's bounding boxes): the renderer
@@ -452,6 +586,21 @@ impl ListMethod {
             regrown += 1.0;
         }
     }
+}
+
+/// A list method's capture pipelines (`ListMethod::capture_pipelines`).
+struct CapturePipelines {
+    allocate: Option<wgpu::ComputePipeline>,
+    count: Option<wgpu::RenderPipeline>,
+    capture: wgpu::RenderPipeline,
+}
+
+/// A list method's resolve pipelines: the sorted resolve (the pixel lists and their
+/// workgroups, the first dispatch, then the deeper pixels' runs, merges and composite) and the
+/// full-screen pass.
+struct ResolvePipelines {
+    sweep: Option<[wgpu::ComputePipeline; 6]>,
+    resolve: wgpu::RenderPipeline,
 }
 
 /// Refuses a frame whose deepest pixel the one-invocation replay of a submission-order

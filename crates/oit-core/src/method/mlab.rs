@@ -43,6 +43,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 samples: 1,
                 shades_at_resolve: false,
                 aux: Aux::None,
+                counts_in_capture: false,
             },
         )))
     },

@@ -42,6 +42,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 samples: 1,
                 shades_at_resolve: false,
                 aux: Aux::PerTriangle(std::mem::size_of::<PallBlock>() as u64),
+                counts_in_capture: false,
             },
         )))
     },

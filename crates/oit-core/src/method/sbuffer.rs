@@ -42,6 +42,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 samples: 1,
                 shades_at_resolve: false,
                 aux: Aux::PixelOffsets,
+                counts_in_capture: false,
             },
         )))
     },

@@ -29,7 +29,7 @@ pub(crate) const PIXEL_BYTES: u64 = pixel_bytes(1);
 /// (compact_abuffer shades it there: its lights and the shading-cost loop); `run` the fragments a run holds in this frame (RUN, or
 /// the deepest list when shorter).
 /// The array a run is sorted in is [`run_length`] of the deepest list.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct StepCosts {
     pub samples: u64,
     pub frag: u64,

@@ -126,16 +126,46 @@ impl Renderer {
         background: [f32; 3],
         coverage: bool,
     ) -> Result<Frame> {
+        match self.render_counted(camera, info, params, background, coverage, true)? {
+            Some(frame) => Ok(frame),
+            // The method's own count did not fit one pool in one tile: the census plans tiles.
+            None => Ok(self.render_counted(camera, info, params, background, coverage, false)?.expect("a census frame is rendered")),
+        }
+    }
+
+    /// `render_sample`; with `self_count`, a method that counts its fragments in its own
+    /// capture (`Method::counts_in_capture`) does so in place of the census, where the frame
+    /// is whole, one sample and without a budget. None: that frame did not fit one tile, and
+    /// needs the census after all.
+    fn render_counted(
+        &mut self,
+        camera: &Camera,
+        info: &'static MethodInfo,
+        params: &Params,
+        background: [f32; 3],
+        coverage: bool,
+        self_count: bool,
+    ) -> Result<Option<Frame>> {
         let start = Instant::now();
         let gpu = self.gpu.clone();
         let (w, h) = (self.width, self.height);
-        let census = info.needs_census(params) || self.census;
-        let expand_times = self.expand_primitives(camera, background)?;
         if self.memory_budget.is_some() {
             // Under a budget no method keeps storage between frames: what the frame allocates
             // is what it reports, and the census runs with the targets alone.
             self.methods.remove(info.name);
         }
+        let limits = self.limits;
+        // Out of the map while it renders, so that the loop can set each tile's uniform.
+        let mut method = self.methods.remove(info.name).unwrap_or_else(|| info.instantiate(&gpu, &limits));
+        // A method that counts in its capture reports the counts the census would have.
+        let self_counted = self_count
+            && info.needs_census(params)
+            && !self.census
+            && !coverage
+            && self.memory_budget.is_none()
+            && method.counts_in_capture();
+        let census = (info.needs_census(params) && !self_counted) || self.census;
+        let expand_times = self.expand_primitives(camera, background)?;
         // The census, in bands of rows the targets hold; `drawn` is the tile whose opaque pass
         // the targets hold.
         let mut counts = Vec::new();
@@ -155,17 +185,18 @@ impl Renderer {
                 drawn = Some(band);
             }
         }
-        let max_depth_complexity = counts.iter().copied().max().unwrap_or(0);
-        let fragments: u64 = counts.iter().map(|&c| c as u64).sum();
-
-        let limits = self.limits;
-        // Out of the map while it renders, so that the loop can set each tile's uniform.
-        let mut method = self.methods.remove(info.name).unwrap_or_else(|| info.instantiate(&gpu, &limits));
-        let result = self.run_tiles(&mut *method, camera, info, params, background, coverage, &counts, drawn);
+        let result = self.run_tiles(&mut *method, camera, info, params, background, coverage, &counts, drawn, self_counted);
         if self.memory_budget.is_none() {
             self.methods.insert(info.name, method);
         }
-        let (tiles, report, mut pass_times, arrays) = result?;
+        let Some((tiles, mut report, mut pass_times, arrays)) = result? else {
+            return Ok(None);
+        };
+        if let Some(c) = report.counts.take() {
+            counts = c;
+        }
+        let max_depth_complexity = counts.iter().copied().max().unwrap_or(0);
+        let fragments: u64 = counts.iter().map(|&c| c as u64).sum();
         if let (Some(p), Some(mut e)) = (pass_times.as_mut(), expand_times) {
             e.append(p);
             *p = e;
@@ -181,7 +212,7 @@ impl Renderer {
         let stats = Stats {
             method: info.name.to_string(),
             params: params.clone(),
-            census,
+            census: census || self_counted,
             fragments,
             max_depth_complexity,
             memory_bytes: report.memory_bytes,
@@ -202,13 +233,14 @@ impl Renderer {
             peak_memory_bytes: report.memory_bytes + target_bytes,
             ..Default::default()
         };
-        Ok(Frame { width: w, height: h, image: arrays.image, depth_complexity: counts, error_bound: arrays.bound, stats })
+        Ok(Some(Frame { width: w, height: h, image: arrays.image, depth_complexity: counts, error_bound: arrays.bound, stats }))
     }
 
     /// Renders `method` over the planned tiles, each into the targets and then into the frame's
     /// arrays. A method whose storage proves larger than planned (pall's pool follows its
     /// triangles' bounding boxes, not the fragments) is planned again with the budget divided by
-    /// how far it went over.
+    /// how far it went over. With `self_counted` (no census ran: the method counts in its own
+    /// capture), None where the frame would need more than one tile or pool.
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     fn run_tiles(
         &mut self,
@@ -220,17 +252,21 @@ impl Renderer {
         coverage: bool,
         counts: &[u32],
         mut drawn: Option<Tile>,
-    ) -> Result<(Vec<Tile>, MethodReport, Option<Vec<(&'static str, f64)>>, FrameArrays)> {
+        self_counted: bool,
+    ) -> Result<Option<(Vec<Tile>, MethodReport, Option<Vec<(&'static str, f64)>>, FrameArrays)>> {
         let gpu = self.gpu.clone();
         let (w, h) = (self.width, self.height);
         let frame_max_depth_complexity = counts.iter().copied().max().unwrap_or(0);
         let mut squeeze = 1.0f64;
         loop {
-            let plan = self.plan_tiles(info, params, counts, coverage, squeeze)?;
+            let plan = self.plan_tiles(info, params, counts, coverage, squeeze, self_counted)?;
             if self.into.is_some() && plan.targets != (w, h) {
                 return Err(self.target_refused());
             }
             let tiles = plan.tiles;
+            if self_counted && !(tiles.len() == 1 && tiles[0].is_whole()) {
+                return Ok(None);
+            }
             if self.ensure_targets(plan.targets.0, plan.targets.1, coverage)? {
                 drawn = None;
             }
@@ -270,6 +306,9 @@ impl Renderer {
                     variant,
                 };
                 let r = method.render(&mut cx)?;
+                if self_counted && (r.pool_short.is_some() || r.counts.is_none()) {
+                    return Ok(None);
+                }
                 if let Some(short) = r.pool_short {
                     report.pool_short = Some(short);
                     break;
@@ -278,6 +317,7 @@ impl Renderer {
                     pass_times.get_or_insert_with(Vec::new).extend(t);
                 }
                 report.memory_bytes = report.memory_bytes.max(r.memory_bytes);
+                report.counts = r.counts;
                 report.overflow_fragments += r.overflow_fragments;
                 extra.add(&r.extra, tile.pixels() as f64);
                 self.read_tile(*tile, r.error_bound, &mut arrays)?;
@@ -301,7 +341,7 @@ impl Renderer {
                         info.name
                     )));
                 }
-                _ => return Ok((tiles, report, pass_times, arrays)),
+                _ => return Ok(Some((tiles, report, pass_times, arrays))),
             }
         }
     }

@@ -70,8 +70,18 @@ impl Renderer {
 
     /// The screen tiles `info`'s method renders this frame in (one unless its storage and the
     /// frame's targets would pass a binding or the memory budget), and the size of the targets:
-    /// the frame's where the method's tiles fit beside them, else the largest tile's.
-    pub(super) fn plan_tiles(&self, info: &MethodInfo, params: &Params, counts: &[u32], coverage: bool, squeeze: f64) -> Result<Plan> {
+    /// the frame's where the method's tiles fit beside them, else the largest tile's. With
+    /// `self_counted` (no census: the method counts its fragments in its own capture and reports
+    /// where they do not fit), the plan holds the per-pixel storage alone.
+    pub(super) fn plan_tiles(
+        &self,
+        info: &MethodInfo,
+        params: &Params,
+        counts: &[u32],
+        coverage: bool,
+        squeeze: f64,
+        self_counted: bool,
+    ) -> Result<Plan> {
         let (w, h) = (self.width, self.height);
         let budget = self.memory_budget.unwrap_or(u64::MAX);
         // The method's share of the budget (beside the targets), divided by `squeeze` when a
@@ -111,7 +121,7 @@ impl Renderer {
                 }
                 Footprint {
                     per_pixel,
-                    per_fragment,
+                    per_fragment: if self_counted { 0 } else { per_fragment },
                     budget: budget - fixed,
                     max_pixels: binding / per_pixel,
                     max_fragments: (pool as f64 / squeeze) as u64,
