@@ -166,7 +166,7 @@ impl NodePool {
                 self.counts = storage_buffer(d, "capture counts", pixels * 4, wgpu::BufferUsages::COPY_SRC);
                 self.counts_readback = Some(d.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("capture counts readback"),
-                    size: (pixels * 4).max(4),
+                    size: ALLOC_BYTES + pixels * 4,
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }));
@@ -237,17 +237,21 @@ impl NodePool {
         enc.clear_buffer(&self.counts, 0, None);
     }
 
-    /// Records the copy of the capture's per-pixel counts to their readback.
+    /// Records the copy of the allocator and the capture's per-pixel counts to one readback,
+    /// so that the host waits once for both.
     fn copy_counts(&self, enc: &mut wgpu::CommandEncoder) {
-        if let Some(r) = &self.counts_readback {
-            enc.copy_buffer_to_buffer(&self.counts, 0, r, 0, self.pixels * 4);
-        }
+        let r = self.counts_readback.as_ref().expect("a counting pool has its readback once reserved");
+        enc.copy_buffer_to_buffer(&self.alloc, 0, r, 0, ALLOC_BYTES);
+        enc.copy_buffer_to_buffer(&self.counts, 0, r, ALLOC_BYTES, self.pixels * 4);
     }
 
-    /// The capture's per-pixel counts, row-major in the tile (after `copy_counts` ran).
-    fn read_counts(&self, gpu: &GpuContext) -> Result<Vec<u32>> {
+    /// The allocator after the capture and the capture's per-pixel counts, row-major in the
+    /// tile (after `copy_counts` ran).
+    fn read_counts(&self, gpu: &GpuContext) -> Result<(Alloc, Vec<u32>)> {
         let r = self.counts_readback.as_ref().expect("a counting pool has its readback once reserved");
-        Ok(bytemuck::pod_collect_to_vec(&read_buffer(gpu, r, self.pixels * 4)?))
+        let raw = read_buffer(gpu, r, ALLOC_BYTES + self.pixels * 4)?;
+        let (alloc, counts) = raw.split_at(ALLOC_BYTES as usize);
+        Ok((bytemuck::pod_read_unaligned::<Alloc>(alloc), bytemuck::pod_collect_to_vec(counts)))
     }
 
     /// The allocator after the last capture: nodes asked for (may exceed the capacity) and
@@ -428,9 +432,10 @@ impl ListMethod {
             self.count_and_scan(cx, enc, count, scan, pixels);
         }
         cx.capture(enc, "capture", &p.capture, group);
-        self.pool.copy_count(enc);
         if counting {
             self.pool.copy_counts(enc);
+        } else {
+            self.pool.copy_count(enc);
         }
     }
 
@@ -528,41 +533,39 @@ impl ListMethod {
         loop {
             cx.timer.reset();
             let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-            let (counts, sweeps) = if counting {
+            if counting {
                 // The capture alone, with the largest run in its constants (they do not change
                 // its code, and so its pipeline stays the same from frame to frame); then the
                 // counts plan the resolve.
                 let capture = self.capture_pipelines(cx, &self.consts_for(RUN, StepCosts::default(), 1, true));
                 self.record_capture(cx, &mut enc, &capture, pixels, true);
                 cx.gpu.queue.submit([enc.finish()]);
-                let alloc = self.pool.read_alloc(cx.gpu)?;
-                if alloc.count as u64 > self.pool.capacity {
-                    if alloc.count as u64 > self.pool.max_nodes() {
+                let (alloc, counts) = self.pool.read_counts(cx.gpu)?;
+                let count = alloc.count as u64;
+                if count > self.pool.capacity {
+                    if count > self.pool.max_nodes() {
                         // More than one pool holds: the renderer plans tiles from a census.
-                        return Ok(MethodReport {
-                            pool_short: Some(alloc.count as f64 / self.pool.max_nodes() as f64),
-                            ..Default::default()
-                        });
+                        return Ok(MethodReport { pool_short: Some(count as f64 / self.pool.max_nodes() as f64), ..Default::default() });
                     }
-                    self.pool.reserve(cx.gpu, alloc.count as u64, pixels, triangles, tiled)?;
+                    self.pool.reserve(cx.gpu, count, pixels, triangles, tiled)?;
                     regrown += 1.0;
                     continue;
                 }
-                let counts = self.pool.read_counts(cx.gpu)?;
+                // The capture's allocator is the frame's: the resolve allocates nothing, so the
+                // frame is reported without waiting for it (the renderer waits for the image).
                 let deepest = counts.iter().copied().max().unwrap_or(0);
                 let (consts, sweeps) = self.resolve_plan(cx, deepest, true)?;
                 let p = self.resolve_pipelines(cx, &consts);
-                enc = cx.gpu.device.create_command_encoder(&Default::default());
+                let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
                 self.record_resolve(cx, &mut enc, &p, sweeps);
-                (Some(counts), sweeps)
-            } else {
-                let (consts, sweeps) = self.resolve_plan(cx, cx.max_depth_complexity, false)?;
-                let capture = self.capture_pipelines(cx, &consts);
-                self.record_capture(cx, &mut enc, &capture, pixels, false);
-                let p = self.resolve_pipelines(cx, &consts);
-                self.record_resolve(cx, &mut enc, &p, sweeps);
-                (None, sweeps)
-            };
+                cx.gpu.queue.submit([enc.finish()]);
+                return self.report(cx, count, regrown, self.sweeps.is_some().then_some(sweeps), Some(counts));
+            }
+            let (consts, sweeps) = self.resolve_plan(cx, cx.max_depth_complexity, false)?;
+            let capture = self.capture_pipelines(cx, &consts);
+            self.record_capture(cx, &mut enc, &capture, pixels, false);
+            let p = self.resolve_pipelines(cx, &consts);
+            self.record_resolve(cx, &mut enc, &p, sweeps);
             cx.gpu.queue.submit([enc.finish()]);
             let alloc = self.pool.read_alloc(cx.gpu)?;
             if alloc.escaped > 0 {
@@ -575,7 +578,7 @@ impl ListMethod {
             let count = alloc.count as u64;
             let sweeps = self.sweeps.is_some().then_some(sweeps);
             if count <= self.pool.capacity {
-                return self.report(cx, count, regrown, sweeps, counts);
+                return self.report(cx, count, regrown, sweeps, None);
             }
             if count > self.pool.max_nodes() && cx.tile.pixels() > 1 {
                 // More nodes than the census planned for (pall's bounding boxes): the renderer
