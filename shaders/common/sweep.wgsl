@@ -347,7 +347,7 @@ fn order_ties(run: ptr<function, Run>, n: u32, px: u32) -> u32 {
         var j = i;
         while j > 0u {
             let p = (*run).entries[j - 1u];
-            if entry_depth(p) != entry_depth(e) {
+            if !same_depth(p, e) {
                 break;
             }
             if !loaded {

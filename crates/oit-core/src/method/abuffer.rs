@@ -4,7 +4,7 @@
 use super::frame::{FrameCtx, Limits, Method, MethodReport};
 use super::info::{never, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, Tiling};
 use super::list_pipelines::{swept, FRAME, SAMPLES};
-use super::lists::{state_words, Aux, ListLayout, ListMethod, PIXEL_BYTES, STATE_WORDS};
+use super::lists::{state_words, Aux, ListLayout, ListMethod, COUNTED_PIXEL_BYTES, STATE_WORDS};
 use crate::cache::PipelineSpec;
 use crate::context::GpuContext;
 use crate::error::Result;
@@ -25,8 +25,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: &[AntialiasMode::Frames, AntialiasMode::Coverage],
     memory: Memory::Scene { formula: "24 B/fragment + 80 B/pixel (the node pool grows with the scene)" },
     error_bound: ErrorBound::Exact,
-    // A pixel's sweep words and the count its capture keeps where it runs without a census.
-    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES + 4, per_fragment: 24, per_triangle: 0 },
+    tiling: Tiling::Storage { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
     census: true,
     census_when: never,
     main: None,

@@ -7,7 +7,7 @@ use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::list_pipelines::{swept_after, FRAME};
 use super::lists::{Aux, ListLayout, ListMethod};
-use super::lists::{PIXEL_BYTES, STATE_WORDS};
+use super::lists::{COUNTED_PIXEL_BYTES, STATE_WORDS};
 use crate::cache::PipelineSpec;
 use crate::error::Result;
 use crate::gpu_types::{CompactNode, PrimShading};
@@ -26,8 +26,7 @@ pub const INFO: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: Memory::Scene { formula: "12 B/fragment + 80 B/pixel + 176 B/triangle" },
     error_bound: ErrorBound::Exact,
-    // A pixel's sweep words and the count its capture keeps where it runs without a census.
-    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES + 4, per_fragment: 12, per_triangle: 176 },
+    tiling: Tiling::Storage { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: 12, per_triangle: 176 },
     census: true,
     census_when: never,
     main: None,

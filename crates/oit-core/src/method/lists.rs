@@ -5,7 +5,7 @@
 
 use super::frame::{Dispatch, FrameCtx, Limits, MethodReport};
 use super::list_pipelines::{POOL_LAYOUT, SWEEPS};
-pub(crate) use super::sweep_costs::{pixel_bytes, state_words, PIXEL_BYTES, STATE_WORDS};
+pub(crate) use super::sweep_costs::{pixel_bytes, state_words, COUNTED_PIXEL_BYTES, PIXEL_BYTES, STATE_WORDS};
 pub use super::sweep_costs::{resolve_dispatches, step_budget, StepCosts};
 use crate::cache::{spec, PipelineSpec};
 use crate::context::GpuContext;
@@ -514,9 +514,17 @@ impl ListMethod {
             &format!("{} (its per-pixel heads and sweep state)", self.pipelines[0].shader.trim_end_matches(".wgsl")),
             self.pool.pixel_bytes(),
         )?;
-        // Without a census (`counts_in_capture`) the capture counts each pixel's fragments
-        // itself: the host reads them back before it plans the resolve.
-        let counting = cx.depth_complexity.is_empty() && self.counts_in_capture() && tile.is_whole();
+        // Without a census the capture counts each pixel's fragments itself, and the host reads
+        // them back before it plans the resolve. The renderer skips the census only for a whole
+        // frame of a method that `counts_in_capture`: any other frame without counts would plan
+        // its resolve for empty pixels.
+        let counting = cx.depth_complexity.is_empty();
+        if counting && !(self.counts_in_capture() && tile.is_whole()) {
+            return Err(OitError::Device(format!(
+                "{} was given no fragment census for a frame it cannot count itself; please report this with the scene",
+                self.pipelines[0].shader.trim_end_matches(".wgsl")
+            )));
+        }
         // A tile of a larger frame gets a pool of its counted fragments, so that tiles planned
         // within a memory budget stay in it; a whole frame keeps the pool it has, grown to the
         // census's count where that is more (a first frame, or a moving camera, renders once,

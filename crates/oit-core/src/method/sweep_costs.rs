@@ -23,6 +23,10 @@ pub(crate) const fn pixel_bytes(samples: u32) -> u64 {
 
 pub(crate) const PIXEL_BYTES: u64 = pixel_bytes(1);
 
+/// The same with the count a capture keeps where it counts its own fragments in place of the
+/// census (abuffer, compact_abuffer: `ListLayout::counts_in_capture`).
+pub(crate) const COUNTED_PIXEL_BYTES: u64 = PIXEL_BYTES + 4;
+
 /// What one step of the sorted resolve costs on llvmpipe's loop limiter (the constants of
 /// shaders/common/sweep.wgsl, which this mirrors): `frag` is what turning a node into a
 /// fragment adds (nothing, for every method today); `shade` what compositing a fragment adds
