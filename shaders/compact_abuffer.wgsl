@@ -115,6 +115,12 @@ fn frag_shaded(f: Frag, px: u32) -> Frag {
     v.uv = b.x * s.uv[0] + b.y * s.uv[1] + b.z * s.uv[2];
     v.material = bitcast<u32>(s.normal[0].w);
 //!endif
+//!if TEXTURES
+    let planes = uv_planes(s.clip[0], s.clip[1], s.clip[2], s.uv[0], s.uv[1], s.uv[2]);
+    v.uv_plane_u = planes[0];
+    v.uv_plane_v = planes[1];
+    v.uv_plane_w = planes[2];
+//!endif
     return Frag(f.depth, clamp(shade(v), vec4<f32>(0.0), vec4<f32>(1.0)), f.id);
 }
 
@@ -129,7 +135,7 @@ fn tie_key(f: Frag) -> u32 {
     }
     let s = shading[f.id];
     let material = bitcast<u32>(s.normal[0].w);
-    let m1 = surfaces[2u * material + 1u];
+    let base = MATERIAL_VEC4S * material;
     var h = 2166136261u;
     h = mix4(h, s.clip[0]);
     h = mix4(h, s.clip[1]);
@@ -138,8 +144,13 @@ fn tie_key(f: Frag) -> u32 {
     h = mix4(h, vec4<f32>(s.normal[1].yz, s.normal[2].xy));
     h = mix4(h, vec4<f32>(s.normal[2].z, s.uv[0].x, s.uv[0].y, s.uv[1].x));
     h = mix4(h, vec4<f32>(s.uv[1].y, s.uv[2].x, s.uv[2].y, 0.0));
-    h = mix4(h, surfaces[2u * material]);
-    h = mix4(h, vec4<f32>(m1.y, m1.z, 0.0, 0.0));
+    h = mix4(h, surfaces[base]);
+    h = mix4(h, surfaces[base + 1u]);
+    // The texture maps' sampler bits and UV transforms, not their images' places.
+    h = mix4(h, vec4<f32>(surfaces[base + 2u].yzw, surfaces[base + 3u].x));
+    h = mix4(h, vec4<f32>(surfaces[base + 3u].yzw, surfaces[base + 4u].y));
+    h = mix4(h, vec4<f32>(surfaces[base + 4u].zw, surfaces[base + 5u].xy));
+    h = mix4(h, vec4<f32>(surfaces[base + 5u].zw, 0.0, 0.0));
     return h;
 }
 

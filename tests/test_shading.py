@@ -137,6 +137,15 @@ def bilinear(tex: np.ndarray, u: float, v: float) -> np.ndarray:
     return top * (1 - ty) + bottom * ty
 
 
+def stored(tex: np.ndarray) -> np.ndarray:
+    """A float texture as the engine keeps it (docs/shading.md): color rounded to the nearest
+    8-bit sRGB code, alpha to the nearest 8-bit code, read back as linear values."""
+    c = tex[..., :3].astype(float)
+    code = np.round(np.where(c <= 0.0031308, c * 12.92, 1.055 * c ** (1 / 2.4) - 0.055) * 255) / 255
+    rgb = np.where(code <= 0.04045, code / 12.92, ((code + 0.055) / 1.055) ** 2.4)
+    return np.concatenate([rgb, np.round(tex[..., 3:].astype(float) * 255) / 255], -1)
+
+
 def test_textures_sample_bilinearly_with_repeat_and_row_zero_at_v_zero(renderer):
     rng = np.random.default_rng(3)
     tex = rng.uniform(0, 1, (3, 5, 4)).astype(np.float32)
@@ -148,7 +157,7 @@ def test_textures_sample_bilinearly_with_repeat_and_row_zero_at_v_zero(renderer)
     for row, col in [(0, 0), (4, 4), (8, 2), (1, 7), (8, 8)]:
         x, y = (col + 0.5) / W * 2 - 1, 1 - (row + 0.5) / W * 2
         u, v = (x + 1.5) / 3 * 1.5 - 0.25, (y + 1.5) / 3 * 1.5 - 0.25
-        t = bilinear(tex, u, v)
+        t = bilinear(stored(tex), u, v)
         # Interpolated UVs in float32 (the texture has a gradient of up to 5 a unit of u).
         np.testing.assert_allclose(img[row, col, :3], over_white(t[:3], t[3]), atol=2e-5)
 

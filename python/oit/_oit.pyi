@@ -52,6 +52,7 @@ class _Stats(TypedDict, total=False):
     target_bytes: int
     scene_bytes: int
     expanded_bytes: int
+    texture_bytes: int
     scene_bytes_by_primitive: dict[str, float]
     gpu_time_ms: float | None
     pass_times_ms: dict[str, float]

@@ -53,7 +53,8 @@ struct Chunk {
 @group(0) @binding(4) var<uniform> chunk: Chunk;
 // Two vec4 a vertex where the scene is shaded: (unit normal, material index bits), (u, v, 0, 0).
 @group(0) @binding(5) var<storage, read> attributes: array<vec4<f32>>;
-// The material table, then every texture's texels (common/shading.wgsl); the same in every chunk.
+// The material table (MATERIAL_VEC4S vec4 a material: oit_core::gpu_types::GpuMaterial), then
+// each image's record (common/shading.wgsl); the same in every chunk.
 @group(0) @binding(6) var<storage, read> surfaces: array<vec4<f32>>;
 //!if INSTANCED
 // A mesh drawn other than once in place: each instance's transform, the inverse transpose of
@@ -87,6 +88,12 @@ struct VsOut {
     @location(4) uv: vec2<f32>,
     @location(5) @interpolate(flat) material: u32,
 //!endif
+//!if TEXTURES
+    // The triangle's UV planes (`uv_planes`): what a texture's mip level is chosen from.
+    @location(6) @interpolate(flat) uv_plane_u: vec3<f32>,
+    @location(7) @interpolate(flat) uv_plane_v: vec3<f32>,
+    @location(8) @interpolate(flat) uv_plane_w: vec3<f32>,
+//!endif
 }
 
 @vertex
@@ -119,7 +126,13 @@ fn vs_main(
     out.material = bitcast<u32>(a.w);
     out.normal = placed_normal(a.xyz, ii);
     out.uv = attributes[2u * v + 1u].xy;
-    if (bitcast<u32>(surfaces[2u * out.material].w) & CULL_BACK) != 0u && !faces_front(vi, ii) {
+//!if TEXTURES
+    let planes = triangle_uv_planes(vi, ii);
+    out.uv_plane_u = planes[0];
+    out.uv_plane_v = planes[1];
+    out.uv_plane_w = planes[2];
+//!endif
+    if (bitcast<u32>(surfaces[MATERIAL_VEC4S * out.material].w) & CULL_BACK) != 0u && !faces_front(vi, ii) {
         // A culled back face: all three corners behind the near plane, so nothing is drawn.
         out.clip = vec4<f32>(0.0, 0.0, -1.0, 1.0);
     }
@@ -140,6 +153,39 @@ fn faces_front(vi: u32, ii: u32) -> bool {
     let c = frame.view_proj * placed(indices[first + 2u], ii);
     return (determinant(mat3x3<f32>(a.xyw, b.xyw, c.xyw)) > 0.0) != mirrors(ii);
 }
+
+//!if TEXTURES
+// The UV planes of the triangle of vertex `vi` (every corner computes the same).
+fn triangle_uv_planes(vi: u32, ii: u32) -> mat3x3<f32> {
+    let first = vi - vi % 3u;
+    let i = vec3<u32>(indices[first], indices[first + 1u], indices[first + 2u]);
+    let a = frame.view_proj * placed(i.x, ii);
+    let b = frame.view_proj * placed(i.y, ii);
+    let c = frame.view_proj * placed(i.z, ii);
+    return uv_planes(a, b, c, attributes[2u * i.x + 1u].xy, attributes[2u * i.y + 1u].xy, attributes[2u * i.z + 1u].xy);
+}
+
+// A triangle's UVs as ratios of planes in NDC: with X, Y, W its clip corners' x, y and w, its
+// barycentrics at (px, py) are c / (c0 + c1 + c2), c = X×Y - px W×Y - py X×W; the rows are
+// (f·X×Y, f·W×Y, f·X×W) for f = its u, its v and 1. The float64 twin is
+// oit_core::shading::uv_footprint.
+fn uv_planes(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, ua: vec2<f32>, ub: vec2<f32>, uc: vec2<f32>) -> mat3x3<f32> {
+    let x = vec3<f32>(a.x, b.x, c.x);
+    let y = vec3<f32>(a.y, b.y, c.y);
+    let w = vec3<f32>(a.w, b.w, c.w);
+    let c0 = cross(x, y);
+    let cx = cross(w, y);
+    let cy = cross(x, w);
+    let u = vec3<f32>(ua.x, ub.x, uc.x);
+    let v = vec3<f32>(ua.y, ub.y, uc.y);
+    let one = vec3<f32>(1.0);
+    return mat3x3<f32>(
+        vec3<f32>(dot(u, c0), dot(u, cx), dot(u, cy)),
+        vec3<f32>(dot(v, c0), dot(v, cx), dot(v, cy)),
+        vec3<f32>(dot(one, c0), dot(one, cx), dot(one, cy)),
+    );
+}
+//!endif
 
 // Vertex `v` of the chunk placed by instance `ii` (world space, w = 1); its color times the
 // instance's; a shading normal carried by the instance (renormalized; zero stays zero); the

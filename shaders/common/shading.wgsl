@@ -8,23 +8,116 @@
 // constants (SHADING_MODE, SHADING_FLAT, TWO_SIDED, TEXTURED ...) come from consts.rs.
 
 //!if TEXTURES
-// One texel, repeat wrap; `first` is the texture's first texel in `surfaces`.
-fn texel(first: u32, size: vec2<i32>, x: i32, y: i32) -> vec4<f32> {
-    let w = ((x % size.x) + size.x) % size.x;
-    let h = ((y % size.y) + size.y) % size.y;
-    return surfaces[first + u32(h * size.x + w)];
+// The texture atlas (oit_core::upload::Atlas): every image's levels in the layers of one 8-bit
+// RGBA array. An image's record in `surfaces` is a header (levels, where its sRGB decoding
+// table is (0: linear), width, height), then (x, y, layer, width | height << 16) a level.
+@group(0) @binding(10) var atlas: texture_2d_array<f32>;
+
+// A sampler's bits (oit_core::shading::Sampler::bits): wrap u in bits 0-1 and v in 2-3
+// (0 repeat, 1 mirrored repeat, 2 clamp to edge), then these.
+const SAMPLER_MAG_LINEAR: u32 = 16u;
+const SAMPLER_MIN_LINEAR: u32 = 32u;
+const SAMPLER_MIPS: u32 = 64u;
+const SAMPLER_MIPS_LINEAR: u32 = 128u;
+
+// Texel `i` of a row of `n` brought into [0, n), as Vulkan addresses (Wrap::texel).
+fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {
+    if mode == 0u {
+        return ((i % n) + n) % n;
+    }
+    if mode == 2u {
+        return clamp(i, 0, n - 1);
+    }
+    let m = ((i % (2 * n)) + 2 * n) % (2 * n);
+    return select(2 * n - 1 - m, m, m < n);
 }
 
-// Bilinear, repeat wrap, texel centers at (i + 1/2) / w; row 0 is v = 0.
-fn texture_sample(first: u32, size: vec2<i32>, uv: vec2<f32>) -> vec4<f32> {
-    let p = uv * vec2<f32>(size) - 0.5;
-    let f = floor(p);
-    let t = p - f;
+// One texel, linear: sRGB color decoded through the table at `srgb` in `surfaces` (256
+// values, four a vec4: exact, where an sRGB view's decoding is approximate on some adapters).
+fn atlas_texel(level: vec4<u32>, srgb: u32, size: vec2<i32>, wrap: u32, x: i32, y: i32) -> vec4<f32> {
+    let at = vec2<i32>(level.xy) + vec2<i32>(wrap_texel(x, size.x, wrap & 3u), wrap_texel(y, size.y, (wrap >> 2u) & 3u));
+    let t = textureLoad(atlas, at, level.z, 0);
+    if srgb == 0u {
+        return t;
+    }
+    let code = vec3<u32>(round(t.rgb * 255.0));
+    let r = surfaces[srgb + code.x / 4u][code.x % 4u];
+    let g = surfaces[srgb + code.y / 4u][code.y % 4u];
+    let b = surfaces[srgb + code.z / 4u][code.z % 4u];
+    return vec4<f32>(r, g, b, t.a);
+}
+
+// Level `l` of the image at `image` at `uv`, nearest or bilinear, texel centers at (i + 1/2) / w.
+fn sample_level(image: u32, srgb: u32, l: u32, uv: vec2<f32>, linear: bool, wrap: u32) -> vec4<f32> {
+    let level = bitcast<vec4<u32>>(surfaces[image + 1u + l]);
+    let size = vec2<i32>(i32(level.w & 0xffffu), i32(level.w >> 16u));
+    let p = uv * vec2<f32>(size);
+    if !linear {
+        let f = floor(p);
+        return atlas_texel(level, srgb, size, wrap, i32(f.x), i32(f.y));
+    }
+    let q = p - 0.5;
+    let f = floor(q);
+    let t = q - f;
     let x = i32(f.x);
     let y = i32(f.y);
-    let top = texel(first, size, x, y) * (1.0 - t.x) + texel(first, size, x + 1, y) * t.x;
-    let bottom = texel(first, size, x, y + 1) * (1.0 - t.x) + texel(first, size, x + 1, y + 1) * t.x;
+    let top = atlas_texel(level, srgb, size, wrap, x, y) * (1.0 - t.x) + atlas_texel(level, srgb, size, wrap, x + 1, y) * t.x;
+    let bottom = atlas_texel(level, srgb, size, wrap, x, y + 1) * (1.0 - t.x) + atlas_texel(level, srgb, size, wrap, x + 1, y + 1) * t.x;
     return top * (1.0 - t.y) + bottom * t.y;
+}
+
+// The UVs' derivatives along the frame's x and y in pixels at the fragment, (d/dx, d/dy),
+// from its triangle's UV planes (common/scene.wgsl `uv_planes`).
+fn uv_footprint(in: VsOut) -> vec4<f32> {
+    let at = frame_xy(in.clip.xy);
+    let ndc = vec2<f32>(at.x * 2.0 / f32(frame.size.x) - 1.0, 1.0 - at.y * 2.0 / f32(frame.size.y));
+    let pu = in.uv_plane_u;
+    let pv = in.uv_plane_v;
+    let pd = in.uv_plane_w;
+    let nu = pu.x - ndc.x * pu.y - ndc.y * pu.z;
+    let nv = pv.x - ndc.x * pv.y - ndc.y * pv.z;
+    let d = pd.x - ndc.x * pd.y - ndc.y * pd.z;
+    let dd = d * d;
+    let dx = vec2<f32>(-pu.y * d + nu * pd.y, -pv.y * d + nv * pd.y) / dd;
+    let dy = vec2<f32>(-pu.z * d + nu * pd.z, -pv.z * d + nv * pd.z) / dd;
+    return vec4<f32>(dx * (2.0 / f32(frame.size.x)), dy * (-2.0 / f32(frame.size.y)));
+}
+
+// A material's texture map `k` (0 base color, 1 emissive) at `uv` for a fragment whose UVs
+// change by `footprint` to its neighbours: the level and filters as oit_core::shading::
+// TextureMap::sample chooses them (the float64 twin).
+fn sample_map(material: u32, k: u32, uv_in: vec2<f32>, footprint: vec4<f32>) -> vec4<f32> {
+    let m0 = surfaces[MATERIAL_VEC4S * material + 2u + 2u * k];
+    let m1 = surfaces[MATERIAL_VEC4S * material + 3u + 2u * k];
+    let image = bitcast<u32>(m0.x);
+    let bits = bitcast<u32>(m0.y);
+    let uv = vec2<f32>(m0.z * uv_in.x + m0.w * uv_in.y + m1.x, m1.y * uv_in.x + m1.z * uv_in.y + m1.w);
+    let header = bitcast<vec4<u32>>(surfaces[image]);
+    let srgb = header.y;
+    let size = vec2<f32>(f32(header.z), f32(header.w));
+    let dx = vec2<f32>(m0.z * footprint.x + m0.w * footprint.y, m1.y * footprint.x + m1.z * footprint.y) * size;
+    let dy = vec2<f32>(m0.z * footprint.z + m0.w * footprint.w, m1.y * footprint.z + m1.z * footprint.w) * size;
+    let lod = log2(max(length(dx), length(dy)));
+    let wrap = bits & 15u;
+    if !(lod > 0.0) {
+        return sample_level(image, srgb, 0u, uv, (bits & SAMPLER_MAG_LINEAR) != 0u, wrap);
+    }
+    let min_linear = (bits & SAMPLER_MIN_LINEAR) != 0u;
+    if (bits & SAMPLER_MIPS) == 0u {
+        return sample_level(image, srgb, 0u, uv, min_linear, wrap);
+    }
+    let top = f32(header.x - 1u);
+    if (bits & SAMPLER_MIPS_LINEAR) == 0u {
+        let l = clamp(ceil(lod + 0.5) - 1.0, 0.0, top);
+        return sample_level(image, srgb, u32(l), uv, min_linear, wrap);
+    }
+    let base = min(floor(lod), top);
+    let t = select(lod - base, 0.0, base == top);
+    let a = sample_level(image, srgb, u32(base), uv, min_linear, wrap);
+    if t == 0.0 {
+        return a;
+    }
+    return a * (1.0 - t) + sample_level(image, srgb, u32(base) + 1u, uv, min_linear, wrap) * t;
 }
 
 //!endif
@@ -50,37 +143,67 @@ fn shading_cost(n: vec3<f32>, v: vec3<f32>, count: u32) -> f32 {
 }
 
 //!if SHADED
-// The vertex color times the texture, alpha times opacity: all that alpha depends on.
+// The vertex color times the texture, alpha times opacity and tested against the cutoff: all
+// that alpha depends on.
 fn surface_base(in: VsOut, m0: vec4<f32>) -> vec4<f32> {
     var base = in.color;
+    let flags = bitcast<u32>(m0.w);
 //!if TEXTURES
-    if (bitcast<u32>(m0.w) & TEXTURED) != 0u {
-        let m1 = bitcast<vec4<u32>>(surfaces[2u * in.material + 1u]);
-        base = base * texture_sample(m1.x, vec2<i32>(m1.yz), in.uv);
+    if (flags & TEXTURED) != 0u {
+        base = base * sample_map(in.material, 0u, in.uv, uv_footprint(in));
     }
 //!endif
     base.a = base.a * m0.z;
 //!if FALLOFF
-    base.a = base.a * falloff((bitcast<u32>(m0.w) & FALLOFF_MASK) >> FALLOFF_SHIFT, in.uv);
+    base.a = base.a * falloff((flags & FALLOFF_MASK) >> FALLOFF_SHIFT, in.uv);
+//!endif
+//!if ALPHA_TESTS
+    if (flags & ALPHA_TEST) != 0u {
+        base.a = select(0.0, 1.0, base.a >= surfaces[MATERIAL_VEC4S * in.material + 1u].w);
+    }
 //!endif
     return base;
 }
 
+//!if EMISSIVE
+// The light the surface gives off: its emissive color times its emissive texture.
+fn surface_emission(in: VsOut, flags: u32) -> vec3<f32> {
+    var e = surfaces[MATERIAL_VEC4S * in.material + 1u].rgb;
+//!if TEXTURES
+    if (flags & EMISSIVE_TEXTURED) != 0u {
+        e = e * sample_map(in.material, 1u, in.uv, uv_footprint(in)).rgb;
+    }
+//!endif
+    return e;
+}
+//!endif
+
 fn shade(in: VsOut) -> vec4<f32> {
-    let m0 = surfaces[2u * in.material];
+    let m0 = surfaces[MATERIAL_VEC4S * in.material];
     let flags = bitcast<u32>(m0.w);
     let base = surface_base(in, m0);
+//!if EMISSIVE
+    let emission = surface_emission(in, flags);
+//!endif
     let v = to_eye(in.clip.xy);
     var extra = 0.0;
     if SHADING_COST != 0u {
         extra = shading_cost(normalize(in.normal), v, SHADING_COST) * frame.ambient.w;
     }
     if (flags & SHADING_MODE) == SHADING_UNLIT {
+//!if EMISSIVE
+        return vec4<f32>(clamp(base.rgb + emission, vec3<f32>(0.0), vec3<f32>(1.0)) + extra, base.a);
+//!else
         return vec4<f32>(base.rgb + extra, base.a);
+//!endif
     }
 //!if PRIMITIVES
     if (flags & SHADING_MODE) == SHADING_HAIR {
+//!if EMISSIVE
+        return vec4<f32>(clamp(hair(base.rgb, normalize(in.normal), v, m0) + emission, vec3<f32>(0.0), vec3<f32>(1.0)) + extra, base.a);
+//!else
         return vec4<f32>(hair(base.rgb, normalize(in.normal), v, m0) + extra, base.a);
+//!endif
     }
 //!endif
 //!if PHONG
@@ -98,7 +221,11 @@ fn shade(in: VsOut) -> vec4<f32> {
         let h = hv * inverseSqrt(max(dot(hv, hv), 1e-30));
         highlight += radiance * pow(max(dot(n, h), 0.0), m0.y);
     }
+//!if EMISSIVE
+    let rgb = clamp(base.rgb * diffuse + m0.x * highlight + emission, vec3<f32>(0.0), vec3<f32>(1.0));
+//!else
     let rgb = clamp(base.rgb * diffuse + m0.x * highlight, vec3<f32>(0.0), vec3<f32>(1.0));
+//!endif
     return vec4<f32>(rgb + extra, base.a);
 //!else
     // No surface of the scene shades flat or smooth (PHONG = 0): never reached.
@@ -110,7 +237,7 @@ fn shade(in: VsOut) -> vec4<f32> {
 // passes that read only alpha (hybrid's k-TAB store, stochastic's depth pass), no lights.
 fn shaded_alpha(raw: VsOut) -> VsOut {
     var out = raw;
-    out.color.a = surface_base(raw, surfaces[2u * raw.material]).a;
+    out.color.a = surface_base(raw, surfaces[MATERIAL_VEC4S * raw.material]).a;
     return out;
 }
 //!else

@@ -57,7 +57,23 @@ pub fn scene_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         storage(7),
         compute(8),
         storage(9),
+        atlas_entry(10),
     ]
+}
+
+/// The texture atlas (upload.rs `Atlas`): every image of the scene's materials with its mips,
+/// read texel by texel (shaders/common/shading.wgsl filters and decodes sRGB).
+fn atlas_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        },
+        count: None,
+    }
 }
 
 /// Group 0 of the expansion pass (shaders/expand.wgsl): the scene's bindings with the expanded

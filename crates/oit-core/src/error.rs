@@ -18,6 +18,9 @@ pub enum OitError {
     /// The device failed during work (maps to `RuntimeError`).
     #[error("{0}")]
     Device(String),
+    /// A file, or one that a file refers to, is not there (maps to `FileNotFoundError`).
+    #[error("{0}")]
+    NotFound(String),
 }
 
 pub type Result<T> = std::result::Result<T, OitError>;

@@ -34,19 +34,36 @@ pub struct GpuLight {
     pub radiance: [f32; 4],
 }
 
-/// Mirrors `Material` in `shaders/common/shading.wgsl`: one record of the material table.
+/// Mirrors the material records of `surfaces` in `shaders/common/shading.wgsl`
+/// (`MATERIAL_VEC4S` vec4 each): one record of the material table.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuMaterial {
     pub specular: f32,
     pub shininess: f32,
     pub opacity: f32,
-    /// `Shading::code()`, plus TWO_SIDED (bit 8) and TEXTURED (bit 9).
+    /// `Shading::code()`, plus the flag bits of `Shading::flags`.
     pub flags: u32,
-    /// The first texel in the table, the texture's width and height.
-    pub texture: [u32; 3],
-    pub pad: u32,
+    /// Linear emissive RGB, and the alpha cutoff (read where ALPHA_TEST is set).
+    pub emissive: [f32; 3],
+    pub alpha_cutoff: f32,
+    /// The base color texture and the emissive texture.
+    pub maps: [GpuTextureMap; 2],
 }
+
+/// A texture as a material uses it: where its image's record is in `surfaces` (a header
+/// (levels, sRGB, width, height), then (x, y, layer, width | height << 16) a level in the
+/// atlas), the sampler's bits (`Sampler::bits`), and the UV transform's two rows.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuTextureMap {
+    pub image: u32,
+    pub sampler: u32,
+    pub transform: [f32; 6],
+}
+
+/// vec4 a material record.
+pub const MATERIAL_VEC4S: u32 = (std::mem::size_of::<GpuMaterial>() / 16) as u32;
 
 /// Mirrors `Instance` in `shaders/common/scene.wgsl`: one row of the instance table.
 #[repr(C)]

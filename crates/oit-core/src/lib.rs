@@ -35,5 +35,5 @@ pub use primitive::Primitive;
 pub use reference::{reference, reference_antialiased, ReferenceImage};
 pub use renderer::{coverage_methods, shared_context, Frame, Renderer, Target, COVERAGE_SAMPLES};
 pub use scene::{Camera, Instance, Mesh, Scene};
-pub use shading::{Falloff, Light, Material, Shading, Texture, MAX_LIGHTS};
+pub use shading::{Falloff, Filter, Light, Material, Sampler, Shading, Texture, TextureMap, Wrap, MAX_LIGHTS};
 pub use stats::Stats;

@@ -279,7 +279,8 @@ fn trace_frame(
                         let mut hits: Vec<Hit> = Vec::new();
                         let mut edge = false;
                         if let Some(bvh) = bvh {
-                            trace(bvh, tris, looks, o, d, center, &vp, &mut hits, &mut edge);
+                            let at = (center, DVec2::new(x, y), DVec2::new(wf, hf));
+                            trace(bvh, tris, looks, o, d, at, &vp, &mut hits, &mut edge);
                         }
                         let (rgba, n, tie) = composite(&mut hits, background);
                         img[4 * k..4 * k + 4].copy_from_slice(&rgba);
@@ -317,7 +318,17 @@ fn report_progress<T>(workers: &[std::thread::ScopedJoinHandle<'_, T>], rows_don
 }
 
 #[allow(clippy::too_many_arguments)]
-fn trace(bvh: &Bvh2, tris: &[Tri], looks: &Looks<'_>, o: DVec3, d: DVec3, center: DVec2, vp: &DMat4, hits: &mut Vec<Hit>, edge: &mut bool) {
+fn trace(
+    bvh: &Bvh2,
+    tris: &[Tri],
+    looks: &Looks<'_>,
+    o: DVec3,
+    d: DVec3,
+    (center, ndc, size): (DVec2, DVec2, DVec2),
+    vp: &DMat4,
+    hits: &mut Vec<Hit>,
+    edge: &mut bool,
+) {
     let to_eye = -d.normalize();
     let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()), -1e-3, 1.0 + 1e-3);
     bvh.ray_traverse_anyhit(ray, |_, id| {
@@ -349,12 +360,20 @@ fn trace(bvh: &Bvh2, tris: &[Tri], looks: &Looks<'_>, o: DVec3, d: DVec3, center
             let w = 1.0 - u - v;
             let mut color = t.c[0] * w + t.c[1] * u + t.c[2] * v;
             if looks.shaded {
+                let material = looks.materials[t.mesh];
+                let (duv_dx, duv_dy) = if material.texture.is_some() || material.emissive_texture.is_some() {
+                    shading::uv_footprint(t.v.map(|p| *vp * p.extend(1.0)), t.uv, ndc, size)
+                } else {
+                    (DVec2::ZERO, DVec2::ZERO)
+                };
                 let surface = shading::Surface {
                     color,
                     normal: t.n[0] * w + t.n[1] * u + t.n[2] * v,
                     uv: t.uv[0] * w + t.uv[1] * u + t.uv[2] * v,
+                    duv_dx,
+                    duv_dy,
                     to_eye,
-                    material: looks.materials[t.mesh],
+                    material,
                 };
                 let (shaded, grazing) = shading::shade(&surface, &looks.lighting);
                 color = shaded;

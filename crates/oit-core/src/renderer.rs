@@ -361,6 +361,8 @@ impl Renderer {
             sets_only: scene.sets_only,
             phong: scene.phong,
             falloff: scene.falloff,
+            emissive: scene.emissive,
+            alpha_test: scene.alpha_test,
         }
     }
 }

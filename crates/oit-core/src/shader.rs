@@ -53,6 +53,8 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("SETS_ONLY", 0),
     Const::U32("PHONG", 1),
     Const::U32("FALLOFF", 1),
+    Const::U32("EMISSIVE", 1),
+    Const::U32("ALPHA_TESTS", 1),
     // Whether `expanded` is writable: the expansion pass of strands and particles only.
     Const::U32("EXPANDING", 0),
 ];
@@ -83,10 +85,14 @@ pub struct SceneVariant {
     /// Whether any particle set fades its alpha towards its rim (a falloff): without one, the
     /// falloff's code is not compiled.
     pub falloff: bool,
+    /// Whether any material gives off light (an emissive color), and whether any tests its
+    /// alpha against a cutoff (glTF's MASK): without one, that code is not compiled.
+    pub emissive: bool,
+    pub alpha_test: bool,
 }
 
 impl SceneVariant {
-    pub fn consts(&self) -> [Const; 10] {
+    pub fn consts(&self) -> [Const; 12] {
         [
             Const::U32("SHADED", self.shaded as u32),
             Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
@@ -97,6 +103,8 @@ impl SceneVariant {
             Const::U32("SETS_ONLY", (self.primitives && self.sets_only) as u32),
             Const::U32("PHONG", (self.shaded && self.phong) as u32),
             Const::U32("FALLOFF", (self.shaded && self.primitives && self.falloff) as u32),
+            Const::U32("EMISSIVE", (self.shaded && self.emissive) as u32),
+            Const::U32("ALPHA_TESTS", (self.shaded && self.alpha_test) as u32),
             // Only shaders/expand.wgsl writes the corners (its own //!define).
             Const::U32("EXPANDING", 0),
         ]
@@ -127,6 +135,8 @@ const UNLIT: SceneVariant = SceneVariant {
     sets_only: false,
     phong: true,
     falloff: true,
+    emissive: false,
+    alpha_test: false,
 };
 
 /// `DEFAULT_CONSTS` with `variant`'s constants in place of the defaults of the same names.

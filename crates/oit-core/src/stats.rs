@@ -33,6 +33,9 @@ pub struct Stats {
     /// The part of `scene_bytes` that strand and particle corners take: built on the GPU each
     /// frame, not uploaded.
     pub expanded_bytes: u64,
+    /// The part of `scene_bytes` that the materials' textures take (the atlas of every image
+    /// with its mips, each image once).
+    pub texture_bytes: u64,
     pub gpu_time_ms: Option<f64>,
     pub pass_times_ms: Vec<(&'static str, f64)>,
     pub overflow_fragments: u64,
@@ -82,6 +85,7 @@ pub const SCHEMA: &[StatKey] = &[
     key("target_bytes", "int", "the frame's targets and readbacks as allocated (tile-sized under a small budget)"),
     key("scene_bytes", "int", "the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's"),
     key("expanded_bytes", "int", "the part of scene_bytes that strands and particles build on the GPU each frame, not uploaded"),
+    key("texture_bytes", "int", "the part of scene_bytes that textures take (each image once, with its mips, 4 bytes a texel)"),
     key(
         "scene_bytes_by_primitive",
         "dict[str, float]",
@@ -130,6 +134,7 @@ impl Stats {
             ("target_bytes", Int(Some(self.target_bytes))),
             ("scene_bytes", Int(Some(self.scene_bytes))),
             ("expanded_bytes", Int(Some(self.expanded_bytes))),
+            ("texture_bytes", Int(Some(self.texture_bytes))),
             ("scene_bytes_by_primitive", Numbers(primitive_bytes(self.scene_bytes_by_primitive))),
             ("gpu_time_ms", Float(self.gpu_time_ms)),
             ("pass_times_ms", Numbers(summed(&self.pass_times_ms))),

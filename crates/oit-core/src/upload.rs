@@ -6,11 +6,11 @@
 use glam::Vec3;
 
 use crate::context::GpuContext;
-use crate::error::{OitError, Result};
-use crate::gpu_types::{GpuInstance, GpuMaterial, GpuSegment};
+use crate::error::{invalid, OitError, Result};
+use crate::gpu_types::{GpuInstance, GpuMaterial, GpuSegment, GpuTextureMap, MATERIAL_VEC4S};
 use crate::primitive::{self, Primitive, PRIM_MESH, PRIM_PARTICLES, PRIM_STRANDS};
 use crate::scene::{Instance, Mesh, Scene};
-use crate::shading::Shading;
+use crate::shading::{Shading, Texture, TextureMap};
 use crate::targets::storage_buffer;
 
 /// One instance of a mesh, in the drawn order: its centroid in world space, its mesh (within
@@ -142,6 +142,13 @@ pub struct GpuScene {
     /// whether any has a falloff (FALLOFF).
     pub phong: bool,
     pub falloff: bool,
+    /// Whether any material gives off light (EMISSIVE), and whether any tests alpha
+    /// (ALPHA_TESTS).
+    pub emissive: bool,
+    pub alpha_test: bool,
+    /// The bytes the materials' images with their mips take on the GPU (the atlas, bound in
+    /// every chunk's group 0; 0 without textures: a 1-texel placeholder is bound).
+    pub texture_bytes: u64,
     /// The matrices (`execute::expansion_view`) the corners in `expanded` were last built
     /// under; None until the first expansion.
     pub expanded_view: std::cell::Cell<Option<[u32; 32]>>,
@@ -258,6 +265,7 @@ struct Shared<'a> {
     expand_layout: &'a wgpu::BindGroupLayout,
     uniform: &'a wgpu::Buffer,
     surfaces: &'a wgpu::Buffer,
+    atlas: &'a Atlas,
     shaded: bool,
     instanced: bool,
 }
@@ -438,16 +446,19 @@ fn upload<'a>(
                 (8, &seg),
                 (9, &expanded),
             ];
-            let bind = |layout: &wgpu::BindGroupLayout, label: &str, skip: Option<u32>| {
+            let bind = |layout: &wgpu::BindGroupLayout, label: &str, skip: Option<u32>, views: &[(u32, &wgpu::TextureView)]| {
                 let entries: Vec<wgpu::BindGroupEntry> = buffers
                     .iter()
                     .filter(|(binding, _)| Some(*binding) != skip)
                     .map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
+                    .chain(
+                        views.iter().map(|&(binding, v)| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }),
+                    )
                     .collect();
                 gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
             };
-            let group = bind(shared.layout, label, None);
-            let expand = (corners > 0).then(|| (bind(shared.expand_layout, "expand", Some(8)), g.kind == PRIM_STRANDS));
+            let group = bind(shared.layout, label, None, &[(10, &shared.atlas.view)]);
+            let expand = (corners > 0).then(|| (bind(shared.expand_layout, "expand", Some(8), &[]), g.kind == PRIM_STRANDS));
             Chunk { group, triangles: g.triangles(), drawn: chunk_drawn[k], expand }
         })
         .collect();
@@ -534,11 +545,12 @@ impl GpuScene {
         max_binding_bytes: u64,
     ) -> Result<Self> {
         let shaded = scene.shaded();
-        let table = if shaded { surfaces(scene) } else { vec![[0.0; 4]; 2] };
+        let images = if shaded { images(scene) } else { Vec::new() };
+        let (atlas, places) = Atlas::new(gpu, &images)?;
+        let table = if shaded { surfaces(scene, &images, &places) } else { vec![[0.0; 4]; MATERIAL_VEC4S as usize] };
         if table.len() as u64 * 16 > max_binding_bytes {
             return Err(OitError::OutOfMemory(format!(
-                "the scene's materials and textures take {} bytes, past a storage binding ({max_binding_bytes} bytes): \
-                 use smaller textures",
+                "the scene's material table takes {} bytes, past a storage binding ({max_binding_bytes} bytes): use fewer meshes or materials",
                 table.len() * 16
             )));
         }
@@ -546,20 +558,24 @@ impl GpuScene {
         gpu.queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&table));
         let instanced = scene.instanced();
         let expand_layout = gpu.cache.layout(&gpu.device, crate::cache::Layout::Expand);
-        let shared = Shared { layout, expand_layout: &expand_layout, uniform, surfaces: &buffer, shaded, instanced };
+        let shared = Shared { layout, expand_layout: &expand_layout, uniform, surfaces: &buffer, atlas: &atlas, shaded, instanced };
         let meshes = || scene.placed().enumerate().map(|(i, (m, list))| (i, m, list));
         let mut transparent = upload(gpu, "transparent", meshes().filter(|(_, m, _)| !m.opaque), &shared, max_binding_bytes)?;
         let opaque = upload(gpu, "opaque", meshes().filter(|(_, m, _)| m.opaque), &shared, max_binding_bytes)?;
         if shaded {
-            transparent.bytes[PRIM_MESH as usize] += table.len() as u64 * 16;
+            transparent.bytes[PRIM_MESH as usize] += table.len() as u64 * 16 + atlas.bytes;
         }
-        let textured = shaded && scene.meshes().iter().any(|m| m.material.texture.is_some());
+        let textured = !images.is_empty();
         let primitives = scene.meshes().iter().any(|m| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair);
         let sets_only = scene.meshes().iter().all(|m| m.primitive != Primitive::Triangles);
         let phong = scene.meshes().iter().any(|m| matches!(m.material.shading, Shading::Flat | Shading::Smooth));
         let falloff = scene.meshes().iter().any(|m| m.material.falloff != crate::shading::Falloff::None);
         let instances = scene.instance_count() as u64;
+        let emissive = scene.meshes().iter().any(|m| m.material.emissive != [0.0; 3]);
+        let alpha_test = scene.meshes().iter().any(|m| m.material.alpha_cutoff.is_some());
         Ok(Self {
+            emissive,
+            alpha_test,
             transparent,
             opaque,
             shaded,
@@ -570,6 +586,7 @@ impl GpuScene {
             sets_only,
             phong,
             falloff,
+            texture_bytes: atlas.bytes,
             expanded_view: Default::default(),
         })
     }
@@ -598,23 +615,137 @@ fn flat_corners(m: &Mesh) -> Mesh {
     out
 }
 
-/// The material table (two vec4 a mesh: `GpuMaterial`), then the texels of every texture.
-fn surfaces(scene: &Scene) -> Vec<[f32; 4]> {
+/// Every image the scene's materials use, once however many use it, in first-use order.
+fn images(scene: &Scene) -> Vec<&Texture> {
+    let mut seen = std::collections::HashSet::new();
+    let maps = scene.meshes().iter().flat_map(|m| [&m.material.texture, &m.material.emissive_texture]);
+    maps.flatten().filter(|t| seen.insert(std::sync::Arc::as_ptr(&t.image))).map(|t| &*t.image).collect()
+}
+
+/// The material table (`MATERIAL_VEC4S` vec4 a mesh: `GpuMaterial`), then, where there are
+/// images, the sRGB decoding table (the linear value of each 8-bit code, four a vec4) and each
+/// image's record: a header (levels, the table's place or 0 for a linear image, width, height)
+/// and, a level, its place in the atlas (x, y, layer, width | height << 16).
+fn surfaces(scene: &Scene, images: &[&Texture], places: &[Vec<[u32; 4]>]) -> Vec<[f32; 4]> {
     let meshes = scene.meshes();
-    let mut texels: Vec<[f32; 4]> = Vec::new();
-    let mut table: Vec<[f32; 4]> = Vec::with_capacity(2 * meshes.len());
+    let base = MATERIAL_VEC4S as usize * meshes.len();
+    let mut records: Vec<[u32; 4]> = Vec::new();
+    if !images.is_empty() {
+        let decode = crate::shading::srgb_table();
+        records.extend(decode.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]].map(f32::to_bits)));
+    }
+    let mut first = Vec::with_capacity(images.len());
+    for (image, levels) in images.iter().zip(places) {
+        first.push((base + records.len()) as u32);
+        let table = if image.srgb { base as u32 } else { 0 };
+        records.push([levels.len() as u32, table, image.width, image.height]);
+        records.extend_from_slice(levels);
+    }
+    let map = |t: &Option<TextureMap>| {
+        t.as_ref().map_or(GpuTextureMap::default(), |t| {
+            let at = images.iter().position(|i| std::ptr::eq(*i, &*t.image)).expect("every image is in the atlas");
+            let [a, b] = t.transform;
+            GpuTextureMap { image: first[at], sampler: t.sampler.bits(), transform: [a[0], a[1], a[2], b[0], b[1], b[2]] }
+        })
+    };
+    let mut table: Vec<[f32; 4]> = Vec::with_capacity(base + records.len());
     for m in meshes {
         let mat = &m.material;
-        let flags = Shading::flags(mat);
-        let mut texture = [0; 3];
-        if let Some(t) = &mat.texture {
-            texture = [(2 * meshes.len() + texels.len()) as u32, t.width, t.height];
-            texels.extend_from_slice(&t.texels);
-        }
-        let g = GpuMaterial { specular: mat.specular, shininess: mat.shininess, opacity: mat.opacity, flags, texture, pad: 0 };
+        let g = GpuMaterial {
+            specular: mat.specular,
+            shininess: mat.shininess,
+            opacity: mat.opacity,
+            flags: Shading::flags(mat),
+            emissive: mat.emissive,
+            alpha_cutoff: mat.alpha_cutoff.unwrap_or(0.0),
+            maps: [map(&mat.texture), map(&mat.emissive_texture)],
+        };
         table.extend_from_slice(bytemuck::cast_slice(&[g]));
         debug_assert!(mat.shading != Shading::Smooth || m.normals.len() == m.positions.len());
     }
-    table.extend(texels);
+    table.extend(records.iter().map(|r| r.map(f32::from_bits)));
     table
+}
+
+/// The scene's images with their mip chains, packed level by level into the layers of one
+/// 8-bit RGBA 2D array texture (shelves of rectangles, tallest first), read through an sRGB
+/// 4 bytes a texel plus a third for the mips, and what packing leaves.
+pub struct Atlas {
+    pub view: wgpu::TextureView,
+    /// Bytes of the texture (0 for the placeholder of a scene without textures).
+    pub bytes: u64,
+}
+
+impl Atlas {
+    /// Packs and uploads `images`; returns the atlas and, an image, its levels' places.
+    fn new(gpu: &GpuContext, images: &[&Texture]) -> Result<(Self, Vec<Vec<[u32; 4]>>)> {
+        let max_side = gpu.limits.max_texture_dimension_2d;
+        let rects: Vec<(usize, usize, u32, u32)> = images
+            .iter()
+            .enumerate()
+            .flat_map(|(i, t)| t.levels().iter().enumerate().map(move |(l, level)| (i, l, level.width, level.height)))
+            .collect();
+        if let Some(&(i, _, w, h)) = rects.iter().find(|r| r.2 > max_side || r.3 > max_side) {
+            return Err(invalid!("texture {i} is {w} x {h}, past the adapter's largest texture side ({max_side}): downscale it"));
+        }
+        let area: u64 = rects.iter().map(|r| r.2 as u64 * r.3 as u64).sum();
+        let largest = rects.iter().map(|r| r.2.max(r.3)).max().unwrap_or(1);
+        let side = largest.max(((area as f64 * 1.15).sqrt().ceil() as u32).max(1)).next_power_of_two().min(max_side);
+        // Shelves, tallest rectangles first: (x, y, layer) of each.
+        let mut order: Vec<usize> = (0..rects.len()).collect();
+        order.sort_by_key(|&k| std::cmp::Reverse((rects[k].3, rects[k].2)));
+        let mut at = vec![[0u32; 4]; rects.len()];
+        let (mut x, mut y, mut shelf, mut layer) = (0u32, 0u32, 0u32, 0u32);
+        for k in order {
+            let (_, _, w, h) = rects[k];
+            if x + w > side {
+                (x, y, shelf) = (0, y + shelf, 0);
+            }
+            if y + h > side {
+                (x, y, shelf, layer) = (0, 0, 0, layer + 1);
+            }
+            at[k] = [x, y, layer, w | h << 16];
+            x += w;
+            shelf = shelf.max(h);
+        }
+        let layers = if rects.is_empty() { 1 } else { layer + 1 };
+        if layers > gpu.limits.max_texture_array_layers {
+            return Err(OitError::OutOfMemory(format!(
+                "the scene's textures need {layers} layers of {side} x {side} texels, past the adapter's {}: use fewer or smaller textures",
+                gpu.limits.max_texture_array_layers
+            )));
+        }
+        let size = if rects.is_empty() { 1 } else { side };
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("texture atlas"),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let mut places: Vec<Vec<[u32; 4]>> = images.iter().map(|t| Vec::with_capacity(t.levels().len())).collect();
+        for (&(i, l, w, h), &place) in rects.iter().zip(&at) {
+            let [x, y, z, _] = place;
+            gpu.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x, y, z },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                bytemuck::cast_slice(&images[i].levels()[l].texels),
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(h) },
+                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            );
+            places[i].push(place);
+        }
+        let view = texture
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        let bytes = if rects.is_empty() { 0 } else { 4 * side as u64 * side as u64 * layers as u64 };
+        let atlas = Self { view, bytes };
+        Ok((atlas, places))
+    }
 }

@@ -69,9 +69,21 @@ fn the_64_bit_sort_keys_validate() {
 fn an_unlit_variant_has_no_shading_varyings() {
     let unlit = compose("blend.wgsl", &variant_consts(SceneVariant::default()));
     let lit = compose("blend.wgsl", DEFAULT_CONSTS);
-    for varying in ["normal: vec3<f32>", "uv: vec2<f32>", "material: u32", "fn texture_sample"] {
+    let code = ["fn sample_map", "uv_plane_u: vec3<f32>", "fn surface_emission", "(flags & ALPHA_TEST) != 0u"];
+    for varying in ["normal: vec3<f32>", "uv: vec2<f32>", "material: u32"].into_iter().chain(code) {
         assert!(!unlit.contains(varying), "the unlit blend shader still has `{varying}`");
         assert!(lit.contains(varying), "the lit blend shader lacks `{varying}`");
+    }
+}
+
+#[test]
+fn a_lit_scene_without_textures_emission_or_alpha_tests_compiles_without_their_code() {
+    let lit = SceneVariant { shaded: true, lights: 1, phong: true, ..Default::default() };
+    let plain = compose("blend.wgsl", &variant_consts(lit));
+    let all = compose("blend.wgsl", &variant_consts(SceneVariant { textured: true, emissive: true, alpha_test: true, ..lit }));
+    for code in ["fn sample_map", "uv_plane_u: vec3<f32>", "fn surface_emission", "(flags & ALPHA_TEST) != 0u"] {
+        assert!(!plain.contains(code), "a lit scene without them kept `{code}`");
+        assert!(all.contains(code), "a textured, emissive, alpha-tested scene lacks `{code}`");
     }
 }
 

@@ -30,6 +30,7 @@ impl From<Error> for PyErr {
         let msg = e.to_string();
         match e {
             OitError::InvalidInput(_) => PyValueError::new_err(msg),
+            OitError::NotFound(_) => pyo3::exceptions::PyFileNotFoundError::new_err(msg),
             OitError::OutOfMemory(_) => PyMemoryError::new_err(msg),
             OitError::NoAdapter(_) | OitError::Unsupported(_) | OitError::Device(_) => PyRuntimeError::new_err(msg),
         }
@@ -90,7 +91,8 @@ impl Scene {
                 }
                 let flat: Vec<f32> = a.iter().copied().collect();
                 let texels = flat.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-                Some(oit_core::Texture::new(w as u32, h as u32, texels).map_err(Error::from)?)
+                let image = oit_core::Texture::new(w as u32, h as u32, texels).map_err(Error::from)?;
+                Some(oit_core::TextureMap::new(std::sync::Arc::new(image)))
             }
             None => None,
         };

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use oit_core::{Falloff, Light, Material, Mesh, Primitive, Shading, Texture};
+use oit_core::{Falloff, Light, Material, Mesh, Primitive, Shading, Texture, TextureMap};
 
 pub const MAGIC: &[u8; 8] = b"OITSCENE";
 /// The newest version; a file without surfaces, lights or ambient term is written as 1, one
@@ -186,7 +186,7 @@ fn read_surface(r: &mut Reader<'_>, mesh: Mesh, n: usize) -> Result<Mesh, String
     let (h, w) = (r.u32("the texture height")?, r.u32("the texture width")?);
     let texture = if h > 0 && w > 0 {
         let texels = r.array((h as usize).saturating_mul(w as usize), "texels")?;
-        Some(Texture::new(w, h, texels).map_err(|e| e.to_string())?)
+        Some(TextureMap::new(std::sync::Arc::new(Texture::new(w, h, texels).map_err(|e| e.to_string())?)))
     } else {
         None
     };
@@ -267,8 +267,8 @@ pub fn encode(scene: &SceneData) -> Vec<u8> {
             out.extend(bytemuck::cast_slice(&m.mesh.uvs));
             match &mat.texture {
                 Some(t) => {
-                    u32s(&mut out, &[t.height, t.width]);
-                    out.extend(bytemuck::cast_slice(&t.texels));
+                    u32s(&mut out, &[t.image.height, t.image.width]);
+                    out.extend(bytemuck::cast_slice(&t.image.linear_texels()));
                 }
                 None => u32s(&mut out, &[0, 0]),
             }
@@ -366,7 +366,7 @@ mod tests {
         let material = Material { shading: Shading::Smooth, specular: 0.5, opacity: 0.75, ..Default::default() };
         let texture = Texture::new(1, 2, vec![[1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.5]]).unwrap();
         lit.mesh = lit.mesh.with_surface(None, Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), material).unwrap();
-        lit.mesh.material.texture = Some(texture);
+        lit.mesh.material.texture = Some(TextureMap::new(std::sync::Arc::new(texture)));
         let light = Light::new([0.0, -1.0, -1.0], [1.0, 0.5, 0.25], 0.8).unwrap();
         let scene = SceneData { meshes: vec![lit, triangle(true)], lights: vec![light], ambient: [0.1, 0.2, 0.3], ..Default::default() };
         let bytes = encode(&scene);
@@ -375,7 +375,9 @@ mod tests {
         let (m, plain) = (&back.meshes[0].mesh, &back.meshes[1].mesh);
         assert_eq!((m.material.shading, m.material.specular, m.material.opacity), (Shading::Smooth, 0.5, 0.75));
         assert_eq!(m.normals, scene.meshes[0].mesh.normals);
-        assert_eq!(m.material.texture.as_ref().unwrap().texels[1], [0.0, 0.0, 1.0, 0.5]);
+        let texels = |m: &Mesh| m.material.texture.as_ref().unwrap().image.levels()[0].texels.clone();
+        assert_eq!(texels(m), texels(&scene.meshes[0].mesh));
+        assert_eq!(texels(m)[1], [0, 0, 255, 128]);
         assert!(plain.material.is_plain() && plain.opaque);
         assert_eq!((back.lights[0].direction, back.lights[0].intensity, back.ambient), ([0.0, -1.0, -1.0], 0.8, [0.1, 0.2, 0.3]));
         assert_eq!(encode(&back), bytes);

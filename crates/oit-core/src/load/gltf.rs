@@ -11,9 +11,9 @@ use std::path::Path;
 use glam::{DMat4, DVec3};
 use gltf::material::AlphaMode;
 
-use super::{bounds, named, srgb_to_linear, FileCamera, LoadedFile, NamedMesh, Projection};
+use super::{bounds, named, FileCamera, LoadedFile, NamedMesh, Projection};
 use crate::scene::Instance;
-use crate::shading::{Material, Texture};
+use crate::shading::{Material, Texture, TextureMap};
 
 pub fn load(path: &Path) -> Result<LoadedFile, String> {
     let (doc, buffers, images) = gltf::import(path).map_err(|e| format!("not a readable glTF file ({e})"))?;
@@ -95,31 +95,14 @@ fn primitive(
     let cutoff = material.alpha_cutoff().unwrap_or(0.5);
     let info = pbr.base_color_texture();
     let uvs: Option<Vec<[f32; 2]>> = info.as_ref().and_then(|t| reader.read_tex_coords(t.tex_coord())).map(|t| t.into_f32().collect());
-    let mut texture = match (&info, &uvs) {
-        (Some(t), Some(_)) => Some(texture(&images[t.texture().source().index()])?),
+    let texture = match (&info, &uvs) {
+        (Some(t), Some(_)) => Some(TextureMap::new(std::sync::Arc::new(texture(&images[t.texture().source().index()])?))),
         _ => None,
     };
-    match mode {
-        AlphaMode::Opaque => colors.iter_mut().for_each(|c| c[3] = 1.0),
-        AlphaMode::Mask => {
-            // Alpha-tested: texel alpha times the factor's decides, per texel; the vertices pass.
-            let keep = |a: f32| if a >= cutoff { 1.0 } else { 0.0 };
-            match &mut texture {
-                Some(t) => {
-                    let fa = factor[3];
-                    t.texels.iter_mut().for_each(|c| c[3] = keep(c[3] * fa));
-                    colors.iter_mut().for_each(|c| c[3] = 1.0);
-                }
-                None => colors.iter_mut().for_each(|c| c[3] = keep(c[3])),
-            }
-        }
-        AlphaMode::Blend => {}
-    }
     if mode == AlphaMode::Opaque {
-        if let Some(t) = &mut texture {
-            t.texels.iter_mut().for_each(|c| c[3] = 1.0);
-        }
+        colors.iter_mut().for_each(|c| c[3] = 1.0);
     }
+    let alpha_cutoff = (mode == AlphaMode::Mask).then_some(cutoff);
     let mut mesh = named(name, positions, indices, colors, mode == AlphaMode::Opaque)?;
     if let Some(normals) = reader.read_normals() {
         // Zero normals (some exporters write them) are recomputed; instances carry the rest.
@@ -133,12 +116,12 @@ fn primitive(
         mesh.mesh.uvs = uvs.unwrap_or_default();
     }
     let double = material.double_sided();
-    mesh.mesh.material = Material { two_sided: double, cull_back_faces: !double, texture, ..Default::default() };
+    mesh.mesh.material = Material { two_sided: double, cull_back_faces: !double, texture, alpha_cutoff, ..Default::default() };
     Ok(Some(mesh))
 }
 
-/// A decoded image to a linear texture: color channels are sRGB (8-bit) or linear (16-bit and
-/// float ones taken as they are); gray ones spread to RGB; alpha 1 where there is none.
+/// A decoded image to an 8-bit sRGB texture: 16-bit and float channels rounded to 8 bits;
+/// gray ones spread to RGB; alpha 1 where there is none.
 fn texture(image: &gltf::image::Data) -> Result<Texture, String> {
     use gltf::image::Format as F;
     let (channels, bytes) = match image.format {
@@ -153,34 +136,31 @@ fn texture(image: &gltf::image::Data) -> Result<Texture, String> {
         F::R32G32B32FLOAT => (3, 4),
         F::R32G32B32A32FLOAT => (4, 4),
     };
-    let value = |b: &[u8]| -> f32 {
+    let value = |b: &[u8]| -> u8 {
         match bytes {
-            1 => srgb_to_linear(b[0] as f32 / 255.0),
-            2 => u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
-            _ => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            1 => b[0],
+            2 => (u16::from_le_bytes([b[0], b[1]]) as f32 / 257.0).round() as u8,
+            _ => (f32::from_le_bytes([b[0], b[1], b[2], b[3]]).clamp(0.0, 1.0) * 255.0).round() as u8,
         }
     };
-    let alpha = |b: &[u8]| -> f32 {
-        match bytes {
-            1 => b[0] as f32 / 255.0,
-            _ => value(b),
-        }
-    };
-    let texels = image
+    let rgba = image
         .pixels
         .chunks_exact(channels * bytes)
-        .map(|p| {
-            let c = |i: usize| &p[i * bytes..(i + 1) * bytes];
+        .flat_map(|p| {
+            let c = |i: usize| value(&p[i * bytes..(i + 1) * bytes]);
             let a = match channels {
-                2 => alpha(c(1)),
-                4 => alpha(c(3)),
-                _ => 1.0,
+                2 => c(1),
+                4 => c(3),
+                _ => 255,
             };
-            let rgb = if channels >= 3 { [value(c(0)), value(c(1)), value(c(2))] } else { [value(c(0)); 3] };
-            [rgb[0], rgb[1], rgb[2], a].map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) })
+            if channels >= 3 {
+                [c(0), c(1), c(2), a]
+            } else {
+                [c(0), c(0), c(0), a]
+            }
         })
         .collect();
-    Texture::new(image.width, image.height, texels).map_err(|e| e.to_string())
+    Texture::from_rgba8(image.width, image.height, rgba, true).map_err(|e| e.to_string())
 }
 
 fn file_camera(camera: &gltf::Camera<'_>, world: &DMat4, name: String, lo: DVec3, hi: DVec3) -> Result<FileCamera, String> {

@@ -12,9 +12,9 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use crate::error::{invalid, Result};
+use crate::error::{invalid, OitError, Result};
 use crate::scene::{Instance, Mesh, Scene};
-use crate::shading::{Material, Shading, Texture};
+use crate::shading::{Material, Shading, Texture, TextureMap};
 
 /// The alpha every mesh gets when nothing in a file is transparent (the command line and the
 /// viewer; `Scene.from_file` keeps the file's).
@@ -23,6 +23,9 @@ pub const VIEWING_ALPHA: f32 = 0.4;
 pub const DEFAULT_RGB: [f32; 3] = [0.8, 0.8, 0.8];
 /// The ambient term a loaded scene gets (docs/shading.md): the lights are the headlight.
 pub const AMBIENT: [f32; 3] = [0.1; 3];
+/// The largest side of a loaded image: larger ones are downscaled, keeping their aspect, with
+/// a warning (the side every adapter can sample).
+pub const MAX_TEXTURE_SIZE: u32 = Texture::MAX_SIZE;
 /// The extensions `load_file` reads, as its messages list them.
 pub const FORMATS: &str = ".obj (with .mtl), .gltf, .glb, .ply and .stl";
 
@@ -78,40 +81,80 @@ impl Default for Surface {
     }
 }
 
-/// Everything a file holds, in the file's order.
+/// Everything a file holds, in the file's order, and what of it is not drawn.
 #[derive(Clone, Debug, Default)]
 pub struct LoadedFile {
     pub meshes: Vec<NamedMesh>,
     pub cameras: Vec<FileCamera>,
+    /// One sentence a feature the file uses and oit does not draw, with how many objects use it
+    /// ("2 animations are not drawn: oit shows the base pose"); each feature said once.
+    pub warnings: Vec<String>,
+}
+
+/// Why a format's loader refused a file: `load_file` prefixes the file's path.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LoadError {
+    /// The file breaks its format's rules: the message names the object and the rule.
+    Invalid(String),
+    /// A file it refers to (a buffer, an image, a material library) is not there: the message
+    /// names it and the object that refers to it.
+    NotFound(String),
+}
+
+impl From<String> for LoadError {
+    fn from(e: String) -> Self {
+        Self::Invalid(e)
+    }
+}
+
+impl From<&str> for LoadError {
+    fn from(e: &str) -> Self {
+        Self::Invalid(e.to_string())
+    }
+}
+
+impl LoadError {
+    fn at(self, path: &Path) -> OitError {
+        match self {
+            Self::Invalid(e) => invalid!("{}: {e}", path.display()),
+            Self::NotFound(e) => OitError::NotFound(format!("{}: {e}", path.display())),
+        }
+    }
 }
 
 /// Reads `path` by its extension. Bad files are `InvalidInput` naming the file and the fault.
 pub fn load_file(path: &Path, surface: Surface) -> Result<LoadedFile> {
     if !path.is_file() {
-        return Err(invalid!("no such file: {}: check the path", path.display()));
+        return Err(OitError::NotFound(format!("no such file: {}: check the path", path.display())));
     }
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_lowercase();
-    let fail = |e: String| invalid!("{}: {e}", path.display());
+    let fail = |e: LoadError| e.at(path);
     let mut file = match ext.as_str() {
-        "obj" => LoadedFile { meshes: obj::load(path).map_err(fail)?, cameras: Vec::new() },
-        "ply" => LoadedFile { meshes: vec![ply::load_ply(path).map_err(fail)?], cameras: Vec::new() },
-        "stl" => LoadedFile { meshes: vec![ply::load_stl(path).map_err(fail)?], cameras: Vec::new() },
-        "gltf" | "glb" => gltf::load(path).map_err(fail)?,
+        "obj" => LoadedFile { meshes: obj::load(path).map_err(|e| fail(e.into()))?, ..Default::default() },
+        "ply" => LoadedFile { meshes: vec![ply::load_ply(path).map_err(|e| fail(e.into()))?], ..Default::default() },
+        "stl" => LoadedFile { meshes: vec![ply::load_stl(path).map_err(|e| fail(e.into()))?], ..Default::default() },
+        "gltf" | "glb" => gltf::load(path).map_err(|e| fail(e.into()))?,
         _ => return Err(invalid!("{}: unknown file type '.{ext}': oit reads {FORMATS}", path.display())),
     };
     if ext == "ply" && file.meshes.iter().all(|m| m.mesh.indices.is_empty() && !m.mesh.positions.is_empty()) {
         // A point cloud: hard discs facing the eye, one a point.
         for m in &mut file.meshes {
-            m.mesh = points_as_particles(std::mem::take(&mut m.mesh), surface.point_radius).map_err(|e| fail(e.to_string()))?;
+            m.mesh = points_as_particles(std::mem::take(&mut m.mesh), surface.point_radius).map_err(|e| fail(e.to_string().into()))?;
         }
         return Ok(file);
     }
-    if file.meshes.iter().all(|m| m.mesh.indices.is_empty()) {
-        return Err(invalid!("{} has no triangles: oit draws triangle meshes (and a PLY of points only as particles)", path.display()));
+    let drawn = |m: &NamedMesh| !m.mesh.indices.is_empty() || m.mesh.primitive != crate::primitive::Primitive::Triangles;
+    if !file.meshes.iter().any(drawn) {
+        return Err(invalid!(
+            "{} has nothing to draw: no triangles, lines or points (oit draws triangle meshes, lines as strands and points as particles)",
+            path.display()
+        ));
     }
-    file.meshes.retain(|m| !m.mesh.indices.is_empty());
+    file.meshes.retain(drawn);
     for m in &mut file.meshes {
-        restyle(&mut m.mesh, surface).map_err(|e| invalid!("{}: '{}': {e}", path.display(), m.name))?;
+        if m.mesh.primitive == crate::primitive::Primitive::Triangles {
+            restyle(&mut m.mesh, surface).map_err(|e| invalid!("{}: '{}': {e}", path.display(), m.name))?;
+        }
     }
     Ok(file)
 }
@@ -145,8 +188,9 @@ fn restyle(mesh: &mut Mesh, surface: Surface) -> Result<()> {
 /// strictly between 0 and 1 (alpha-tested surfaces, 0 or 1 everywhere, do not).
 pub fn blends(mesh: &Mesh) -> bool {
     let partial = |a: f32| a > 0.0 && a < 1.0;
-    let texture = mesh.material.texture.as_ref().is_some_and(|t| t.texels.iter().any(|c| partial(c[3])));
-    !mesh.opaque && (partial(mesh.material.opacity) || texture || mesh.colors.iter().any(|c| partial(c[3])))
+    let texture = mesh.material.texture.as_ref().is_some_and(|t| t.image.has_partial_alpha());
+    let tested = mesh.material.alpha_cutoff.is_some();
+    !mesh.opaque && !tested && (partial(mesh.material.opacity) || texture || mesh.colors.iter().any(|c| partial(c[3])))
 }
 
 /// Makes every mesh transparent at `alpha` (vertex alpha; textures keep theirs).
@@ -208,14 +252,11 @@ pub(crate) fn named(
     Ok(NamedMesh::new(name, mesh))
 }
 
-/// An 8-bit image to a linear texture: RGB decoded from sRGB, alpha as it is.
-pub(crate) fn texture_from_rgba8(width: u32, height: u32, rgba: &[u8]) -> std::result::Result<Texture, String> {
-    let texels = rgba.chunks_exact(4).map(|p| [srgb8(p[0]), srgb8(p[1]), srgb8(p[2]), p[3] as f32 / 255.0]).collect();
-    Texture::new(width, height, texels).map_err(|e| e.to_string())
-}
-
-fn srgb8(c: u8) -> f32 {
-    srgb_to_linear(c as f32 / 255.0)
+/// An 8-bit sRGB color image (linear alpha), 4 bytes a texel row-major, as a texture with the
+/// default sampler (repeat wrap, trilinear).
+pub(crate) fn texture_map(width: u32, height: u32, rgba: Vec<u8>) -> std::result::Result<TextureMap, String> {
+    let image = Texture::from_rgba8(width, height, rgba, true).map_err(|e| e.to_string())?;
+    Ok(TextureMap::new(std::sync::Arc::new(image)))
 }
 
 /// The box around every mesh's instances (file cameras without a far plane, the viewer's fit);

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use super::{named, srgb_to_linear, texture_from_rgba8, NamedMesh, DEFAULT_RGB};
-use crate::shading::{Material, Texture};
+use super::{named, srgb_to_linear, texture_map, NamedMesh, DEFAULT_RGB};
+use crate::shading::{Material, TextureMap};
 
 pub fn load(path: &Path) -> Result<Vec<NamedMesh>, String> {
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
@@ -56,7 +56,7 @@ pub fn load(path: &Path) -> Result<Vec<NamedMesh>, String> {
 }
 
 /// `map_Kd` times `map_d` (whose first channel is the alpha), either optional.
-fn texture(dir: &Path, diffuse: Option<&str>, dissolve: Option<&str>) -> Result<Option<Texture>, String> {
+fn texture(dir: &Path, diffuse: Option<&str>, dissolve: Option<&str>) -> Result<Option<TextureMap>, String> {
     let read = |name: &str| {
         let file = dir.join(name.trim());
         image::open(&file).map(|i| i.to_rgba8()).map_err(|e| format!("texture {}: {e}", file.display()))
@@ -72,5 +72,5 @@ fn texture(dir: &Path, diffuse: Option<&str>, dissolve: Option<&str>) -> Result<
         let mask = image::imageops::resize(&mask, w, h, image::imageops::FilterType::Triangle);
         image.pixels_mut().zip(mask.pixels()).for_each(|(p, m)| p[3] = m[0]);
     }
-    texture_from_rgba8(image.width(), image.height(), image.as_raw()).map(Some)
+    texture_map(image.width(), image.height(), image.into_raw()).map(Some)
 }

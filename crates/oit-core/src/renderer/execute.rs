@@ -220,6 +220,7 @@ impl Renderer {
             scene_bytes: gpu_scene.bytes().iter().sum(),
             scene_bytes_by_primitive: gpu_scene.bytes(),
             expanded_bytes: gpu_scene.transparent.expanded_bytes + gpu_scene.opaque.expanded_bytes,
+            texture_bytes: gpu_scene.texture_bytes,
             gpu_time_ms: pass_times.as_ref().map(|p| p.iter().map(|(_, t)| t).sum()),
             pass_times_ms: pass_times.unwrap_or_default(),
             overflow_fragments: report.overflow_fragments,
