@@ -425,6 +425,25 @@ impl TextureMap {
         DVec2::new(m[0][0] * d.x + m[0][1] * d.y, m[1][0] * d.x + m[1][1] * d.y)
     }
 
+    /// Whether float32 may sample this point differently: within a thousandth of a pixel of a
+    /// nearest filter's texel edge, or of a level of detail where the sampler switches level
+    /// (nearest mips) or filter (magnification against minification).
+    pub fn ambiguous(&self, uv: DVec2, duv_dx: DVec2, duv_dy: DVec2) -> bool {
+        let s = &self.sampler;
+        let lod = self.lod(duv_dx, duv_dy);
+        let near = |x: f64, tol: f64| (x - x.round()).abs() < tol;
+        let switch = (s.mag != s.min && lod.abs() < 1e-3) || (s.mipmap == Some(Filter::Nearest) && lod > 0.0 && near(lod + 0.5, 1e-3));
+        let filter = if lod.is_nan() || lod <= 0.0 { s.mag } else { s.min };
+        let edge = filter == Filter::Nearest && {
+            let level = if lod > 0.0 && s.mipmap.is_some() { lod.max(0.0).round() as u32 } else { 0 };
+            let size = DVec2::new((self.image.width >> level).max(1) as f64, (self.image.height >> level).max(1) as f64);
+            let p = self.map_uv(uv) * size;
+            let texels_a_pixel = 2f64.powf(lod.max(0.0)).max(1.0);
+            near(p.x, 1e-3 * texels_a_pixel + 1e-4) || near(p.y, 1e-3 * texels_a_pixel + 1e-4)
+        };
+        switch || edge
+    }
+
     /// The UVs after the transform.
     pub fn map_uv(&self, uv: DVec2) -> DVec2 {
         let m = self.transform.map(|r| r.map(|x| x as f64));
@@ -687,15 +706,19 @@ pub struct Surface<'a> {
 pub fn shade(s: &Surface<'_>, lighting: &Lighting) -> (DVec4, bool) {
     let m = s.material;
     let mut base = s.color;
+    let maps = [&m.texture, &m.emissive_texture];
+    let mut ambiguous = maps.into_iter().flatten().any(|t| t.ambiguous(s.uv, s.duv_dx, s.duv_dy));
     if let Some(t) = &m.texture {
         base *= t.sample(s.uv, s.duv_dx, s.duv_dy);
     }
     base.w *= m.opacity as f64;
-    let (falloff, mut ambiguous) = m.falloff.factor(s.uv);
+    let (falloff, rim) = m.falloff.factor(s.uv);
+    ambiguous |= rim;
     base.w *= falloff;
     if let Some(cutoff) = m.alpha_cutoff {
-        // float32 may land on the other side of the cutoff: an ambiguous pixel.
-        ambiguous |= (base.w - cutoff as f64).abs() < 1e-5;
+        // float32 (and its UVs, a fraction of a pixel off) may land on the other side of the
+        // cutoff: an ambiguous pixel.
+        ambiguous |= (base.w - cutoff as f64).abs() < 2e-3;
         base.w = if base.w >= cutoff as f64 { 1.0 } else { 0.0 };
     }
     let mut emissive = DVec3::from(m.emissive.map(|x| x as f64));
