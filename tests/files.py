@@ -35,30 +35,46 @@ class Gltf:
         self.bin += data
         return len(self.doc["bufferViews"]) - 1
 
-    def _accessor(self, a: np.ndarray, kind: str) -> int:
-        component = 5125 if a.dtype == np.uint32 else 5126
-        acc = {"bufferView": self._view(a.tobytes()), "componentType": component, "count": len(a), "type": kind}
+    def _accessor(self, a: np.ndarray, kind: str, **extra) -> int:
+        component = {"int8": 5120, "uint8": 5121, "int16": 5122, "uint16": 5123, "uint32": 5125}.get(a.dtype.name, 5126)
+        a = a.astype(np.float32) if component == 5126 else a
+        acc = {"bufferView": self._view(a.tobytes()), "componentType": component, "count": len(a), "type": kind, **extra}
         if kind == "VEC3" and component == 5126:
             acc["min"], acc["max"] = a.min(0).tolist(), a.max(0).tolist()
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 
+    def accessor(self, a, kind: str, **extra) -> int:
+        """An accessor of `a` (its dtype gives the componentType; float64 is written float32)."""
+        return self._accessor(np.asarray(a), kind, **extra)
+
     def material(self, **m) -> int:
         self.doc["materials"].append(m)
         return len(self.doc["materials"]) - 1
 
-    def texture(self, rgba8: np.ndarray) -> int:
-        """A PNG texture (sRGB color, linear alpha) of an (h, w, 4) uint8 image."""
+    def texture(self, rgba8: np.ndarray, sampler: dict | None = None) -> int:
+        """A PNG texture (sRGB color, linear alpha) of an (h, w, 4) uint8 image, with `sampler`."""
         view = self._view(encode_png(rgba8))
         self.doc.setdefault("images", []).append({"bufferView": view, "mimeType": "image/png"})
-        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1})
+        texture = {"source": len(self.doc["images"]) - 1}
+        if sampler is not None:
+            self.doc.setdefault("samplers", []).append(sampler)
+            texture["sampler"] = len(self.doc["samplers"]) - 1
+        self.doc.setdefault("textures", []).append(texture)
         return len(self.doc["textures"]) - 1
 
-    def mesh(self, positions, indices, material: int | None = None, uvs=None, name: str = "") -> int:
-        attributes = {"POSITION": self._accessor(np.asarray(positions, np.float32), "VEC3")}
+    def mesh(self, positions, indices, material: int | None = None, uvs=None, name: str = "", mode: int | None = None,
+             attributes: dict | None = None) -> int:
+        """A mesh of one primitive; `indices` None draws the vertices in order, `mode` is glTF's
+        (None: TRIANGLES), `attributes` more accessors by name (COLOR_0: accessor index)."""
+        attributes = {"POSITION": self._accessor(np.asarray(positions, np.float32), "VEC3"), **(attributes or {})}
         if uvs is not None:
             attributes["TEXCOORD_0"] = self._accessor(np.asarray(uvs, np.float32), "VEC2")
-        prim = {"attributes": attributes, "indices": self._accessor(np.asarray(indices, np.uint32).reshape(-1), "SCALAR")}
+        prim: dict = {"attributes": attributes}
+        if indices is not None:
+            prim["indices"] = self._accessor(np.asarray(indices, np.uint32).reshape(-1), "SCALAR")
+        if mode is not None:
+            prim["mode"] = mode
         if material is not None:
             prim["material"] = material
         self.doc["meshes"].append({"name": name, "primitives": [prim]})
@@ -69,6 +85,20 @@ class Gltf:
         if root:
             self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
         return len(self.doc["nodes"]) - 1
+
+    def gltf(self, path: Path, bin_name: str | None = None) -> Path:
+        """The document as .gltf at `path`, its buffer in the file `bin_name` next to it (None:
+        a base64 data URI)."""
+        import base64
+
+        blob = bytes(self.bin)
+        if bin_name is None:
+            uri = "data:application/octet-stream;base64," + base64.b64encode(blob).decode()
+        else:
+            uri = bin_name
+            (path.parent / bin_name).write_bytes(blob)
+        path.write_text(json.dumps({**self.doc, "buffers": [{"byteLength": len(blob), "uri": uri}]}))
+        return path
 
     def glb(self) -> bytes:
         doc = {**self.doc, "buffers": [{"byteLength": len(self.bin)}]}
@@ -145,4 +175,57 @@ def ply_points(path: Path) -> Path:
     head = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
             "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\nend_header\n")
     path.write_text(head + "-0.5 0 0 255 0 0 128\n0.5 0 0 0 255 0 128\n0 0.5 0.2 0 0 255 255\n")
+    return path
+
+
+# OBJ/MTL, PLY and STL as exporters write them (tests/test_load_formats.py).
+
+def obj_lines_points_empty_usemtl(path: Path) -> Path:
+    """A red triangle, then after an empty `usemtl` a polyline (`l`, 3 points) and two points
+    (`p`) in the default gray; the vertices' box is 3 by 4 (diagonal 5)."""
+    path.with_suffix(".mtl").write_text("newmtl red\nKd 1 0 0\n")
+    path.write_text(f"mtllib {path.with_suffix('.mtl').name}\nv 0 0 0\nv 3 0 0\nv 3 4 0\nv 0 4 0\n"
+                    "o tri\nusemtl red\nf 1 2 3\no wire\nusemtl\nl 1 2 3\no dots\np 1 4\n")
+    return path
+
+
+def obj_meshlab_tr(path: Path, tr: str = "1.000000") -> Path:
+    """A quad whose material MeshLab wrote: `Tr 1.000000` and no `d`."""
+    path.with_suffix(".mtl").write_text(f"#\n# Wavefront material file\n# Converted by Meshlab Group\n#\n\n"
+                                        f"newmtl material_0\nKa 0.2 0.2 0.2\nKd 0.5 0.5 1\nKs 1 1 1\nTr {tr}\nillum 2\nNs 0\n")
+    v = "".join(f"v {x} {y} {z}\n" for x, y, z in QUAD.tolist())
+    path.write_text(f"mtllib {path.with_suffix('.mtl').name}\n{v}usemtl material_0\nf 1 2 3 4\n")
+    return path
+
+
+def stl_ascii_solids(path: Path, names: list[str], facets: int = 1) -> Path:
+    """An ASCII STL of one `solid` block a name (an empty name is a bare `solid` header), each
+    of `facets` triangles."""
+    text = ""
+    for name in names:
+        text += f"solid {name}\n" if name else "solid\n"
+        for k in range(facets):
+            text += (f" facet normal 0 0 1\n  outer loop\n   vertex 0 0 {k}\n   vertex 1 0 {k}\n   vertex 0 1 {k}\n"
+                     "  endloop\n endfacet\n")
+        text += f"endsolid {name}\n"
+    path.write_text(text)
+    return path
+
+
+def ply_face_colors(path: Path, binary: bool = False) -> Path:
+    """A quad as two triangles sharing an edge: face 0 red (opaque), face 1 blue at alpha
+    128/255, 8-bit per-face colors (the shared vertices are split)."""
+    head = ("ply\nformat {} 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 2\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+            "property uchar blue\nproperty uchar alpha\nend_header\n")
+    faces = [([0, 1, 2], (255, 0, 0, 255)), ([0, 2, 3], (0, 0, 255, 128))]
+    if binary:
+        data = head.format("binary_big_endian").encode() + QUAD.astype(">f4").tobytes()
+        for idx, rgba in faces:
+            data += struct.pack(">B3i4B", 3, *idx, *rgba)
+        path.write_bytes(data)
+    else:
+        rows = "".join(f"{x} {y} {z}\n" for x, y, z in QUAD.tolist())
+        rows += "".join(f"3 {' '.join(map(str, idx))} {' '.join(map(str, rgba))}\n" for idx, rgba in faces)
+        path.write_text(head.format("ascii") + rows)
     return path

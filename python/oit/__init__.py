@@ -20,8 +20,9 @@ if not _os.environ.get("XDG_RUNTIME_DIR"):
     _os.environ["XDG_RUNTIME_DIR"] = _runtime
 
 from ._api import Camera, FileCamera, Frame, Renderer, Scene, Stats, constants, memory_bytes, methods, reference
+from ._load import OitLoadWarning
 from .comparison import Comparison, compare
 
-__all__ = ["Camera", "Comparison", "FileCamera", "Frame", "Renderer", "Scene", "Stats", "compare", "constants", "memory_bytes",
-           "methods", "reference"]
+__all__ = ["Camera", "Comparison", "FileCamera", "Frame", "OitLoadWarning", "Renderer", "Scene", "Stats", "compare", "constants",
+           "memory_bytes", "methods", "reference"]
 __version__ = "0.1.0"

@@ -28,7 +28,7 @@ from ._checks import (
     _transforms,
     _vector,
 )
-from ._load import read
+from ._load import read, warn
 from ._memory import available_memory
 from ._primitives import PrimitiveMethods
 from ._trimesh import trimesh_arrays
@@ -194,7 +194,10 @@ class Scene(PrimitiveMethods):
         transparent at it; `shading` ("smooth" with the file's normals, "flat" or "unlit") and
         `specular` style every surface. `scene.mesh_names` names the meshes, and
         `scene.cameras` lists the file's cameras (`FileCamera.camera(aspect)` gives an oit.Camera).
-        The same loader (oit-core's) reads files for the viewer and `python -m oit render`."""
+        The same loader (oit-core's) reads files for the viewer and `python -m oit render`.
+        What the file has that oit does not draw (animations, skins...) is said once a feature
+        as an `oit.OitLoadWarning`; a refused file raises ValueError naming the file, the object
+        and the rule, and a missing file it refers to (a .bin, an image) FileNotFoundError."""
         return load_file(path, alpha, shading=shading, specular=specular, point_radius=point_radius)[0]
 
     @classmethod
@@ -380,8 +383,10 @@ class FileCamera:
 def load_file(path: str | os.PathLike, alpha: float | None = None, *, shading: str = "smooth", specular: float = 0.25,
               viewing: bool = False, point_radius: float | None = None) -> tuple[Scene, str | None]:
     """`Scene.from_file`, and with `viewing` the command line's convenience: when nothing in
-    the file is transparent every mesh is drawn at alpha 0.4, and the second value says so."""
-    native, names, cameras, note = read(path, alpha, shading, specular, viewing, point_radius)
+    the file is transparent every mesh is drawn at alpha 0.4, and the second value says so.
+    What the file has that oit does not draw is said once each, as an `oit.OitLoadWarning`."""
+    native, names, cameras, note, warnings = read(path, alpha, shading, specular, viewing, point_radius)
+    warn(path, warnings, stacklevel=3)
     scene = Scene()
     scene._native, scene.mesh_names = native, names
     scene.cameras = [FileCamera(c["name"], np.array(c["view"], dtype=np.float64),

@@ -16,10 +16,23 @@ from .hairfile import read_hair
 FORMATS = (".obj", ".gltf", ".glb", ".ply", ".stl", ".hair")
 
 
+class OitLoadWarning(UserWarning):
+    """Something in a file that oit reads but does not draw (animations, skins, an unknown
+    extension...): one warning a feature, naming it and how many objects use it."""
+
+
+def warn(path: str | os.PathLike, messages: list[str], stacklevel: int = 2) -> None:
+    """Each of the loader's `messages` about `path` as one OitLoadWarning."""
+    import warnings
+
+    for m in messages:
+        warnings.warn(f"{os.fspath(path)}: {m}", OitLoadWarning, stacklevel=stacklevel + 1)
+
+
 def read(path: str | os.PathLike, alpha: float | None, shading: str, specular: float, viewing: bool,
-         point_radius: float | None) -> tuple[Any, list[str], list[dict[str, Any]], str | None]:
+         point_radius: float | None) -> tuple[Any, list[str], list[dict[str, Any]], str | None, list[str]]:
     """The native scene of `path`, its mesh names, its cameras (as the native loader gives
-    them) and the viewing note (`_api.load_file`)."""
+    them), the viewing note and the loader's warnings (`_api.load_file`)."""
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__}")
     path = os.fspath(path)
@@ -35,9 +48,9 @@ def read(path: str | os.PathLike, alpha: float | None, shading: str, specular: f
         raise ValueError(f"specular must be >= 0, got {specular}")
     radius = None if point_radius is None else _number(point_radius, "point_radius")
     if path.lower().endswith(".hair"):
-        return _hair_scene(path, alpha, float(specular)), [os.path.splitext(os.path.basename(path))[0]], [], None
-    native, names, cameras, note = _oit.load_file(path, shading, float(specular), alpha, viewing, radius)
-    return native, list(names), list(cameras), note
+        return _hair_scene(path, alpha, float(specular)), [os.path.splitext(os.path.basename(path))[0]], [], None, []
+    native, names, cameras, note, warnings = _oit.load_file(path, shading, float(specular), alpha, viewing, radius)
+    return native, list(names), list(cameras), note, list(warnings)
 
 
 def _hair_scene(path: str, alpha: float | None, specular: float) -> Any:

@@ -253,8 +253,17 @@ def load_file(
     alpha: float | None = None,
     viewing: bool = False,
     point_radius: float | None = None,
-) -> tuple[Scene, list[str], list[dict[str, Any]], str | None]:
+) -> tuple[Scene, list[str], list[dict[str, Any]], str | None, list[str]]:
     """Reads `path`; `shading` and `specular` style every surface (`load::Surface`). `alpha`
     makes every mesh transparent at it; `viewing` adds the command line's convenience (every
     mesh at VIEWING_ALPHA when nothing blends) and returns its note; `point_radius` sizes a point
-    cloud's particles (None: 1/200 of its box's diagonal)."""
+    cloud's particles (None: 1/200 of its box's diagonal). Returns the scene, its mesh names, the
+    file's cameras, the note and the loader's warnings (one sentence a feature not drawn). A
+    panic while reading is a RuntimeError naming the file."""
+
+# Every entry above runs under the binding's panic guard (crates/oit-py/src/guard.rs): a panic is
+# a RuntimeError that says it is a bug. `_GUARDED` names the guarded entries ("Scene.add_mesh",
+# "methods", ...) and `_panic_for_test` panics on purpose (tests/test_load_entry_points.py).
+_GUARDED: list[str]
+
+def _panic_for_test() -> None: ...

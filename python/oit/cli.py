@@ -6,9 +6,11 @@ failures."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
 from typing import Any, Callable
 
 EXIT_USAGE = 2
@@ -279,6 +281,25 @@ SUBCOMMANDS: Sequence[Subcommand] = (
 )
 
 
+@contextlib.contextmanager
+def _load_warnings_as_lines(prog: str) -> Iterator[None]:
+    """Each OitLoadWarning (what a file has that oit does not draw) as one line on stderr,
+    every time a file is loaded, instead of Python's two-line warning with its source line."""
+    from ._load import OitLoadWarning
+
+    def show(message: Any, category: type, filename: str, lineno: int, file: Any = None, line: Any = None) -> None:
+        if issubclass(category, OitLoadWarning):
+            print(f"{prog}: warning: {message}", file=sys.stderr)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    with warnings.catch_warnings():
+        shown = warnings.showwarning
+        warnings.showwarning = show
+        warnings.simplefilter("always", OitLoadWarning)
+        yield
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m oit", description="Order-independent transparency on wgpu.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -300,7 +321,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     args.passthrough = passthrough
     try:
-        return args.run(args)
+        with _load_warnings_as_lines(f"{parser.prog} {args.command}"):
+            return args.run(args)
     except (ValueError, TypeError, MemoryError, RuntimeError, OSError) as e:
         # Engine and input errors carry messages that say what to do; no traceback.
         print(f"{parser.prog} {args.command}: error: {e}", file=sys.stderr)

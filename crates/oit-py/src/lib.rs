@@ -12,10 +12,12 @@ use pyo3::types::{PyDict, PyList};
 use oit_core::{OitError, ParamKind, ParamValue};
 
 mod convert;
+mod guard;
 mod load;
 mod primitives;
 
 use convert::{array, instances, matrix, rows, InstanceArrays};
+use guard::guarded;
 
 struct Error(OitError);
 
@@ -45,6 +47,7 @@ struct Scene {
     inner: oit_core::Scene,
 }
 
+guarded! {
 #[pymethods]
 impl Scene {
     #[new]
@@ -267,6 +270,7 @@ impl Scene {
         self.inner.meshes().iter().map(|m| (m.triangle_count(), m.positions.len(), m.opaque)).collect()
     }
 }
+}
 
 impl Scene {
     fn mesh_index(&self, mesh: i64) -> PyResult<usize> {
@@ -342,6 +346,7 @@ fn stats_dict<'py>(py: Python<'py>, s: &oit_core::Stats) -> PyResult<Bound<'py, 
     Ok(d)
 }
 
+guarded! {
 #[pymethods]
 impl Renderer {
     #[new]
@@ -448,6 +453,9 @@ impl Renderer {
         Ok((image, dc, stats, bound).into_pyobject(py)?.into_any())
     }
 }
+}
+
+guarded! { fns GUARDED_FUNCTIONS;
 
 /// Every method: name, summary, exact, bounded memory, passes, parameters.
 #[pyfunction]
@@ -598,6 +606,14 @@ fn view_direction(view_proj: PyReadonlyArray2<'_, f64>) -> PyResult<(f64, f64, f
     Ok(camera.view_direction().into())
 }
 
+/// Panics on purpose, under the guard: tests/test_load_entry_points.py proves it arrives as a
+/// RuntimeError, not as PanicException.
+#[pyfunction]
+fn _panic_for_test() -> PyResult<()> {
+    panic!("a panic on purpose (oit._oit._panic_for_test)")
+}
+}
+
 #[pymodule]
 fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
@@ -610,5 +626,10 @@ fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stats_schema, m)?)?;
     m.add_function(wrap_pyfunction!(extra_merge_rules, m)?)?;
     m.add_function(wrap_pyfunction!(load::load_file, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
+    let classes = [("Scene", Scene::GUARDED), ("Renderer", Renderer::GUARDED)];
+    let mut guarded: Vec<String> = classes.iter().flat_map(|(c, names)| names.iter().map(move |n| format!("{c}.{n}"))).collect();
+    guarded.extend(GUARDED_FUNCTIONS.iter().chain(load::GUARDED).map(|n| n.to_string()));
+    m.add("_GUARDED", guarded)?;
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! The core's loader (`oit_core::load`) for `oit.Scene.from_file` and the command line: the
 //! scene, its mesh names, the file's cameras as dicts, and the viewing-alpha note.
 
+use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
@@ -8,12 +9,17 @@ use pyo3::types::{PyDict, PyList};
 
 use oit_core::load::{self, Projection, Surface};
 
+use crate::guard::{self, guarded};
 use crate::{Error, Scene};
+
+guarded! { fns GUARDED;
 
 /// Reads `path`; `shading` and `specular` style every surface (`load::Surface`). `alpha`
 /// makes every mesh transparent at it; `viewing` adds the command line's convenience (every
 /// mesh at VIEWING_ALPHA when nothing blends) and returns its note; `point_radius` sizes a point
-/// cloud's particles (None: 1/200 of its box's diagonal).
+/// cloud's particles (None: 1/200 of its box's diagonal). Returns the scene, its mesh names, the
+/// file's cameras, the note and the loader's warnings (one sentence a feature not drawn). A
+/// panic while reading is a RuntimeError naming the file (`guard::bug`).
 #[pyfunction]
 #[pyo3(signature = (path, shading="smooth", specular=0.25, alpha=None, viewing=false, point_radius=None))]
 #[allow(clippy::type_complexity)]
@@ -25,18 +31,20 @@ pub fn load_file<'py>(
     alpha: Option<f32>,
     viewing: bool,
     point_radius: Option<f32>,
-) -> PyResult<(Scene, Vec<String>, Bound<'py, PyList>, Option<String>)> {
+) -> PyResult<(Scene, Vec<String>, Bound<'py, PyList>, Option<String>, Vec<String>)> {
     let surface = Surface { shading: oit_core::Shading::from_name(shading).map_err(Error::from)?, specular, point_radius };
+    let read = || -> oit_core::Result<_> {
+        let mut file = load::load_file(&path, surface)?;
+        let note = match (viewing, alpha) {
+            (true, a) => load::viewing_alpha(&mut file.meshes, a)?,
+            (false, Some(a)) => load::set_alpha(&mut file.meshes, a).map(|_| None)?,
+            (false, None) => None,
+        };
+        Ok((file, note))
+    };
     let (file, note) = py
-        .detach(|| -> oit_core::Result<_> {
-            let mut file = load::load_file(&path, surface)?;
-            let note = match (viewing, alpha) {
-                (true, a) => load::viewing_alpha(&mut file.meshes, a)?,
-                (false, Some(a)) => load::set_alpha(&mut file.meshes, a).map(|_| None)?,
-                (false, None) => None,
-            };
-            Ok((file, note))
-        })
+        .detach(|| catch_unwind(AssertUnwindSafe(read)))
+        .map_err(|payload| guard::bug(&format!("loading {}", path.display()), &*payload))?
         .map_err(Error::from)?;
     let cameras = PyList::empty(py);
     for c in &file.cameras {
@@ -62,7 +70,9 @@ pub fn load_file<'py>(
         cameras.append(d)?;
     }
     let names = file.meshes.iter().map(|m| m.name.clone()).collect();
-    Ok((Scene { inner: file.scene() }, names, cameras, note))
+    let warnings = file.warnings.clone();
+    Ok((Scene { inner: file.scene() }, names, cameras, note, warnings))
+}
 }
 
 /// One dict a mesh: opaque, shading, textured, two_sided, cull_back_faces, the vertex

@@ -332,6 +332,11 @@ impl ViewerApp {
         let events = ctx.input(|i| i.raw.events.clone());
         for e in events {
             let egui::Event::Screenshot { image, .. } = e else { continue };
+            if let Some(err) = self.render_error.as_ref().filter(|_| job.exit) {
+                // A picture of the error banner is no screenshot: fail as the command line does.
+                eprintln!("oit-viewer: error: {err}");
+                std::process::exit(1);
+            }
             let ppp = ctx.pixels_per_point();
             let img = if job.crop_view { image.region(&self.view_rect, Some(ppp)) } else { (*image).clone() };
             let result = screenshot::write_png(&job.path, &img);

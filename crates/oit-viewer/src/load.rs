@@ -46,7 +46,16 @@ pub fn load(path: &Path, alpha: Option<f32>) -> Result<SceneData, String> {
         }
         return Ok(scene);
     }
-    let mut file = core_load::load_file(path, Surface::default()).map_err(|e| {
+    // The loader never panics on any bytes; should it all the same, say it is a bug, not crash.
+    let read = std::panic::catch_unwind(|| core_load::load_file(path, Surface::default())).map_err(|payload| {
+        let msg = payload.downcast_ref::<&str>().copied().or_else(|| payload.downcast_ref::<String>().map(String::as_str));
+        format!(
+            "loading {} failed on an internal error ({}): this is a bug in oit; please report it with the file",
+            path.display(),
+            msg.unwrap_or("no message")
+        )
+    })?;
+    let mut file = read.map_err(|e| {
         let e = e.to_string();
         if e.contains("unknown file type") {
             format!("{e} (and the viewer .oitscene)")
@@ -54,6 +63,10 @@ pub fn load(path: &Path, alpha: Option<f32>) -> Result<SceneData, String> {
             e
         }
     })?;
+    // What the file has that the viewer does not draw, a line each (as the command line says it).
+    for w in &file.warnings {
+        eprintln!("oit-viewer: warning: {}: {w}", path.display());
+    }
     if let Some(note) = core_load::viewing_alpha(&mut file.meshes, alpha).map_err(|e| e.to_string())? {
         eprintln!("oit-viewer: {}: {note}", path.display());
     }

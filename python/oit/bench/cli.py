@@ -1,6 +1,6 @@
 """The bench's command line (`python -m oit bench`, also `python -m oit.bench`): the main sweep
 (oit.bench.results) or, instead of it, the experiments (--temporal, --auto, --antialias, --scale,
---shading-cost), and
+--shading-cost, --load, --fuzz-load), and
 the tables and plots they write into --out."""
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from .figure7 import figure7_table
 from .floor import BASELINE, FLOOR_COLUMNS, GROWTH, load_baseline, peers_floor, write_baseline
 from .floor import SCENES as FLOOR_SCENE_NAMES
 from .harness import QUICK_SIZE, write_tables
+from .load import LOAD_COLUMNS, LOAD_TRIANGLES, TARGET_TRIANGLES_PER_S, fuzz_load, load_speed
 from .results import COLUMNS, run
 from .scale import SCALE_METHODS, SWEEPS, parse_size, scale, write_scale
 from .shading import SHADING_COLUMNS, SHADING_COSTS, SHADING_METHODS, shading_cost
@@ -96,6 +97,18 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--strand-counts", type=int, nargs="+", default=list(STRAND_COUNTS), help=argparse.SUPPRESS)
     ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
                     help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
+    ap.add_argument("--load", action="store_true",
+                    help=f"instead of the method sweep: a {LOAD_TRIANGLES / 1e6:.1f} M-triangle mesh as OBJ, GLB, binary PLY "
+                         "and binary STL, each loaded by Scene.from_file in a fresh interpreter: triangles a second "
+                         f"(target {TARGET_TRIANGLES_PER_S / 1e6:.0f} M) and peak resident memory (load.csv, load.md)")
+    ap.add_argument("--load-triangles", type=int, default=LOAD_TRIANGLES, help=argparse.SUPPRESS)
+    ap.add_argument("--fuzz-load", action="store_true",
+                    help="instead of the method sweep: mutated files of every format loaded for --seconds from --seed; "
+                         "exits 1 on anything but a scene, ValueError or OSError (a panic, another exception, a hang, "
+                         "runaway memory), keeping the failing files in --out")
+    ap.add_argument("--seconds", type=float, default=60.0, help="--fuzz-load: how long to run (default: %(default)s)")
+    ap.add_argument("--seed", type=int, default=0, help="--fuzz-load: the random seed (default: %(default)s)")
+    ap.add_argument("--fuzz-cases", type=int, default=None, help=argparse.SUPPRESS)
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -119,6 +132,16 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
+    if a.load or a.fuzz_load:
+        if a.load:
+            write_tables(a.out, "load", load_speed(a.load_triangles), LOAD_COLUMNS)
+        if a.fuzz_load:
+            report = fuzz_load(a.seconds, a.seed, a.out, a.fuzz_cases)
+            for f in report.failures:
+                print(f"error: {f}", file=sys.stderr)
+            print(report.summary())
+            return 1 if report.failures else 0
+        return 0
     if a.peers_floor:
         # The floor's scenes among --scenes (by default all three of them).
         scenes = tuple(s for s in FLOOR_SCENE_NAMES if s in a.scenes) or FLOOR_SCENE_NAMES

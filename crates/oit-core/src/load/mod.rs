@@ -7,6 +7,7 @@
 mod gltf;
 mod obj;
 mod ply;
+mod stl;
 
 use std::path::Path;
 
@@ -130,10 +131,10 @@ pub fn load_file(path: &Path, surface: Surface) -> Result<LoadedFile> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_lowercase();
     let fail = |e: LoadError| e.at(path);
     let mut file = match ext.as_str() {
-        "obj" => LoadedFile { meshes: obj::load(path).map_err(|e| fail(e.into()))?, ..Default::default() },
-        "ply" => LoadedFile { meshes: vec![ply::load_ply(path).map_err(|e| fail(e.into()))?], ..Default::default() },
-        "stl" => LoadedFile { meshes: vec![ply::load_stl(path).map_err(|e| fail(e.into()))?], ..Default::default() },
-        "gltf" | "glb" => gltf::load(path).map_err(|e| fail(e.into()))?,
+        "obj" => obj::read(path, surface.point_radius).map_err(fail)?,
+        "ply" => LoadedFile { meshes: vec![ply::load_ply(path).map_err(fail)?], ..Default::default() },
+        "stl" => LoadedFile { meshes: stl::read(path).map_err(fail)?, ..Default::default() },
+        "gltf" | "glb" => gltf::load_with(path, surface.point_radius).map_err(fail)?,
         _ => return Err(invalid!("{}: unknown file type '.{ext}': oit reads {FORMATS}", path.display())),
     };
     if ext == "ply" && file.meshes.iter().all(|m| m.mesh.indices.is_empty() && !m.mesh.positions.is_empty()) {
@@ -265,5 +266,7 @@ pub fn bounds(meshes: &[NamedMesh]) -> Option<(DVec3, DVec3)> {
     crate::scene::placed_bounds(meshes.iter().map(|m| (&m.mesh, m.instances.as_slice())))
 }
 
+#[cfg(test)]
+mod formats_tests;
 #[cfg(test)]
 mod tests;

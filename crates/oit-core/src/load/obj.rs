@@ -1,76 +1,717 @@
-//! OBJ with its MTL: one mesh per object and material; the diffuse color `Kd` and texture
-//! `map_Kd` (sRGB), the dissolve `d` (or `Tr` = 1 - d) and dissolve texture `map_d` as alpha,
-//! vertex colors (`v x y z r g b`, sRGB), normals and UVs.
+//! OBJ with its MTL, read line by line as exporters write them (docs/loading.md): one mesh per
+//! object (`o`/`g`) and material (`usemtl`; an empty one is no material); faces fanned into
+//! triangles, `l` lines as strands and `p` points as particles; vertex colors
+//! (`v x y z r g b`, sRGB), normals and UVs; `Kd` and `map_Kd` (sRGB), the dissolve `d`,
+//! `Tr` and `map_d` as alpha. Errors name the line (`line 12: face index 9 is past the 8
+//! vertices`); a missing `.mtl` is a warning (the meshes drawn gray), a missing image its MTL
+//! names is `NotFound` naming it and the MTL line.
 
-use std::path::Path;
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
 
-use super::{named, srgb_to_linear, texture_map, NamedMesh, DEFAULT_RGB};
-use crate::shading::{Material, TextureMap};
+use super::{named, srgb_to_linear, texture_map, LoadError, LoadedFile, NamedMesh, DEFAULT_RGB, MAX_TEXTURE_SIZE};
+use crate::scene::Mesh;
+use crate::shading::{Falloff, Material, TextureMap};
 
-pub fn load(path: &Path) -> Result<Vec<NamedMesh>, String> {
-    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| format!("not a readable OBJ file ({e})"))?;
-    // A missing or broken MTL leaves the meshes gray, as other viewers do.
-    let materials = materials.unwrap_or_default();
+/// A strand's width and a particle's radius (where `Surface::point_radius` gives none), as
+/// fractions of the diagonal of the box around the file's vertices.
+pub const LINE_WIDTH_OF_DIAGONAL: f32 = 1.0 / 500.0;
+pub const POINT_RADIUS_OF_DIAGONAL: f32 = 1.0 / 200.0;
+
+const NONE: u32 = u32::MAX;
+
+/// The file's meshes and warnings; `point_radius` sizes `p` points (None: 1/200 of the box
+/// diagonal).
+pub fn read(path: &Path, point_radius: Option<f32>) -> Result<LoadedFile, LoadError> {
+    let file = std::fs::File::open(path).map_err(|e| LoadError::Invalid(format!("cannot read it ({e})")))?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let mut out = Vec::new();
-    for (i, model) in models.into_iter().enumerate() {
-        let m = model.mesh;
-        let positions: Vec<[f32; 3]> = m.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
-        let indices: Vec<[u32; 3]> = m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
-        if indices.is_empty() {
-            continue;
-        }
-        let material = m.material_id.and_then(|id| materials.get(id));
-        let (rgb, alpha) = material.map_or((DEFAULT_RGB, 1.0), |mt| {
-            let d = mt.dissolve.or_else(|| mt.unknown_param.get("Tr").and_then(|t| t.trim().parse::<f32>().ok()).map(|t| 1.0 - t));
-            (mt.diffuse.map_or(DEFAULT_RGB, |d| d.map(srgb_to_linear)), d.unwrap_or(1.0).clamp(0.0, 1.0))
-        });
-        let colors = if !m.vertex_color.is_empty() && m.vertex_color.len() == m.positions.len() {
-            m.vertex_color.chunks_exact(3).map(|c| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), alpha]).collect()
-        } else {
-            vec![[rgb[0], rgb[1], rgb[2], alpha]]
-        };
-        let texture = match material {
-            Some(mt) if !m.texcoords.is_empty() => texture(dir, mt.diffuse_texture.as_deref(), mt.dissolve_texture.as_deref())?,
-            _ => None,
-        };
-        let opaque = alpha == 1.0 && material.is_none_or(|mt| mt.dissolve_texture.is_none());
-        let name = if model.name.is_empty() { format!("object {i}") } else { model.name };
-        let mut mesh = named(name, positions, indices, colors, opaque)?;
-        if m.normals.len() == m.positions.len() {
-            mesh.mesh.normals = m.normals.chunks_exact(3).map(|n| [n[0], n[1], n[2]]).collect();
-            // Zero normals (some exporters write them) are recomputed instead.
-            if mesh.mesh.normals.iter().any(|n| n.iter().all(|&x| x == 0.0) || n.iter().any(|x| !x.is_finite())) {
-                mesh.mesh.normals.clear();
-            }
-        }
-        if m.texcoords.len() / 2 == mesh.mesh.positions.len() && texture.is_some() {
-            // OBJ's v points up the image; the texture's row 0 is v = 0.
-            mesh.mesh.uvs = m.texcoords.chunks_exact(2).map(|t| [t[0], 1.0 - t[1]]).collect();
-        }
-        mesh.mesh.material = Material { texture: texture.filter(|_| !mesh.mesh.uvs.is_empty()), ..Default::default() };
-        out.push(mesh);
+    let mut obj = Obj::default();
+    let mut lines = Lines::new(std::io::BufReader::with_capacity(1 << 16, file));
+    while let Some((number, line)) = lines.next().map_err(|e| LoadError::Invalid(format!("cannot read it ({e})")))? {
+        obj.statement(line, number, dir)?;
     }
-    Ok(out)
+    obj.finish_group();
+    obj.build(point_radius)
 }
 
-/// `map_Kd` times `map_d` (whose first channel is the alpha), either optional.
-fn texture(dir: &Path, diffuse: Option<&str>, dissolve: Option<&str>) -> Result<Option<TextureMap>, String> {
-    let read = |name: &str| {
-        let file = dir.join(name.trim());
-        image::open(&file).map(|i| i.to_rgba8()).map_err(|e| format!("texture {}: {e}", file.display()))
+/// Physical lines joined where one ends in a backslash, each with its first line's number.
+pub(super) struct Lines<R> {
+    reader: R,
+    buf: Vec<u8>,
+    next_number: usize,
+}
+
+impl<R: BufRead> Lines<R> {
+    pub fn new(reader: R) -> Self {
+        Self { reader, buf: Vec::new(), next_number: 1 }
+    }
+
+    pub fn next(&mut self) -> std::io::Result<Option<(usize, &[u8])>> {
+        self.buf.clear();
+        let number = self.next_number;
+        loop {
+            let start = self.buf.len();
+            if self.reader.read_until(b'\n', &mut self.buf)? == 0 {
+                return Ok((!self.buf.is_empty() || start > 0).then_some((number, &self.buf[..])));
+            }
+            self.next_number += 1;
+            while self.buf.last().is_some_and(|b| matches!(b, b'\n' | b'\r')) {
+                self.buf.pop();
+            }
+            if self.buf.last() == Some(&b'\\') {
+                self.buf.pop();
+                self.buf.push(b' ');
+                continue;
+            }
+            return Ok(Some((number, &self.buf[..])));
+        }
+    }
+}
+
+/// The whitespace-separated words of a line.
+pub(super) fn tokens(line: &[u8]) -> Tokens<'_> {
+    Tokens(line)
+}
+
+pub(super) struct Tokens<'a>(&'a [u8]);
+
+impl<'a> Iterator for Tokens<'a> {
+    type Item = &'a [u8];
+
+    fn next(&mut self) -> Option<&'a [u8]> {
+        let s = self.0;
+        let mut i = 0;
+        while i < s.len() && s[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        let start = i;
+        while i < s.len() && !s[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        self.0 = &s[i..];
+        (i > start).then(|| &s[start..i])
+    }
+}
+
+/// A number of a text format, finite.
+pub(super) fn number(token: Option<&[u8]>, what: &str) -> Result<f32, String> {
+    let t = token.ok_or_else(|| format!("{what} is missing"))?;
+    match decimal(t).or_else(|| std::str::from_utf8(t).ok()?.parse::<f64>().ok()).map(|x| x as f32) {
+        Some(x) if x.is_finite() => Ok(x),
+        _ => Err(format!("{what} '{}' is not a finite number", short(&String::from_utf8_lossy(t)))),
+    }
+}
+
+/// The common case of a decimal (`-12.5`, `3e-4`, at most 19 digits) exactly, as the
+/// standard parser would give it; None for anything else (the caller falls back to it).
+pub(super) fn decimal(t: &[u8]) -> Option<f64> {
+    const POW10: [f64; 23] =
+        [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22];
+    let (negative, mut t) = match t.first()? {
+        b'-' => (true, &t[1..]),
+        b'+' => (false, &t[1..]),
+        _ => (false, t),
+    };
+    let (mut mantissa, mut scale) = (0u64, 0i32);
+    let mut any = false;
+    while let [d @ b'0'..=b'9', tail @ ..] = t {
+        mantissa = mantissa.checked_mul(10)?.checked_add((d - b'0') as u64)?;
+        any = true;
+        t = tail;
+    }
+    if let [b'.', tail @ ..] = t {
+        t = tail;
+        while let [d @ b'0'..=b'9', tail @ ..] = t {
+            mantissa = mantissa.checked_mul(10)?.checked_add((d - b'0') as u64)?;
+            scale -= 1;
+            any = true;
+            t = tail;
+        }
+    }
+    if !any {
+        return None;
+    }
+    if let [b'e' | b'E', tail @ ..] = t {
+        let (negative, mut e) = match tail.first()? {
+            b'-' => (true, &tail[1..]),
+            b'+' => (false, &tail[1..]),
+            _ => (false, tail),
+        };
+        let mut exponent = 0i32;
+        let mut any = false;
+        while let [d @ b'0'..=b'9', tail @ ..] = e {
+            exponent = (exponent * 10 + (d - b'0') as i32).min(10_000);
+            any = true;
+            e = tail;
+        }
+        if !any {
+            return None;
+        }
+        scale += if negative { -exponent } else { exponent };
+        t = e;
+    }
+    // Exact: the mantissa and the power of ten are both representable, one rounding.
+    if !t.is_empty() || mantissa > 1 << 53 || scale.unsigned_abs() > 22 {
+        return None;
+    }
+    let x = mantissa as f64;
+    let x = if scale < 0 { x / POW10[(-scale) as usize] } else { x * POW10[scale as usize] };
+    Some(if negative { -x } else { x })
+}
+
+fn short(s: &str) -> String {
+    s.chars().take(40).collect()
+}
+
+/// The text after the keyword, trimmed (names and file names may hold spaces).
+fn rest(line: &[u8]) -> String {
+    let line = trim(line);
+    let start = line.iter().position(|b| b.is_ascii_whitespace()).unwrap_or(line.len());
+    String::from_utf8_lossy(trim(&line[start..])).into_owned()
+}
+
+fn trim(mut s: &[u8]) -> &[u8] {
+    while let [first, tail @ ..] = s {
+        if !first.is_ascii_whitespace() {
+            break;
+        }
+        s = tail;
+    }
+    while let [head @ .., last] = s {
+        if !last.is_ascii_whitespace() {
+            break;
+        }
+        s = head;
+    }
+    s
+}
+
+/// A fast hash for vertex keys: FxHash's step a word, MurmurHash3's finalizer.
+#[derive(Default, Clone, Copy)]
+pub(super) struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for c in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..c.len()].copy_from_slice(c);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+    }
+
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(i as u64);
+    }
+
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+
+    fn finish(&self) -> u64 {
+        // MurmurHash3's finalizer: every input bit reaches the table's index and tag bits.
+        let mut h = self.0;
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+        h ^ (h >> 33)
+    }
+}
+
+pub(super) type KeyMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
+
+/// Three words as a key that hashes in two steps.
+pub(super) fn key3(k: [u32; 3]) -> (u64, u32) {
+    ((k[0] as u64) << 32 | k[1] as u64, k[2])
+}
+
+/// A run of statements under one object name and material.
+#[derive(Default)]
+struct Group {
+    name: String,
+    material: Option<String>,
+    /// (position, uv, normal) of each of its vertices, NONE where absent.
+    keys: Vec<[u32; 3]>,
+    lookup: KeyMap<(u64, u32), u32>,
+    triangles: Vec<[u32; 3]>,
+    /// Positions (file indices) of its `l` lines and points of its `p` statements.
+    line_points: Vec<u32>,
+    line_counts: Vec<u32>,
+    points: Vec<u32>,
+}
+
+impl Group {
+    fn is_empty(&self) -> bool {
+        self.triangles.is_empty() && self.line_counts.is_empty() && self.points.is_empty()
+    }
+}
+
+#[derive(Default)]
+struct Mtl {
+    rgb: Option<[f32; 3]>,
+    dissolve: Option<f32>,
+    tr: Option<f32>,
+    /// (image, the MTL file and line naming it).
+    map_kd: Option<(PathBuf, String)>,
+    map_d: Option<(PathBuf, String)>,
+}
+
+impl Mtl {
+    /// The rule of docs/loading.md: `d` wins; `Tr` alone is 1 - d, except `Tr 1`, which
+    /// MeshLab and several exporters write meaning opaque, and which would otherwise hide
+    /// the mesh.
+    fn alpha(&self) -> f32 {
+        let a = match (self.dissolve, self.tr) {
+            (Some(d), _) => d,
+            (None, Some(t)) if t >= 1.0 => 1.0,
+            (None, Some(t)) => 1.0 - t,
+            (None, None) => 1.0,
+        };
+        a.clamp(0.0, 1.0)
+    }
+}
+
+#[derive(Default)]
+struct Obj {
+    positions: Vec<[f32; 3]>,
+    /// Vertex colors (sRGB), NaN for vertices written without one; empty while none has one.
+    colors: Vec<[f32; 3]>,
+    uvs: Vec<[f32; 2]>,
+    normals: Vec<[f32; 3]>,
+    group: Group,
+    groups: Vec<Group>,
+    materials: HashMap<String, Mtl>,
+    corners: Vec<[u32; 3]>,
+    /// For faces of positions alone: (group, its vertex) of each position.
+    slot: Vec<(u32, u32)>,
+    group_id: u32,
+    short_faces: usize,
+    short_lines: usize,
+    missing_mtl: Vec<String>,
+}
+
+impl Obj {
+    fn statement(&mut self, line: &[u8], at: usize, dir: &Path) -> Result<(), LoadError> {
+        if tokens(line).next() == Some(b"mtllib") {
+            return self.mtllib(&rest(line), at, dir);
+        }
+        self.geometry(line).map_err(|e| LoadError::Invalid(format!("line {at}: {e}")))
+    }
+
+    fn geometry(&mut self, line: &[u8]) -> Result<(), String> {
+        let mut t = tokens(line);
+        let Some(key) = t.next() else { return Ok(()) };
+        match key {
+            b"v" => {
+                let p = [number(t.next(), "x")?, number(t.next(), "y")?, number(t.next(), "z")?];
+                // x y z [w] or x y z r g b.
+                let rest: Vec<&[u8]> = t.take(4).collect();
+                if rest.len() >= 3 {
+                    if self.colors.len() < self.positions.len() {
+                        self.colors.resize(self.positions.len(), [f32::NAN; 3]);
+                    }
+                    let c = [number(Some(rest[0]), "red")?, number(Some(rest[1]), "green")?, number(Some(rest[2]), "blue")?];
+                    self.colors.push(c);
+                } else if !self.colors.is_empty() {
+                    self.colors.push([f32::NAN; 3]);
+                }
+                self.positions.push(p);
+            }
+            b"vt" => {
+                let u = number(t.next(), "u")?;
+                let v = if let Some(v) = t.next() { number(Some(v), "v")? } else { 0.0 };
+                self.uvs.push([u, v]);
+            }
+            b"vn" => self.normals.push([number(t.next(), "x")?, number(t.next(), "y")?, number(t.next(), "z")?]),
+            b"f" | b"fo" => {
+                self.corners.clear();
+                for c in t {
+                    let key = self.corner(c, "face")?;
+                    self.corners.push(key);
+                }
+                if self.corners.len() < 3 {
+                    self.short_faces += 1;
+                    return Ok(());
+                }
+                let g = &mut self.group;
+                let mut local = [0u32; 3];
+                for (k, key) in self.corners.iter().enumerate() {
+                    let next = g.keys.len() as u32;
+                    let i = if key[1] == NONE && key[2] == NONE {
+                        // A position alone: its slot in the file-wide table, tagged by group.
+                        let v = key[0] as usize;
+                        if self.slot.len() <= v {
+                            self.slot.resize(self.positions.len(), (NONE, NONE));
+                        }
+                        let (group, i) = self.slot[v];
+                        if group == self.group_id {
+                            i
+                        } else {
+                            self.slot[v] = (self.group_id, next);
+                            next
+                        }
+                    } else {
+                        *g.lookup.entry(key3(*key)).or_insert(next)
+                    };
+                    if i == next {
+                        g.keys.push(*key);
+                    }
+                    // A fan: (0, k - 1, k).
+                    match k {
+                        0 => local[0] = i,
+                        1 => local[2] = i,
+                        _ => {
+                            local[1] = local[2];
+                            local[2] = i;
+                            g.triangles.push(local);
+                        }
+                    }
+                }
+            }
+            b"l" => {
+                let before = self.group.line_points.len();
+                for c in t {
+                    let v = self.corner(c, "line")?[0];
+                    self.group.line_points.push(v);
+                }
+                let n = self.group.line_points.len() - before;
+                if n < 2 {
+                    self.group.line_points.truncate(before);
+                    self.short_lines += 1;
+                } else {
+                    self.group.line_counts.push(n as u32);
+                }
+            }
+            b"p" => {
+                for c in t {
+                    let v = self.corner(c, "point")?[0];
+                    self.group.points.push(v);
+                }
+            }
+            b"o" | b"g" => {
+                self.finish_group();
+                self.group.name = rest(line);
+            }
+            b"usemtl" => {
+                let name = rest(line);
+                let name = (!name.is_empty()).then_some(name);
+                if name != self.group.material {
+                    self.finish_group();
+                    self.group.material = name;
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or negative (from the end), as 0-based
+    /// indices (NONE where absent).
+    fn corner(&self, token: &[u8], statement: &str) -> Result<[u32; 3], String> {
+        let mut parts = token.split(|&b| b == b'/');
+        let mut out = [NONE; 3];
+        let counts = [(self.positions.len(), "vertices"), (self.uvs.len(), "texture coordinates"), (self.normals.len(), "normals")];
+        for (k, (n, what)) in counts.into_iter().enumerate() {
+            match parts.next() {
+                Some([]) if k > 0 => {}
+                None if k > 0 => {}
+                Some(p) => out[k] = index(p, n, statement, what)?,
+                None => unreachable!("split yields at least one part"),
+            }
+        }
+        Ok(out)
+    }
+
+    fn finish_group(&mut self) {
+        if self.group.is_empty() {
+            return;
+        }
+        let next = Group { name: self.group.name.clone(), material: self.group.material.clone(), ..Default::default() };
+        let mut done = std::mem::replace(&mut self.group, next);
+        done.lookup = KeyMap::default();
+        self.group_id += 1;
+        self.groups.push(done);
+    }
+
+    /// `mtllib a.mtl [b.mtl ...]`: the whole text as one name first (names may hold spaces).
+    fn mtllib(&mut self, names: &str, line: usize, dir: &Path) -> Result<(), LoadError> {
+        if names.is_empty() {
+            return Ok(());
+        }
+        let whole = dir.join(names.replace('\\', "/"));
+        let files: Vec<String> =
+            if whole.is_file() { vec![names.to_string()] } else { names.split_whitespace().map(str::to_string).collect() };
+        for name in files {
+            let file = dir.join(name.replace('\\', "/"));
+            if !file.is_file() {
+                // OBJ files are often shared without their .mtl: drawn gray, as other viewers do.
+                self.missing_mtl.push(format!("'{name}' (line {line})"));
+                continue;
+            }
+            let label = file.file_name().map_or(name.clone(), |n| n.to_string_lossy().into_owned());
+            self.read_mtl(&file, &label)?;
+        }
+        Ok(())
+    }
+
+    fn read_mtl(&mut self, file: &Path, label: &str) -> Result<(), LoadError> {
+        let at = |n: usize| move |e: String| LoadError::Invalid(format!("{label}, line {n}: {e}"));
+        let f = std::fs::File::open(file).map_err(|e| LoadError::Invalid(format!("cannot read {label} ({e})")))?;
+        let dir = file.parent().unwrap_or(Path::new("."));
+        let mut lines = Lines::new(std::io::BufReader::new(f));
+        let mut current: Option<String> = None;
+        while let Some((n, line)) = lines.next().map_err(|e| LoadError::Invalid(format!("cannot read {label} ({e})")))? {
+            let mut t = tokens(line);
+            let Some(key) = t.next() else { continue };
+            if key == b"newmtl" {
+                let name = rest(line);
+                self.materials.insert(name.clone(), Mtl::default());
+                current = Some(name);
+                continue;
+            }
+            let Some(m) = current.as_ref().and_then(|c| self.materials.get_mut(c)) else { continue };
+            match key {
+                b"Kd" => {
+                    let r = t.next();
+                    if r == Some(b"spectral") || r == Some(b"xyz") {
+                        continue;
+                    }
+                    let r = number(r, "Kd's red").map_err(at(n))?;
+                    let (g, b) = match (t.next(), t.next()) {
+                        (Some(g), Some(b)) => (number(Some(g), "Kd's green").map_err(at(n))?, number(Some(b), "Kd's blue").map_err(at(n))?),
+                        _ => (r, r),
+                    };
+                    m.rgb = Some([r, g, b]);
+                }
+                b"d" => {
+                    let v = t.find(|x| *x != b"-halo");
+                    m.dissolve = Some(number(v, "d").map_err(at(n))?);
+                }
+                b"Tr" => m.tr = Some(number(t.next(), "Tr").map_err(at(n))?),
+                b"map_Kd" | b"map_d" => {
+                    let name = map_file(t);
+                    if name.is_empty() {
+                        continue;
+                    }
+                    let entry = (dir.join(name.replace('\\', "/")), format!("{label}, line {n}"));
+                    if key == b"map_Kd" {
+                        m.map_kd = Some(entry);
+                    } else {
+                        m.map_d = Some(entry);
+                    }
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn build(self, point_radius: Option<f32>) -> Result<LoadedFile, LoadError> {
+        let mut out = LoadedFile::default();
+        let diagonal = diagonal(&self.positions);
+        let mut textures: HashMap<(Option<PathBuf>, Option<PathBuf>), Option<TextureMap>> = HashMap::new();
+        let mut unknown = std::collections::BTreeSet::new();
+        let mut downscaled = 0;
+        for (i, g) in self.groups.iter().enumerate() {
+            let mtl = g.material.as_ref().and_then(|name| {
+                let m = self.materials.get(name);
+                if m.is_none() {
+                    unknown.insert(name.clone());
+                }
+                m
+            });
+            let rgb = mtl.and_then(|m| m.rgb).map_or(DEFAULT_RGB, |c| c.map(srgb_to_linear));
+            let alpha = mtl.map_or(1.0, Mtl::alpha);
+            let opaque = alpha == 1.0 && mtl.is_none_or(|m| m.map_d.is_none());
+            let name = if g.name.is_empty() { format!("object {i}") } else { g.name.clone() };
+            let several = [!g.triangles.is_empty(), !g.line_counts.is_empty(), !g.points.is_empty()].iter().filter(|&&x| x).count() > 1;
+            let color_of = |v: u32| -> Option<[f32; 4]> {
+                let c = self.colors.get(v as usize)?;
+                (!c[0].is_nan()).then(|| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), alpha])
+            };
+            let colors_of = |vs: &mut dyn Iterator<Item = u32>| -> Vec<[f32; 4]> {
+                let colors: Option<Vec<[f32; 4]>> = if self.colors.is_empty() { None } else { vs.map(color_of).collect() };
+                colors.unwrap_or_else(|| vec![[rgb[0], rgb[1], rgb[2], alpha]])
+            };
+            if !g.triangles.is_empty() {
+                let positions = g.keys.iter().map(|k| self.positions[k[0] as usize]).collect();
+                let colors = colors_of(&mut g.keys.iter().map(|k| k[0]));
+                let mut mesh = named(name.clone(), positions, g.triangles.clone(), colors, opaque)?;
+                if g.keys.iter().all(|k| k[2] != NONE) {
+                    let normals: Vec<[f32; 3]> = g.keys.iter().map(|k| self.normals[k[2] as usize]).collect();
+                    // Zero normals (some exporters write them) are recomputed instead.
+                    if !normals.iter().any(|n| n.iter().all(|&x| x == 0.0)) {
+                        mesh.mesh.normals = normals;
+                    }
+                }
+                let mut texture = None;
+                if let Some(m) = mtl.filter(|m| m.map_kd.is_some() || m.map_d.is_some()) {
+                    if g.keys.iter().all(|k| k[1] != NONE) {
+                        let key = (m.map_kd.as_ref().map(|x| x.0.clone()), m.map_d.as_ref().map(|x| x.0.clone()));
+                        texture = match textures.get(&key) {
+                            Some(t) => t.clone(),
+                            None => {
+                                let (t, small) = load_texture(m.map_kd.as_ref(), m.map_d.as_ref())?;
+                                downscaled += small as usize;
+                                textures.insert(key, t.clone());
+                                t
+                            }
+                        };
+                    }
+                }
+                if texture.is_some() {
+                    // OBJ's v points up the image; the texture's row 0 is v = 0.
+                    mesh.mesh.uvs = g.keys.iter().map(|k| self.uvs[k[1] as usize]).map(|t| [t[0], 1.0 - t[1]]).collect();
+                }
+                mesh.mesh.material = Material { texture, ..Default::default() };
+                out.meshes.push(mesh);
+            }
+            if !g.line_counts.is_empty() {
+                let positions = g.line_points.iter().map(|&v| self.positions[v as usize]).collect();
+                let colors = colors_of(&mut g.line_points.iter().copied());
+                let width = diagonal.map_or(1.0, |d| d * LINE_WIDTH_OF_DIAGONAL);
+                let mesh =
+                    Mesh::strands(positions, g.line_counts.clone(), vec![width], colors, opaque).map_err(|e| format!("'{name}': {e}"))?;
+                out.meshes.push(NamedMesh::new(if several { format!("{name} (lines)") } else { name.clone() }, mesh));
+            }
+            if !g.points.is_empty() {
+                let positions = g.points.iter().map(|&v| self.positions[v as usize]).collect();
+                let colors = colors_of(&mut g.points.iter().copied());
+                let radius = point_radius.unwrap_or_else(|| diagonal.map_or(1.0, |d| d * POINT_RADIUS_OF_DIAGONAL));
+                let mesh = Mesh::particles(positions, vec![radius], colors, opaque, Falloff::Hard).map_err(|e| format!("'{name}': {e}"))?;
+                out.meshes.push(NamedMesh::new(if several { format!("{name} (points)") } else { name }, mesh));
+            }
+        }
+        if !self.missing_mtl.is_empty() {
+            out.warnings.push(format!(
+                "the material librar{} {} named by mtllib {} not there: its meshes are drawn gray",
+                if self.missing_mtl.len() == 1 { "y" } else { "ies" },
+                self.missing_mtl.join(", "),
+                if self.missing_mtl.len() == 1 { "is" } else { "are" }
+            ));
+        }
+        if !unknown.is_empty() && self.missing_mtl.is_empty() {
+            let names: Vec<String> = unknown.iter().map(|n| format!("'{n}'")).collect();
+            out.warnings.push(format!(
+                "{} material{} named by usemtl {} in no .mtl file ({}): drawn gray",
+                unknown.len(),
+                if unknown.len() == 1 { "" } else { "s" },
+                if unknown.len() == 1 { "is" } else { "are" },
+                names.join(", ")
+            ));
+        }
+        if self.short_faces > 0 {
+            out.warnings.push(format!("{} faces with fewer than 3 vertices are not drawn", self.short_faces));
+        }
+        if self.short_lines > 0 {
+            out.warnings.push(format!("{} lines (l) with fewer than 2 points are not drawn", self.short_lines));
+        }
+        if downscaled > 0 {
+            out.warnings.push(format!("{downscaled} textures are larger than {MAX_TEXTURE_SIZE} texels a side: downscaled to fit"));
+        }
+        Ok(out)
+    }
+}
+
+/// A 0-based index from a 1-based or negative (-1: the last) OBJ index.
+fn index(token: &[u8], n: usize, statement: &str, what: &str) -> Result<u32, String> {
+    let s = std::str::from_utf8(token).ok();
+    let Some(i) = s.and_then(|s| s.parse::<i64>().ok()) else {
+        return Err(format!("'{}' is not an index", short(&String::from_utf8_lossy(token))));
+    };
+    let k = match i {
+        0 => return Err(format!("{statement} index 0 is not an index into the {n} {what}: OBJ counts from 1")),
+        i if i > 0 && i as u64 <= n as u64 => i - 1,
+        i if i < 0 && i.unsigned_abs() <= n as u64 => n as i64 + i,
+        i if i > 0 => return Err(format!("{statement} index {i} is past the {n} {what}")),
+        i => return Err(format!("{statement} index {i} reaches before the first of the {n} {what}")),
+    };
+    Ok(k as u32)
+}
+
+/// The file name of a `map_*` statement after its options (`-s 1 1 1`, `-bm 0.5`, ...).
+fn map_file<'a>(mut t: impl Iterator<Item = &'a [u8]>) -> String {
+    let mut words = Vec::new();
+    while let Some(w) = t.next() {
+        let args = match w {
+            b"-blendu" | b"-blendv" | b"-cc" | b"-clamp" | b"-imfchan" | b"-bm" | b"-boost" | b"-texres" | b"-type" => 1,
+            b"-mm" => 2,
+            b"-o" | b"-s" | b"-t" => 3,
+            _ if words.is_empty() && w.starts_with(b"-") && w.len() > 1 && !w[1].is_ascii_digit() => 0,
+            _ => {
+                words.push(String::from_utf8_lossy(w).into_owned());
+                continue;
+            }
+        };
+        // -o/-s/-t take one to three numbers.
+        let mut left = args;
+        let mut peek = Vec::new();
+        while left > 0 {
+            let Some(x) = t.next() else { break };
+            if args == 3 && left < 3 && std::str::from_utf8(x).ok().and_then(|s| s.parse::<f32>().ok()).is_none() {
+                peek.push(String::from_utf8_lossy(x).into_owned());
+                break;
+            }
+            left -= 1;
+        }
+        words.extend(peek);
+    }
+    words.join(" ")
+}
+
+/// The diagonal of the box around the positions, where it is finite and > 0.
+fn diagonal(positions: &[[f32; 3]]) -> Option<f32> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k] as f64);
+            hi[k] = hi[k].max(p[k] as f64);
+        }
+    }
+    let d = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt() as f32;
+    (d.is_finite() && d > 0.0).then_some(d)
+}
+
+/// `map_Kd` times `map_d` (whose first channel is the alpha), either optional, and whether it
+/// was downscaled to MAX_TEXTURE_SIZE.
+fn load_texture(
+    diffuse: Option<&(PathBuf, String)>,
+    dissolve: Option<&(PathBuf, String)>,
+) -> Result<(Option<TextureMap>, bool), LoadError> {
+    let read = |(file, at): &(PathBuf, String)| -> Result<image::RgbaImage, LoadError> {
+        if !file.is_file() {
+            return Err(LoadError::NotFound(format!("{at}: the image {} is not there", file.display())));
+        }
+        let image =
+            image::open(file).map_err(|e| LoadError::Invalid(format!("{at}: the image {} is not readable ({e})", file.display())))?;
+        Ok(image.to_rgba8())
     };
     let mask = dissolve.map(read).transpose()?;
     let mut image = match (diffuse, &mask) {
         (Some(d), _) => read(d)?,
         (None, Some(m)) => image::RgbaImage::from_pixel(m.width(), m.height(), image::Rgba([255; 4])),
-        (None, None) => return Ok(None),
+        (None, None) => return Ok((None, false)),
     };
     if let Some(mask) = mask {
         let (w, h) = (image.width(), image.height());
         let mask = image::imageops::resize(&mask, w, h, image::imageops::FilterType::Triangle);
         image.pixels_mut().zip(mask.pixels()).for_each(|(p, m)| p[3] = m[0]);
     }
-    texture_map(image.width(), image.height(), image.into_raw()).map(Some)
+    let (w, h) = (image.width(), image.height());
+    let large = w.max(h) > MAX_TEXTURE_SIZE;
+    if large {
+        let s = MAX_TEXTURE_SIZE as f64 / w.max(h) as f64;
+        let (nw, nh) = (((w as f64 * s).round() as u32).max(1), ((h as f64 * s).round() as u32).max(1));
+        image = image::imageops::resize(&image, nw, nh, image::imageops::FilterType::Triangle);
+    }
+    let at = diffuse.or(dissolve).map_or(String::new(), |x| x.1.clone());
+    let map = texture_map(image.width(), image.height(), image.into_raw()).map_err(|e| format!("{at}: {e}"))?;
+    Ok((Some(map), large))
 }

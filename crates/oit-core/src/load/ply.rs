@@ -1,81 +1,534 @@
-//! PLY (ASCII or binary; vertex colors with alpha: 8-bit ones are sRGB, float ones linear;
-//! polygons fanned into triangles) and STL (ASCII or binary; gray, opaque).
+//! PLY, ASCII or binary (little or big endian), streamed: every property type, list
+//! properties of any count and index type, and every count checked against the bytes the
+//! file has before anything is allocated for it. Vertex and face colors with alpha (integer
+//! ones are sRGB, float ones linear; a face's color wins over its vertices', and vertices
+//! shared by faces of different colors are split), vertex normals; polygons fanned into
+//! triangles. A PLY of points only becomes particles in `load_file`.
 
+use std::io::Read;
 use std::path::Path;
 
-use super::{named, srgb_to_linear, NamedMesh, DEFAULT_RGB};
+use super::obj::KeyMap;
+use super::{named, srgb_to_linear, LoadError, NamedMesh, DEFAULT_RGB};
 
-fn stem(path: &Path) -> String {
-    path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh").to_string()
+pub fn load_ply(path: &Path) -> Result<NamedMesh, LoadError> {
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh").to_string();
+    let file = std::fs::File::open(path).map_err(|e| format!("cannot read it ({e})"))?;
+    let len = file.metadata().map_err(|e| format!("cannot read it ({e})"))?.len();
+    parse(file, len, stem)
 }
 
-pub fn load_ply(path: &Path) -> Result<NamedMesh, String> {
-    use ply_rs_bw::ply::Property as P;
-    let mut file = std::io::BufReader::new(std::fs::File::open(path).map_err(|e| e.to_string())?);
-    let parser = ply_rs_bw::parser::Parser::<ply_rs_bw::ply::DefaultElement>::new();
-    let ply = parser.read_ply(&mut file).map_err(|e| format!("not a readable PLY file ({e})"))?;
-    let scalar = |p: Option<&P>| -> Option<f64> {
-        Some(match p? {
-            P::Char(v) => *v as f64,
-            P::UChar(v) => *v as f64,
-            P::Short(v) => *v as f64,
-            P::UShort(v) => *v as f64,
-            P::Int(v) => *v as f64,
-            P::UInt(v) => *v as f64,
-            P::Float(v) => *v as f64,
-            P::Double(v) => *v,
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn from_name(name: &[u8]) -> Option<Self> {
+        Some(match name {
+            b"char" | b"int8" => Self::I8,
+            b"uchar" | b"uint8" => Self::U8,
+            b"short" | b"int16" => Self::I16,
+            b"ushort" | b"uint16" => Self::U16,
+            b"int" | b"int32" => Self::I32,
+            b"uint" | b"uint32" => Self::U32,
+            b"float" | b"float32" => Self::F32,
+            b"double" | b"float64" => Self::F64,
             _ => return None,
         })
-    };
-    let vertices = ply.payload.get("vertex").ok_or("no 'vertex' element")?;
-    let mut positions = Vec::with_capacity(vertices.len());
-    let mut colors = Vec::with_capacity(vertices.len());
-    for v in vertices {
-        let xyz = ["x", "y", "z"].map(|k| scalar(v.get(k)));
-        let [Some(x), Some(y), Some(z)] = xyz else { return Err("vertices need x, y and z".into()) };
-        positions.push([x as f32, y as f32, z as f32]);
-        // 8-bit colors are sRGB (alpha linear); float colors are taken as linear.
-        let unit = |k: &str| match v.get(k) {
-            Some(P::UChar(c)) => Some(*c as f32 / 255.0),
-            p => scalar(p).map(|c| c as f32),
-        };
-        let rgb = ["red", "green", "blue"].map(unit);
-        let c = match rgb {
-            [Some(r), Some(g), Some(b)] if matches!(v.get("red"), Some(P::UChar(_))) => [r, g, b].map(srgb_to_linear),
-            [Some(r), Some(g), Some(b)] => [r, g, b],
-            _ => DEFAULT_RGB,
-        };
-        colors.push([c[0], c[1], c[2], unit("alpha").unwrap_or(1.0)]);
     }
-    let faces = ply.payload.get("face").map(Vec::as_slice).unwrap_or_default();
-    let mut indices = Vec::with_capacity(faces.len());
-    for f in faces {
-        let list: Vec<i64> = match f.get("vertex_indices").or_else(|| f.get("vertex_index")) {
-            Some(P::ListInt(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(P::ListUInt(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(P::ListShort(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(P::ListUShort(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(P::ListChar(l)) => l.iter().map(|&i| i as i64).collect(),
-            Some(P::ListUChar(l)) => l.iter().map(|&i| i as i64).collect(),
-            _ => return Err("faces need a 'vertex_indices' list".into()),
-        };
-        if list.iter().any(|&i| i < 0 || i as usize >= positions.len()) {
-            return Err(format!("a face refers to a vertex outside [0, {})", positions.len()));
-        }
-        // A fan triangulates convex polygons.
-        for k in 1..list.len().saturating_sub(1) {
-            indices.push([list[0] as u32, list[k] as u32, list[k + 1] as u32]);
+
+    fn size(self) -> u64 {
+        match self {
+            Self::I8 | Self::U8 => 1,
+            Self::I16 | Self::U16 => 2,
+            Self::I32 | Self::U32 | Self::F32 => 4,
+            Self::F64 => 8,
         }
     }
-    let opaque = colors.iter().all(|c| c[3] >= 1.0);
-    named(stem(path), positions, indices, colors, opaque)
+
+    /// The largest value of an integer type (colors scale by it); None for floats.
+    fn unit(self) -> Option<f64> {
+        match self {
+            Self::I8 => Some(127.0),
+            Self::U8 => Some(255.0),
+            Self::I16 => Some(32767.0),
+            Self::U16 => Some(65535.0),
+            Self::I32 => Some(i32::MAX as f64),
+            Self::U32 => Some(u32::MAX as f64),
+            Self::F32 | Self::F64 => None,
+        }
+    }
 }
 
-pub fn load_stl(path: &Path) -> Result<NamedMesh, String> {
-    let mut file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let mesh = stl_io::read_stl(&mut file).map_err(|e| format!("not a readable STL file ({e})"))?;
-    let positions = mesh.vertices.iter().map(|v| v.0).collect();
-    let indices = mesh.faces.iter().map(|f| f.vertices.map(|i| i as u32)).collect();
-    let [r, g, b] = DEFAULT_RGB;
-    named(stem(path), positions, indices, vec![[r, g, b, 1.0]], true)
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    Scalar(Scalar),
+    List { count: Scalar, item: Scalar },
+}
+
+struct Element {
+    name: String,
+    count: u64,
+    props: Vec<(String, Kind)>,
+}
+
+impl Element {
+    fn find(&self, names: &[&str]) -> Option<usize> {
+        names.iter().find_map(|n| self.props.iter().position(|(p, k)| p == n && matches!(k, Kind::Scalar(_))))
+    }
+
+    fn scalar(&self, i: usize) -> Scalar {
+        match self.props[i].1 {
+            Kind::Scalar(s) => s,
+            Kind::List { item, .. } => item,
+        }
+    }
+
+    /// The fewest bytes an item takes: binary, its scalars and list counts; ASCII, one a value.
+    fn min_bytes(&self, format: Format) -> u64 {
+        self.props
+            .iter()
+            .map(|(_, k)| match (format, k) {
+                (Format::Ascii, _) => 1,
+                (_, Kind::Scalar(s)) => s.size(),
+                (_, Kind::List { count, .. }) => count.size(),
+            })
+            .sum()
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Format {
+    Ascii,
+    Little,
+    Big,
+}
+
+/// A buffered reader that knows how many bytes are left and which line it is on.
+struct Input<R> {
+    r: R,
+    buf: Vec<u8>,
+    pos: usize,
+    end: usize,
+    /// Bytes from `pos` to the end of the file.
+    left: u64,
+    line: usize,
+    token: Vec<u8>,
+}
+
+const BUF: usize = 1 << 16;
+
+impl<R: Read> Input<R> {
+    fn new(r: R, len: u64) -> Self {
+        Self { r, buf: vec![0; BUF], pos: 0, end: 0, left: len, line: 1, token: Vec::new() }
+    }
+
+    /// At least `n` (<= 8) bytes buffered unless the file ends first.
+    fn fill(&mut self, n: usize) -> Result<(), String> {
+        if self.end - self.pos >= n {
+            return Ok(());
+        }
+        self.buf.copy_within(self.pos..self.end, 0);
+        self.end -= self.pos;
+        self.pos = 0;
+        while self.end < n {
+            let k = self.r.read(&mut self.buf[self.end..]).map_err(|e| format!("cannot read it ({e})"))?;
+            if k == 0 {
+                break;
+            }
+            self.end += k;
+        }
+        Ok(())
+    }
+
+    fn byte(&mut self) -> Result<Option<u8>, String> {
+        self.fill(1)?;
+        if self.pos == self.end {
+            return Ok(None);
+        }
+        self.pos += 1;
+        self.left = self.left.saturating_sub(1);
+        Ok(Some(self.buf[self.pos - 1]))
+    }
+
+    /// A header line without its end (None at the end of the file).
+    fn header_line(&mut self) -> Result<Option<Vec<u8>>, String> {
+        let mut line = Vec::new();
+        loop {
+            match self.byte()? {
+                None if line.is_empty() => return Ok(None),
+                None => return Ok(Some(line)),
+                Some(b'\n') => {
+                    self.line += 1;
+                    if line.last() == Some(&b'\r') {
+                        line.pop();
+                    }
+                    return Ok(Some(line));
+                }
+                Some(b) => line.push(b),
+            }
+        }
+    }
+
+    fn binary(&mut self, s: Scalar, format: Format) -> Result<f64, String> {
+        let n = s.size() as usize;
+        self.fill(n)?;
+        if self.end - self.pos < n {
+            return Err("the file ends inside its data (cut short?)".into());
+        }
+        let mut b = [0u8; 8];
+        b[..n].copy_from_slice(&self.buf[self.pos..self.pos + n]);
+        self.pos += n;
+        self.left = self.left.saturating_sub(n as u64);
+        if format == Format::Big {
+            b[..n].reverse();
+        }
+        Ok(match s {
+            Scalar::I8 => b[0] as i8 as f64,
+            Scalar::U8 => b[0] as f64,
+            Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+            Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+            Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::F64 => f64::from_le_bytes(b),
+        })
+    }
+
+    /// The next whitespace-separated word of ASCII data.
+    fn word(&mut self) -> Result<&[u8], String> {
+        self.token.clear();
+        loop {
+            self.fill(1)?;
+            if self.pos == self.end {
+                break;
+            }
+            let chunk = &self.buf[self.pos..self.end];
+            let mut used = 0;
+            let mut done = false;
+            for &b in chunk {
+                if b.is_ascii_whitespace() {
+                    if !self.token.is_empty() {
+                        done = true;
+                        break;
+                    }
+                    self.line += (b == b'\n') as usize;
+                } else {
+                    self.token.push(b);
+                }
+                used += 1;
+            }
+            self.pos += used;
+            self.left = self.left.saturating_sub(used as u64);
+            if done {
+                break;
+            }
+        }
+        if self.token.is_empty() {
+            return Err("the file ends inside its data (cut short?)".into());
+        }
+        Ok(&self.token)
+    }
+
+    fn ascii(&mut self, s: Scalar) -> Result<f64, String> {
+        let w = self.word()?;
+        let text = std::str::from_utf8(w).unwrap_or("");
+        let v = match s {
+            Scalar::F32 | Scalar::F64 => crate::load::obj::decimal(w).or_else(|| text.parse::<f64>().ok()),
+            _ => text.parse::<i64>().ok().map(|i| i as f64).or_else(|| text.parse::<f64>().ok()),
+        };
+        v.ok_or_else(|| format!("'{}' is not a number", String::from_utf8_lossy(&w[..w.len().min(40)])))
+    }
+
+    fn value(&mut self, s: Scalar, format: Format) -> Result<f64, String> {
+        match format {
+            Format::Ascii => self.ascii(s),
+            _ => self.binary(s, format),
+        }
+    }
+
+    /// A list's length, checked against the bytes left.
+    fn list_len(&mut self, count: Scalar, item: Scalar, format: Format) -> Result<usize, String> {
+        let n = self.value(count, format)?;
+        let per = if format == Format::Ascii { 2 } else { item.size() };
+        if !(n >= 0.0 && n.fract() == 0.0) || n * per as f64 > self.left as f64 + 1.0 {
+            return Err(format!("a list of {n} values does not fit in the {} bytes left", self.left));
+        }
+        Ok(n as usize)
+    }
+}
+
+/// What the loader keeps of the vertices.
+struct Vertices {
+    positions: Vec<[f32; 3]>,
+    colors: Vec<[f32; 4]>,
+    normals: Vec<[f32; 3]>,
+}
+
+/// `len` bytes of PLY as one mesh named `name` (points only where it has no faces).
+fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
+    let mut input = Input::new(r, len);
+    let (format, elements) = header(&mut input)?;
+    let at = |input: &Input<_>, what: &str, i: u64, e: String| match format {
+        Format::Ascii => format!("line {}: {what} {i}: {e}", input.line),
+        _ => format!("{what} {i}: {e}"),
+    };
+    // Every element's items must fit in what is left: a count is never trusted on its own.
+    let need: u128 = elements.iter().map(|e| e.count as u128 * e.min_bytes(format) as u128).sum();
+    if need > input.left as u128 {
+        let e = elements.iter().max_by_key(|e| e.count as u128 * e.min_bytes(format) as u128).map_or("", |e| e.name.as_str());
+        return Err(format!(
+            "the header's counts need at least {need} bytes of data, the file has {} (a wrong count in 'element {e}'?)",
+            input.left
+        )
+        .into());
+    }
+    let vertex_count = elements.iter().find(|e| e.name == "vertex").map_or(0, |e| e.count);
+    if vertex_count > u32::MAX as u64 - 1 {
+        return Err(format!("{vertex_count} vertices are more than a mesh holds ({})", u32::MAX - 1).into());
+    }
+    let mut vertices = None;
+    let mut indices: Vec<[u32; 3]> = Vec::new();
+    // The color of each triangle, where faces have colors.
+    let mut face_colors: Vec<[f32; 4]> = Vec::new();
+    let mut values = vec![0f64; 0];
+    let mut list = Vec::new();
+    for e in &elements {
+        let props = &e.props;
+        // A vertex may have alpha alone (gray RGB); a face's color needs its RGB.
+        let color = |e: &Element| {
+            let rgb = [["red", "r", "diffuse_red"], ["green", "g", "diffuse_green"], ["blue", "b", "diffuse_blue"]].map(|n| e.find(&n));
+            let alpha = e.find(&["alpha", "a"]);
+            let has_rgb = rgb.iter().all(Option::is_some);
+            (has_rgb || (alpha.is_some() && e.name == "vertex")).then_some((rgb, alpha))
+        };
+        values.resize(props.len(), 0.0);
+        if e.name == "vertex" && vertices.is_none() {
+            let xyz = ["x", "y", "z"].map(|n| e.find(&[n]));
+            let [Some(x), Some(y), Some(z)] = xyz else { return Err("vertices need x, y and z".into()) };
+            let normal = ["nx", "ny", "nz"].map(|n| e.find(&[n]));
+            let color = color(e);
+            let n = e.count as usize;
+            let mut v = Vertices {
+                positions: Vec::with_capacity(n),
+                colors: Vec::with_capacity(if color.is_some() { n } else { 0 }),
+                normals: Vec::with_capacity(if normal.iter().all(Option::is_some) { n } else { 0 }),
+            };
+            for i in 0..e.count {
+                read_item(&mut input, e, format, &mut values, &mut list).map_err(|m| at(&input, "vertex", i, m))?;
+                v.positions.push([values[x] as f32, values[y] as f32, values[z] as f32]);
+                if let Some((rgb, alpha)) = color {
+                    v.colors.push(to_color(e, &values, rgb, alpha));
+                }
+                if let [Some(a), Some(b), Some(c)] = normal {
+                    v.normals.push([values[a] as f32, values[b] as f32, values[c] as f32]);
+                }
+            }
+            vertices = Some(v);
+        } else if e.name == "face" {
+            let list_at = props.iter().position(|(n, k)| matches!(k, Kind::List { .. }) && (n == "vertex_indices" || n == "vertex_index"));
+            let list_at = list_at.or_else(|| props.iter().position(|(_, k)| matches!(k, Kind::List { .. })));
+            let Some(list_at) = list_at else { return Err("faces need a 'vertex_indices' list".into()) };
+            let color = color(e);
+            indices.reserve(e.count as usize);
+            for i in 0..e.count {
+                list.clear();
+                read_face(&mut input, e, format, &mut values, &mut list, list_at).map_err(|m| at(&input, "face", i, m))?;
+                if let Some(&bad) = list.iter().find(|&&k| !(k >= 0.0 && k < vertex_count as f64 && k.fract() == 0.0)) {
+                    return Err(at(&input, "face", i, format!("vertex index {bad} is past the {vertex_count} vertices")).into());
+                }
+                // A fan triangulates convex polygons.
+                let before = indices.len();
+                for k in 2..list.len() {
+                    indices.push([list[0] as u32, list[k - 1] as u32, list[k] as u32]);
+                }
+                if let Some((rgb, alpha)) = color {
+                    let c = to_color(e, &values, rgb, alpha);
+                    face_colors.extend(std::iter::repeat_n(c, indices.len() - before));
+                }
+            }
+        } else {
+            for i in 0..e.count {
+                read_item(&mut input, e, format, &mut values, &mut list).map_err(|m| at(&input, &e.name, i, m))?;
+            }
+        }
+    }
+    let Some(mut v) = vertices else { return Err("no 'vertex' element".into()) };
+    if !face_colors.is_empty() {
+        split_by_face_color(&mut v, &mut indices, &face_colors);
+    }
+    drop(face_colors);
+    let opaque = v.colors.iter().all(|c| c[3] >= 1.0);
+    let colors = if v.colors.is_empty() { vec![[DEFAULT_RGB[0], DEFAULT_RGB[1], DEFAULT_RGB[2], 1.0]] } else { v.colors };
+    let mut mesh = named(name, v.positions, indices, colors, opaque)?;
+    let usable = |n: &[f32; 3]| n.iter().all(|x| x.is_finite()) && n.iter().any(|&x| x != 0.0);
+    if !v.normals.is_empty() && v.normals.iter().all(usable) && !mesh.mesh.indices.is_empty() {
+        mesh.mesh.normals = v.normals;
+    }
+    Ok(mesh)
+}
+
+fn header<R: Read>(input: &mut Input<R>) -> Result<(Format, Vec<Element>), String> {
+    let bad = |line: usize, e: &str| format!("header line {line}: {e}");
+    match input.header_line()? {
+        Some(l) if l == b"ply" => {}
+        _ => return Err("not a PLY file: it does not start with 'ply'".into()),
+    }
+    let mut format = None;
+    let mut elements: Vec<Element> = Vec::new();
+    loop {
+        let n = input.line;
+        let Some(line) = input.header_line()? else { return Err("the header has no 'end_header'".into()) };
+        let mut t = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty());
+        match t.next() {
+            None | Some(b"comment" | b"obj_info") => {}
+            Some(b"format") => {
+                format = Some(match t.next() {
+                    Some(b"ascii") => Format::Ascii,
+                    Some(b"binary_little_endian") => Format::Little,
+                    Some(b"binary_big_endian") => Format::Big,
+                    _ => return Err(bad(n, "the format is none of ascii, binary_little_endian, binary_big_endian")),
+                })
+            }
+            Some(b"element") => {
+                let name = t.next().ok_or_else(|| bad(n, "an element needs a name and a count"))?;
+                let count = t.next().and_then(|c| std::str::from_utf8(c).ok()?.parse::<u64>().ok());
+                let count = count.ok_or_else(|| bad(n, "an element's count must be a whole number >= 0"))?;
+                elements.push(Element { name: String::from_utf8_lossy(name).into_owned(), count, props: Vec::new() });
+            }
+            Some(b"property") => {
+                let e = elements.last_mut().ok_or_else(|| bad(n, "a property comes before any element"))?;
+                let ty = t.next().ok_or_else(|| bad(n, "a property needs a type and a name"))?;
+                let kind = if ty == b"list" {
+                    let count = t.next().and_then(Scalar::from_name);
+                    let item = t.next().and_then(Scalar::from_name);
+                    match (count, item) {
+                        (Some(count), Some(item)) if !matches!(count, Scalar::F32 | Scalar::F64) => Kind::List { count, item },
+                        _ => return Err(bad(n, "a list property needs an integer count type and an item type")),
+                    }
+                } else {
+                    let name = String::from_utf8_lossy(ty).chars().take(20).collect::<String>();
+                    Kind::Scalar(Scalar::from_name(ty).ok_or_else(|| bad(n, &format!("unknown property type '{name}'")))?)
+                };
+                let name = t.next().ok_or_else(|| bad(n, "a property needs a name"))?;
+                e.props.push((String::from_utf8_lossy(name).into_owned(), kind));
+            }
+            Some(b"end_header") => break,
+            Some(w) => {
+                let w: String = String::from_utf8_lossy(w).chars().take(20).collect();
+                return Err(bad(n, &format!("'{w}' is not a PLY header keyword")));
+            }
+        }
+    }
+    Ok((format.ok_or("the header has no 'format' line")?, elements))
+}
+
+/// One item into `values` (lists read and dropped).
+fn read_item<R: Read>(input: &mut Input<R>, e: &Element, format: Format, values: &mut [f64], list: &mut Vec<f64>) -> Result<(), String> {
+    for (k, (_, kind)) in e.props.iter().enumerate() {
+        match *kind {
+            Kind::Scalar(s) => values[k] = input.value(s, format)?,
+            Kind::List { count, item } => {
+                let n = input.list_len(count, item, format)?;
+                list.clear();
+                for _ in 0..n {
+                    list.push(input.value(item, format)?);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A face: its vertex list into `list`, its other properties into `values`.
+fn read_face<R: Read>(
+    input: &mut Input<R>,
+    e: &Element,
+    format: Format,
+    values: &mut [f64],
+    list: &mut Vec<f64>,
+    list_at: usize,
+) -> Result<(), String> {
+    let mut other = Vec::new();
+    for (k, (_, kind)) in e.props.iter().enumerate() {
+        match *kind {
+            Kind::Scalar(s) => values[k] = input.value(s, format)?,
+            Kind::List { count, item } => {
+                let n = input.list_len(count, item, format)?;
+                let into = if k == list_at { &mut *list } else { &mut other };
+                into.clear();
+                for _ in 0..n {
+                    into.push(input.value(item, format)?);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Straight linear RGBA of an item: integer channels are sRGB scaled by their type's largest
+/// value (alpha linear), float channels linear; missing RGB is the default gray.
+fn to_color(e: &Element, values: &[f64], rgb: [Option<usize>; 3], alpha: Option<usize>) -> [f32; 4] {
+    let channel = |i: usize, srgb: bool| {
+        let s = e.scalar(i);
+        let x = match s.unit() {
+            Some(u) => (values[i] / u) as f32,
+            None => values[i] as f32,
+        };
+        let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+        if srgb && s.unit().is_some() {
+            srgb_to_linear(x)
+        } else {
+            x
+        }
+    };
+    let c = match rgb {
+        [Some(r), Some(g), Some(b)] => [channel(r, true), channel(g, true), channel(b, true)],
+        _ => DEFAULT_RGB,
+    };
+    [c[0], c[1], c[2], alpha.map_or(1.0, |a| channel(a, false))]
+}
+
+/// Gives each triangle its face's color: a vertex takes the color of the first face that uses
+/// it, and a face of another color gets a copy of it.
+fn split_by_face_color(v: &mut Vertices, indices: &mut [[u32; 3]], face_colors: &[[f32; 4]]) {
+    const FREE: u32 = u32::MAX;
+    let n = v.positions.len();
+    let mut owner = vec![FREE; n];
+    let mut copies: KeyMap<(u32, [u32; 4]), u32> = KeyMap::default();
+    let base_colors = std::mem::take(&mut v.colors);
+    let mut colors: Vec<[f32; 4]> = Vec::with_capacity(n);
+    colors.extend((0..n).map(|i| base_colors.get(i).copied().unwrap_or([DEFAULT_RGB[0], DEFAULT_RGB[1], DEFAULT_RGB[2], 1.0])));
+    drop(base_colors);
+    for (t, tri) in indices.iter_mut().enumerate() {
+        let c = face_colors[t];
+        for i in tri.iter_mut() {
+            let k = *i as usize;
+            if owner[k] == FREE {
+                owner[k] = t as u32;
+                colors[k] = c;
+            } else if colors[k] != c {
+                let key = (*i, c.map(f32::to_bits));
+                let next = v.positions.len() as u32;
+                let copy = *copies.entry(key).or_insert(next);
+                if copy == next {
+                    v.positions.push(v.positions[k]);
+                    colors.push(c);
+                    if !v.normals.is_empty() {
+                        v.normals.push(v.normals[k]);
+                    }
+                }
+                *i = copy;
+            }
+        }
+    }
+    v.colors = colors;
 }
