@@ -667,6 +667,28 @@ fn surfaces(scene: &Scene, images: &[&Texture], places: &[Vec<[u32; 4]>]) -> Vec
     table
 }
 
+/// Places `rects` (image, level, width, height) in shelves, tallest first, in square layers of
+/// `side`: (x, y, layer, width | height << 16) each, and the layers used.
+fn shelves(rects: &[(usize, usize, u32, u32)], side: u32) -> (Vec<[u32; 4]>, u32) {
+    let mut order: Vec<usize> = (0..rects.len()).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse((rects[k].3, rects[k].2)));
+    let mut at = vec![[0u32; 4]; rects.len()];
+    let (mut x, mut y, mut shelf, mut layer) = (0u32, 0u32, 0u32, 0u32);
+    for k in order {
+        let (_, _, w, h) = rects[k];
+        if x + w > side {
+            (x, y, shelf) = (0, y + shelf, 0);
+        }
+        if y + h > side {
+            (x, y, shelf, layer) = (0, 0, 0, layer + 1);
+        }
+        at[k] = [x, y, layer, w | h << 16];
+        x += w;
+        shelf = shelf.max(h);
+    }
+    (at, layer + 1)
+}
+
 /// The scene's images with their mip chains, packed level by level into the layers of one
 /// 8-bit RGBA 2D array texture (shelves of rectangles, tallest first), read through an sRGB
 /// 4 bytes a texel plus a third for the mips, and what packing leaves.
@@ -688,34 +710,30 @@ impl Atlas {
         if let Some(&(i, _, w, h)) = rects.iter().find(|r| r.2 > max_side || r.3 > max_side) {
             return Err(invalid!("texture {i} is {w} x {h}, past the adapter's largest texture side ({max_side}): downscale it"));
         }
-        let area: u64 = rects.iter().map(|r| r.2 as u64 * r.3 as u64).sum();
-        let largest = rects.iter().map(|r| r.2.max(r.3)).max().unwrap_or(1);
-        let side = largest.max(((area as f64 * 1.15).sqrt().ceil() as u32).max(1)).next_power_of_two().min(max_side);
-        // Shelves, tallest rectangles first: (x, y, layer) of each.
-        let mut order: Vec<usize> = (0..rects.len()).collect();
-        order.sort_by_key(|&k| std::cmp::Reverse((rects[k].3, rects[k].2)));
-        let mut at = vec![[0u32; 4]; rects.len()];
-        let (mut x, mut y, mut shelf, mut layer) = (0u32, 0u32, 0u32, 0u32);
-        for k in order {
-            let (_, _, w, h) = rects[k];
-            if x + w > side {
-                (x, y, shelf) = (0, y + shelf, 0);
-            }
-            if y + h > side {
-                (x, y, shelf, layer) = (0, 0, 0, layer + 1);
-            }
-            at[k] = [x, y, layer, w | h << 16];
-            x += w;
-            shelf = shelf.max(h);
-        }
-        let layers = if rects.is_empty() { 1 } else { layer + 1 };
-        if layers > gpu.limits.max_texture_array_layers {
+        // The square side that packs into the fewest bytes: from the largest rectangle's power
+        // of two up to the adapter's largest side (a few layers of the smallest side often
+        // waste less than one large layer).
+        let largest = rects.iter().map(|r| r.2.max(r.3)).max().unwrap_or(1).next_power_of_two().min(max_side);
+        let sides = std::iter::successors(Some(largest), |&s| (s < max_side).then(|| (2 * s).min(max_side)));
+        let max_layers = gpu.limits.max_texture_array_layers;
+        let packings: Vec<(u32, Vec<[u32; 4]>, u32)> = sides
+            .map(|side| {
+                let (at, layers) = shelves(&rects, side);
+                (side, at, layers)
+            })
+            .collect();
+        let fewest = packings.iter().map(|p| p.2).min().unwrap_or(1);
+        let Some((side, at, layers)) = packings
+            .into_iter()
+            .filter(|p| p.2 <= max_layers)
+            .min_by_key(|&(side, _, layers)| (side as u64 * side as u64 * layers as u64, layers))
+        else {
             return Err(OitError::OutOfMemory(format!(
-                "the scene's textures need {layers} layers of {side} x {side} texels, past the adapter's {}: use fewer or smaller textures",
-                gpu.limits.max_texture_array_layers
+                "the scene's textures need {fewest} layers of {max_side} x {max_side} texels, past the adapter's {max_layers}: \
+                 use fewer or smaller textures"
             )));
-        }
-        let size = if rects.is_empty() { 1 } else { side };
+        };
+        let (size, layers) = if rects.is_empty() { (1, 1) } else { (side, layers) };
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("texture atlas"),
             size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
