@@ -55,10 +55,43 @@ fi
 "$VENV/bin/python" -m pip install -q --upgrade pip >/dev/null
 "$VENV/bin/python" -m pip install -q "maturin>=1.16,<2" "ruff>=0.17,<0.18"
 
+# with_status WHAT COMMAND...: runs COMMAND with its output in a log, printing one status line
+# every SETUP_STATUS_EVERY seconds (20) while it runs, with the crates cargo has compiled so far;
+# the log's tail when it fails.
+with_status() {
+  local what=$1 log start pid rc=0
+  shift
+  log=$(mktemp)
+  start=$SECONDS
+  "$@" >"$log" 2>&1 &
+  pid=$!
+  while ! wait_for "$pid" "${SETUP_STATUS_EVERY:-20}"; do
+    echo "setup: $what: $((SECONDS - start)) s, $(grep -c "Compiling " "$log" || true) crates compiled so far"
+  done
+  wait "$pid" || rc=$?
+  if [ "$rc" != 0 ]; then
+    tail -n 40 "$log" >&2
+    echo "setup: $what failed (exit $rc)" >&2
+  fi
+  rm -f "$log"
+  return "$rc"
+}
+# wait_for PID SECONDS: whether PID ended within SECONDS.
+wait_for() {
+  local i
+  for ((i = 0; i < $2; i++)); do
+    kill -0 "$1" 2>/dev/null || return 0
+    sleep 1
+  done
+  ! kill -0 "$1" 2>/dev/null
+}
+
 rm -rf dist
-"$VENV/bin/maturin" build --release --out dist -q 2>&1 | grep -v "^🔗\|^📦\|^🍹\|^⚠️" || true
+echo "setup: building the extension (cargo, release; the first build compiles wgpu and takes minutes)"
+with_status "building the extension" "$VENV/bin/maturin" build --release --out dist
 wheel=$(ls dist/oit-*.whl)
 "$VENV/bin/python" -m pip install -q --force-reinstall --no-deps "$wheel"
 # Then its dependencies and extras (the same version is installed: pip adds only what is missing).
-"$VENV/bin/python" -m pip install -q "$wheel[bench,peers,test]"
+echo "setup: installing the bench, peers and test extras from PyPI (matplotlib, FLIP, pygfx, VTK, pytest)"
+with_status "installing the extras" "$VENV/bin/python" -m pip install -q "$wheel[bench,peers,test]"
 echo "setup: installed $(basename "$wheel") with the bench, peers and test extras"

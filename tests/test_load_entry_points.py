@@ -18,8 +18,9 @@ import numpy as np
 import pytest
 
 import oit
-from oit import _oit, cli, view
+from oit import _oit, cli
 from oit.bench.load import glb_pack, gltf_doc, grid
+from test_viewer import VIEWER, needs_viewer
 
 # ---- the panic guard
 
@@ -188,15 +189,6 @@ def test_the_command_line_refuses_with_the_same_message(tmp_path, capsys, case):
 # ---- the viewer
 
 
-def _viewer():
-    try:
-        return view.find_viewer()
-    except RuntimeError:
-        return None
-
-
-VIEWER = _viewer()
-needs_viewer = pytest.mark.skipif(VIEWER is None, reason="needs the oit-viewer binary (`make viewer`)")
 
 
 def _run_viewer(args, tmp_path, display=False):

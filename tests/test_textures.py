@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import oit
-from test_shading import neighbour_step
+from test_shading import assert_within_the_shading_bound
 
 SIZE = 64
 
@@ -39,14 +39,7 @@ def floor_scene(repeat: float = 12.0, meshes: int = 1, shading: str = "smooth") 
 def test_every_exact_method_samples_the_mips_as_the_reference_does(renderer, method):
     scene, camera = floor_scene()
     ref, ambiguous = oit.reference(scene, camera, SIZE, SIZE, return_mask=True)
-    img = renderer(SIZE, SIZE).render(scene, camera, method).image
-    err = np.abs(img[..., :3] - ref[..., :3]).max(-1)
-    # docs/shading.md's bound: float32 shading, plus the image's change over 1e-3 pixel.
-    bound = 4e-6 + 1e-3 * neighbour_step(ref)
-    ok = ~ambiguous
-    assert ok.mean() > 0.9
-    worst = np.unravel_index(np.argmax(np.where(ok, err - bound, -np.inf)), err.shape)
-    assert (err <= bound)[ok].all(), f"{method}: error {err[worst]:.3g} at {worst} past {bound[worst]:.3g}"
+    assert_within_the_shading_bound(method, renderer(SIZE, SIZE).render(scene, camera, method).image, ref, ambiguous)
 
 
 def test_far_away_the_mips_average_what_a_pixel_covers(renderer):

@@ -79,6 +79,43 @@ def _demo(args: argparse.Namespace) -> int:
 # ---- render
 
 
+def _check_animation_writer(ext: str) -> None:
+    """Refuses before any rendering, saying what to install, when the writer of a .gif (Pillow)
+    or an .mp4 (imageio with imageio-ffmpeg) is not installed."""
+    import importlib.util
+
+    needs = {".gif": ("PIL",), ".mp4": ("imageio", "imageio_ffmpeg")}[ext]
+    missing = [m for m in needs if importlib.util.find_spec(m) is None]
+    if missing:
+        what = "Pillow: pip install pillow" if ext == ".gif" else "imageio and imageio-ffmpeg: pip install imageio imageio-ffmpeg"
+        raise RuntimeError(f"writing a {ext[1:].upper()} needs {what} (or pip install 'oit[video]', which has both)")
+
+
+def _plural(n: int, one: str, many: str) -> str:
+    return f"{n} {one if n == 1 else many}"
+
+
+def describe_contents(scene: Any) -> str:
+    """What a scene draws, counted by primitive kind: "2 meshes (1200 triangles), 500 particles,
+    30 strands (600 points)": meshes as added, what they draw as many times as they are instanced."""
+    totals = {"triangles": [0, 0, 0], "particles": [0, 0, 0], "strands": [0, 0, 0]}
+    for i, (kind, (triangles, vertices, _)) in enumerate(zip(scene.primitives(), scene._native.mesh_summary())):
+        n = max(1, len(scene._native.instances(i)[0]))
+        t = totals[kind]
+        # Particles: a quad (2 triangles) each; strands: 2 triangles a segment, one segment fewer than points.
+        t[0] += 1
+        t[1] += n * (triangles if kind == "triangles" else vertices if kind == "particles" else vertices - triangles // 2)
+        t[2] += n * vertices
+    parts = []
+    if totals["triangles"][0]:
+        parts.append(_plural(totals["triangles"][0], "mesh", "meshes") + f" ({_plural(totals['triangles'][1], 'triangle', 'triangles')})")
+    if totals["particles"][0]:
+        parts.append(_plural(totals["particles"][1], "particle", "particles"))
+    if totals["strands"][0]:
+        parts.append(_plural(totals["strands"][1], "strand", "strands") + f" ({_plural(totals['strands'][2], 'point', 'points')})")
+    return ", ".join(parts) or "nothing to draw"
+
+
 def _add_render(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", help="a mesh file: OBJ (with its MTL), glTF, GLB, PLY or STL (docs/loading.md)")
     p.add_argument("-m", "--method", default="abuffer", help="see `python -m oit methods` (default: %(default)s)")
@@ -117,7 +154,7 @@ def _render(args: argparse.Namespace) -> int:
         from .sequence import check_animation_path
 
         output = args.output or os.path.join("out", f"{stem}-{args.method}.gif")
-        check_animation_path(output)
+        _check_animation_writer(check_animation_path(output))
     else:
         output = args.output or os.path.join("out", f"{stem}-{args.method}.png")
     scene = load_for_viewing(args)
@@ -125,8 +162,11 @@ def _render(args: argparse.Namespace) -> int:
     renderer = Renderer(width, height, adapter=args.adapter)
     params: dict[str, Any] = dict(args.param)
     lights = f"{len(args.light)} lights" if args.light else "headlight"
-    alpha = "the file's alpha" if args.alpha is None else f"alpha {args.alpha}"
-    print(f"{args.file}: {scene.mesh_count} meshes, {scene.triangle_count} triangles, {alpha}, {args.shading} shading "
+    if args.alpha is not None:
+        alpha = f"alpha {args.alpha}"
+    else:  # load_for_viewing said it when nothing in the file is transparent
+        alpha = "every mesh at alpha 0.4" if getattr(args, "alpha_note", None) else "the file's alpha"
+    print(f"{args.file}: {describe_contents(scene)}, {alpha}, {args.shading} shading "
           f"({lights}), {width} x {height}, method {args.method}")
     if args.orbit is not None:
         from .sequence import render_sequence, write_animation

@@ -86,7 +86,7 @@ class Comparison:
         if not row["time_ms"] <= budget:
             out.append(f"time {row['time_ms']:.3g} ms > {budget:g} ms")
         if not row["peak_memory_bytes"] <= mem:
-            out.append(f"memory {row['peak_memory_bytes'] / 2**20:.3g} MiB > {mem / 2**20:.3g} MiB")
+            out.append(f"peak memory {row['peak_memory_bytes'] / 2**20:.3g} MiB > {mem / 2**20:.3g} MiB")
         return out
 
     def best(self, tolerance: float | None = None, time_ms: float | None = None, memory: int | None = None) -> dict | None:
@@ -101,11 +101,11 @@ class Comparison:
         """The recommendation in words: the best row, or that none meets the limits and why."""
         tol, budget, mem = self._limits(tolerance, time_ms, memory)
         limits = f"max error <= {tol:g}" + (f", time <= {budget:g} ms" if math.isfinite(budget) else "") \
-            + (f", memory <= {mem / 2**20:.3g} MiB" if math.isfinite(mem) else "")
+            + (f", peak memory <= {mem / 2**20:.3g} MiB" if math.isfinite(mem) else "")
         b = self.best(tolerance, time_ms, memory)
         if b is not None:
             return (f"cheapest within {limits}: {b['method']} {b['params']}".rstrip() +
-                    f" ({b['time_ms']:.3g} ms, {b['peak_memory_bytes'] / 2**20:.3g} MiB, max error {b['max_err']:.3g})")
+                    f" ({b['time_ms']:.3g} ms, peak memory {b['peak_memory_bytes'] / 2**20:.3g} MiB, max error {b['max_err']:.3g})")
         lines = [f"no method meets {limits}:"]
         lines += [f"  {r['method']} {r['params']}: {'; '.join(self.misses(r, tolerance, time_ms, memory))}" for r in self.rows]
         return "\n".join(lines)

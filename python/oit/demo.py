@@ -1,7 +1,11 @@
-"""The built-in demo: a lit, transparent mesh -- two Stanford bunnies from shared/data when it is
-there, else the built-in glass scene -- rendered with hybrid beside its exact answer (abuffer)
-and the blends (sorted, unsorted), over their errors. Method names and errors are drawn in the
-picture (with Pillow, which matplotlib brings; without it the tiles are left unlabelled).
+"""The built-in demo: three lit, transparent shapes generated here (nothing to download, so
+every clone draws the same picture) -- a folded lump behind, a sphere in the middle, a ring in
+front, overlapping on screen and submitted nearest first -- rendered with hybrid beside its
+exact answer (abuffer) and the blends (sorted, unsorted), over their errors. Submitted nearest
+first, `unsorted` blends every overlap in the wrong order; `sorted` puts the meshes back to front
+and is wrong only where a mesh covers itself (the lump's folds, the ring seen through its hole).
+Method names and errors are drawn in the picture (with Pillow, which matplotlib brings; without
+it the tiles are left unlabelled).
 
 Top row: the images. Bottom row: under abuffer, its deviation from the CPU float64 reference
 (ambiguous pixels left black); under the others, |method - abuffer|, the largest over RGB. All
@@ -14,33 +18,32 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import scenes
+from . import geometry
 from ._api import Camera, Frame, Renderer, Scene, reference
 from .imageio import heatmap, label, mosaic
 
 METHODS = ("abuffer", "hybrid", "sorted", "unsorted")
 BACKGROUND = (1.0, 1.0, 1.0)
-MESH_FILE = "stanford-bunny.obj"
-# (offset, straight linear RGBA) of each bunny, nearest first so that the blends differ.
-BUNNIES = (((0.18, 0.0, 0.15), (0.95, 0.45, 0.1, 0.5)), ((-0.2, 0.05, -0.2), (0.15, 0.4, 0.95, 0.55)))
 
 
-def demo_scene(max_triangles: int = 20000) -> tuple[Scene, Camera, str]:
-    """The demo scene, its camera (square aspect) and what it shows."""
-    folder = scenes.shared_data_dir()
-    path = folder / MESH_FILE if folder is not None else None
-    if path is None or not path.is_file():
-        built = scenes.glass(detail=24)
-        return built.scene, built.camera, "the built-in glass scene"
-    p, idx, _ = scenes._dragon_mesh(path, max_triangles)
+def demo_scene(detail: int = 32) -> tuple[Scene, Camera, str]:
+    """The demo scene, its camera (square aspect) and what it shows. `detail`: the ring's and
+    sphere's segments around (the lump has twice as many)."""
+    lump = geometry.blob((0.3, -0.05, -0.55), (0.5, 0.6, 0.42), bumps=0.28, rings=detail, segments=2 * detail, seed=3)
+    sphere = geometry.uv_sphere((-0.22, 0.28, -0.05), 0.36, rings=detail, segments=2 * detail)
+    ring = geometry.torus((-0.05, -0.12, 0.42), 0.38, 0.11, 2 * detail, detail // 2, axis=(0.35, 1.0, 0.5))
+    # (mesh, straight linear RGBA), nearest first: the worst order for blending in submission order.
+    shapes = ((ring, (0.1, 0.35, 0.95, 0.55)), (sphere, (0.15, 0.8, 0.35, 0.45)), (lump, (0.95, 0.45, 0.08, 0.6)))
     scene = Scene()
-    for offset, rgba in BUNNIES:
-        scene.add_mesh(p + np.asarray(offset), idx, rgba, shading="smooth", specular=0.4, shininess=48.0)
+    for (p, idx), rgba in shapes:
+        scene.add_mesh(p, idx, rgba, normals=geometry.vertex_normals(p, idx), shading="smooth", specular=0.4,
+                       shininess=48.0)
     scene.add_light((-0.5, -0.8, -0.6), (1.0, 0.96, 0.9), 0.8)
     scene.add_light((0.9, -0.1, -0.2), (0.6, 0.7, 1.0), 0.3)
     scene.ambient = (0.3, 0.3, 0.3)
-    camera = Camera.look_at(eye=(0.4, 0.5, 2.2), target=(0.0, 0.0, 0.0), fov_y=40.0, near=0.8, far=4.0)
-    return scene, camera, f"two lit {MESH_FILE} ({len(idx)} triangles each)"
+    camera = Camera.look_at(eye=(0.25, 0.45, 2.6), target=(0.0, 0.0, -0.05), fov_y=40.0, near=1.0, far=4.5)
+    triangles = sum(len(idx) for (_, idx), _ in shapes)
+    return scene, camera, f"a ring, a sphere and a folded lump, lit, submitted nearest first ({triangles} triangles)"
 
 
 def reference_bound(ref: np.ndarray) -> np.ndarray:
@@ -75,8 +78,7 @@ class DemoResult:
 
 def run(size: int = 384, adapter: str | None = None) -> DemoResult:
     """Renders the demo at `size` x `size` and compares every method with abuffer."""
-    # About 8 pixels a triangle: finer meshes put a triangle edge near most pixel centers.
-    scene, camera, subject = demo_scene(max_triangles=int(np.clip(size * size // 8, 1000, 20000)))
+    scene, camera, subject = demo_scene()
     renderer = Renderer(size, size, adapter=adapter)
     frames = {m: renderer.render(scene, camera, method=m, background=BACKGROUND, census=True) for m in METHODS}
     exact = frames["abuffer"].image[..., :3].astype(np.float64)

@@ -51,45 +51,92 @@ def pareto_front(points: Sequence[tuple[float, float]]) -> list[int]:
     return front
 
 
-def tradeoff(rows: list[dict], title: str, path: str) -> None:
-    """Mean error (over covered pixels) against each of TRADE_AXES, one marker color per
-    method, parameter values written beside their points, the Pareto front as a dashed step
-    line. Rows below EXACT_BELOW sit on that line, marked 'exact'."""
+def _label_value(params: str) -> str:
+    """The first parameter's value (k, nodes, samples, layers) as a short point label."""
+    value = params.split(" ")[0].partition("=")[2]
+    try:
+        return f"{float(value):.3g}"
+    except ValueError:
+        return value
+
+
+# Where a point's label may go, in points from the point, tried in order.
+LABEL_OFFSETS = ((4, 3), (4, -9), (-10, 3), (-10, -9), (4, 10), (4, -16), (-16, 10), (-16, -16))
+
+
+def _place_labels(ax: Any, labels: list[tuple[float, float, str]]) -> None:
+    """Writes each (x, y, text) beside its point at the first of LABEL_OFFSETS where it overlaps
+    no label placed before it and stays inside the axes; a label with no such place is left out
+    (its point keeps its color in the legend)."""
+    renderer = ax.figure.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    taken: list[Any] = []
+    for x, y, text in labels:
+        for offset in LABEL_OFFSETS:
+            t = ax.annotate(text, (x, y), textcoords="offset points", xytext=offset, fontsize=7)
+            box = t.get_window_extent(renderer)
+            inside = frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+            if inside and not any(box.overlaps(b) for b in taken):
+                taken.append(box)
+                break
+            t.remove()
+
+
+def tradeoff_figure(rows: list[dict], title: str) -> Any:
+    """The figure of `tradeoff`: mean error (over covered pixels) against each of TRADE_AXES,
+    one marker color per method (named in one legend below the panels), parameter values beside
+    their points where they fit without overlapping, the Pareto front as a dashed step line.
+    Rows below EXACT_BELOW sit on that line, which is labelled 'exact' once."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
 
     ok = [r for r in rows if r["status"] == "ok" and math.isfinite(r["mean_err"])]
     methods = list(dict.fromkeys(r["method"] for r in ok))
     palette = [plt.get_cmap(name)(i) for name in ("tab20", "tab20b") for i in range(20)]
     colors = {m: palette[i % len(palette)] for i, m in enumerate(methods)}
-    fig, axes = plt.subplots(1, len(TRADE_AXES), figsize=(6 * len(TRADE_AXES), 5))
+    legend_rows = -(-(len(methods) + 1) // 8)
+    fig, axes = plt.subplots(1, len(TRADE_AXES), figsize=(6 * len(TRADE_AXES), 5 + 0.25 * legend_rows))
+    handles: dict[str, Any] = {}
     for ax, (key, xlabel, log_x) in zip(axes, TRADE_AXES):
         pts = [(r[key], max(r["mean_err"], EXACT_BELOW), r) for r in ok if math.isfinite(r[key])]
         for m in methods:
             mine = [(x, y, r) for x, y, r in pts if r["method"] == m]
             if mine:
-                ax.scatter([p[0] for p in mine], [p[1] for p in mine], color=colors[m], label=m, s=30, zorder=3,
-                           marker="^" if m.startswith(("pygfx-", "vtk-")) else "o")
-            for x, y, r in mine:
-                # The first parameter's value (k, nodes, samples, layers) names the point.
-                text = "exact" if r["mean_err"] < EXACT_BELOW else r["params"].split(" ")[0].partition("=")[2]
-                if text:
-                    ax.annotate(text, (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
+                handles[m] = ax.scatter([p[0] for p in mine], [p[1] for p in mine], color=colors[m], label=m, s=30,
+                                        zorder=3, marker="^" if m.startswith(("pygfx-", "vtk-")) else "o")
         front = [pts[i] for i in pareto_front([(p[0], p[1]) for p in pts])]
         if front:
-            ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="0.4", linestyle="--",
-                    linewidth=1, label="Pareto front", zorder=2)
+            handles["Pareto front"] = ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="0.4",
+                                              linestyle="--", linewidth=1, label="Pareto front", zorder=2)[0]
+        if any(r["mean_err"] < EXACT_BELOW for _, _, r in pts):
+            ax.axhline(EXACT_BELOW, color="0.6", linestyle=":", linewidth=1, zorder=1)
+            ax.annotate(f"exact (error < {EXACT_BELOW:g})", (0.01, EXACT_BELOW), xycoords=("axes fraction", "data"),
+                        textcoords="offset points", xytext=(0, -11), fontsize=7, color="0.3")
         ax.set_yscale("log")
         if log_x:
             ax.set_xscale("log")
+            ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels crowd a short log axis
         ax.set_xlabel(xlabel)
         ax.set_ylabel("mean RGB distance to abuffer (covered pixels)")
         ax.grid(True, which="both", alpha=0.3)
-    axes[1].legend(fontsize=7, ncol=2)  # the wall-time panel has every row, peers included
     fig.suptitle(title)
-    fig.tight_layout()
+    fig.legend(list(handles.values()), list(handles), loc="lower center", ncol=8, fontsize=7, frameon=False)
+    fig.tight_layout(rect=(0, 0.03 * legend_rows + 0.01, 1, 1))
+    # Labels last, once the layout has fixed where every axes is.
+    for ax, (key, _, _) in zip(axes, TRADE_AXES):
+        _place_labels(ax, [(r[key], max(r["mean_err"], EXACT_BELOW), _label_value(r["params"])) for r in ok
+                           if math.isfinite(r[key]) and r["mean_err"] >= EXACT_BELOW and _label_value(r["params"])])
+    return fig
+
+
+def tradeoff(rows: list[dict], title: str, path: str) -> None:
+    """`tradeoff_figure` as a PNG at `path`."""
+    import matplotlib.pyplot as plt
+
+    fig = tradeoff_figure(rows, title)
     fig.savefig(path, dpi=80)
     plt.close(fig)
 

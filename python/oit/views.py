@@ -60,6 +60,7 @@ def load_for_viewing(args: Any) -> Scene:
     scene, note = load_file(args.file, args.alpha, shading=args.shading, specular=args.specular, viewing=True)
     if note:
         print(f"{args.file}: {note}")
+    args.alpha_note = note  # `render` says which alpha it drew at
     for light in getattr(args, "light", []):
         scene.add_light(light)
     scene.ambient = tuple(getattr(args, "ambient", (0.1, 0.1, 0.1)))

@@ -3,12 +3,16 @@
 //! (`Renderer::render_into`), straight into the engine's texture, and the example writes it
 //! out as a PNG.
 //!
-//!     cargo run --release -p oit-core --example over_opaque [out.png]
+//!     make example      (the Makefile's target directory; `cargo run --release -p oit-core
+//!                        --example over_opaque [out.png]` also works, building into ./target)
+//!
+//! The `render_into` call below is the README's Rust block, as it is written there
+//! (tests/test_readme.py checks that the two stay the same; `cargo test` and clippy build this).
 
 #[path = "../tests/common/caller.rs"]
 mod caller;
 
-use oit_core::{shared_context, Camera, Mesh, Renderer, Scene, Target};
+use oit_core::{shared_context, Camera, Mesh, Renderer, Scene};
 
 /// A full-screen quad at NDC depth `z` with one straight RGBA color.
 fn layer(z: f32, rgba: [f32; 4]) -> Mesh {
@@ -17,6 +21,15 @@ fn layer(z: f32, rgba: [f32; 4]) -> Mesh {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // The Vulkan loader's window-system code prints "XDG_RUNTIME_DIR is invalid or not set"
+    // without one (headless machines, CI); a private directory keeps it quiet, as the Python
+    // package and the viewer do. Nothing is written there.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none_or(|d| !std::path::Path::new(&d).is_dir()) {
+        let dir = std::env::temp_dir().join(format!("oit-runtime-{}", std::process::id()));
+        if std::fs::create_dir_all(&dir).is_ok() {
+            std::env::set_var("XDG_RUNTIME_DIR", dir);
+        }
+    }
     let path = std::env::args().nth(1).unwrap_or_else(|| "out/over_opaque.png".into());
     let size = (320, 240);
     let gpu = shared_context(None)?;
@@ -29,16 +42,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     scene.add_mesh(layer(0.8, [0.1, 0.1, 1.0, 0.6]));
     let camera = Camera::from_rows([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])?;
     let mut renderer = Renderer::new(gpu.clone(), size.0, size.1)?;
-    let stats = renderer.render_into(
-        &scene,
-        &camera,
-        "abuffer",
-        &[],
-        [0.0; 3],
-        Target { color: &picture.color, depth: Some(&picture.depth), encode_srgb: false },
-    )?;
+    let caller::Picture { color, depth } = picture;
+    #[rustfmt::skip]
+    let stats = renderer.render_into(&scene, &camera, "abuffer", &[], [0.0; 3],
+                                     oit_core::Target { color: &color, depth: Some(&depth), encode_srgb: false })?;
     println!("{}: {} fragments, {:.1} ms on the GPU", stats.method, stats.fragments, stats.gpu_time_ms.unwrap_or(0.0));
-    let pixels = caller::read_texture(&gpu, &picture.color, 4);
+    let pixels = caller::read_texture(&gpu, &color, 4);
     if let Some(dir) = std::path::Path::new(&path).parent() {
         std::fs::create_dir_all(dir)?;
     }

@@ -17,6 +17,7 @@ from .claims import CLAIM_COLUMNS, run_claims
 from .figure7 import figure7_table
 from .floor import BASELINE, FLOOR_COLUMNS, GROWTH, load_baseline, peers_floor, write_baseline
 from .floor import SCENES as FLOOR_SCENE_NAMES
+from .gpu import run_gpu
 from .harness import QUICK_SIZE, write_tables
 from .load import LOAD_COLUMNS, LOAD_TRIANGLES, TARGET_TRIANGLES_PER_S, fuzz_load, load_speed
 from .results import COLUMNS, run
@@ -109,6 +110,10 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--seconds", type=float, default=60.0, help="--fuzz-load: how long to run (default: %(default)s)")
     ap.add_argument("--seed", type=int, default=0, help="--fuzz-load: the random seed (default: %(default)s)")
     ap.add_argument("--fuzz-cases", type=int, default=None, help=argparse.SUPPRESS)
+    ap.add_argument("--gpu", action="store_true",
+                    help="instead of the method sweep: what may turn on a GPU, about 6 minutes on a hardware adapter (never "
+                         "lavapipe), each part under a time limit (gpu.md, gpu.json; scripts/gpu-bench.sh, oit.bench.gpu)")
+    ap.add_argument("--small", action="store_true", help="--gpu: the same on any adapter at tiny sizes (seconds)")
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -132,6 +137,8 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
+    if a.gpu:
+        return run_gpu(a.out, a.small)
     if a.load or a.fuzz_load:
         if a.load:
             write_tables(a.out, "load", load_speed(a.load_triangles), LOAD_COLUMNS)

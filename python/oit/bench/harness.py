@@ -245,3 +245,4 @@ def write_tables(out: str, name: str, result: Result, columns: list[tuple[str, s
     for n in result.notes:
         print(f"note: {n}")
     print(table)
+    print(f"wrote {os.path.join(out, f'{name}.md')} and {os.path.join(out, f'{name}.csv')}")
