@@ -6,6 +6,7 @@ a PLY whose header claims more than the file holds refused at once."""
 from __future__ import annotations
 
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -73,3 +74,34 @@ def test_ply_claiming_more_than_it_holds_is_refused_at_once(tmp_path):
     with pytest.raises(ValueError, match="need at least 48000000001 bytes of data, the file has 40"):
         oit.Scene.from_file(path)
     assert time.perf_counter() - start < 1.0
+
+
+def test_obj_corners_naming_missing_uvs_or_normals_keep_their_vertices(tmp_path):
+    # Some exporters write `f 1/1/1` with no `vt` or `vn` lines: the corners keep their
+    # vertices and lose the attribute, and the loader says so.
+    path = tmp_path / "dangling.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\nf 1//4 2//4 3//4\n")
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        scene = oit.Scene.from_file(path)
+    assert scene.triangle_count == 2
+    said = [str(w.message) for w in record if w.category is oit.OitLoadWarning]
+    assert any("texture coordinate indices refer past" in m for m in said) and any("normal indices refer past" in m for m in said), said
+
+
+def test_obj_of_vertices_only_is_a_point_cloud(tmp_path):
+    path = tmp_path / "cloud.obj"
+    path.write_text("".join(f"v {x} {x * x} 0\n" for x in range(5)))
+    scene = oit.Scene.from_file(path, point_radius=0.1)
+    assert scene.primitives() == ["particles"]
+    assert [n for _, n, _ in scene._native.mesh_summary()] == [5]
+
+
+def test_ascii_ply_words_past_the_header_properties_are_skipped(tmp_path):
+    # A writer that adds words the header does not declare (a texture number, say) at the end
+    # of each face: they are not read as the next face.
+    path = tmp_path / "extra.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                    "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                    "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 9 1 1\n3 0 2 3 9 1 1\n")
+    assert oit.Scene.from_file(path).triangle_count == 2

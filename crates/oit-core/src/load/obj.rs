@@ -293,6 +293,8 @@ struct Obj {
     group_id: u32,
     short_faces: usize,
     short_lines: usize,
+    /// Texture coordinate and normal indices past what the file defines: left out.
+    dangling: [usize; 2],
     missing_mtl: Vec<String>,
 }
 
@@ -413,7 +415,10 @@ impl Obj {
 
     /// `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or negative (from the end), as 0-based
     /// indices (NONE where absent).
-    fn corner(&self, token: &[u8], statement: &str) -> Result<[u32; 3], String> {
+    /// A texture coordinate or normal index past what the file defines (some exporters write
+    /// `f 1/1/1` with no `vt` lines) leaves that attribute absent, counted for a warning; a
+    /// vertex index past the vertices is an error.
+    fn corner(&mut self, token: &[u8], statement: &str) -> Result<[u32; 3], String> {
         let mut parts = token.split(|&b| b == b'/');
         let mut out = [NONE; 3];
         let counts = [(self.positions.len(), "vertices"), (self.uvs.len(), "texture coordinates"), (self.normals.len(), "normals")];
@@ -421,6 +426,10 @@ impl Obj {
             match parts.next() {
                 Some([]) if k > 0 => {}
                 None if k > 0 => {}
+                Some(p) if k > 0 => match index(p, n, statement, what) {
+                    Ok(i) => out[k] = i,
+                    Err(_) => self.dangling[k - 1] += 1,
+                },
                 Some(p) => out[k] = index(p, n, statement, what)?,
                 None => unreachable!("split yields at least one part"),
             }
@@ -588,6 +597,18 @@ impl Obj {
                 out.meshes.push(NamedMesh::new(if several { format!("{name} (points)") } else { name }, mesh));
             }
         }
+        if out.meshes.is_empty() && !self.positions.is_empty() {
+            // Vertices and nothing drawn from them: a point cloud, as a PLY of points only is.
+            let colors = if self.colors.len() == self.positions.len() && self.colors.iter().all(|c| !c[0].is_nan()) {
+                self.colors.iter().map(|c| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), 1.0]).collect()
+            } else {
+                vec![[DEFAULT_RGB[0], DEFAULT_RGB[1], DEFAULT_RGB[2], 1.0]]
+            };
+            let radius = point_radius.unwrap_or_else(|| diagonal.map_or(1.0, |d| d * POINT_RADIUS_OF_DIAGONAL));
+            let name = self.groups.first().map(|g| g.name.clone()).filter(|n| !n.is_empty()).unwrap_or_else(|| "points".into());
+            let mesh = Mesh::particles(self.positions.clone(), vec![radius], colors, true, Falloff::Hard).map_err(|e| format!("'{name}': {e}"))?;
+            out.meshes.push(NamedMesh::new(name, mesh));
+        }
         if !self.missing_mtl.is_empty() {
             out.warnings.push(format!(
                 "the material librar{} {} named by mtllib {} not there: its meshes are drawn gray",
@@ -608,6 +629,11 @@ impl Obj {
         }
         if self.short_faces > 0 {
             out.warnings.push(format!("{} faces with fewer than 3 vertices are not drawn", self.short_faces));
+        }
+        for (n, what) in self.dangling.iter().zip(["texture coordinate", "normal"]) {
+            if *n > 0 {
+                out.warnings.push(format!("{n} {what} indices refer past the file's {what}s: those corners have none"));
+            }
         }
         if self.short_lines > 0 {
             out.warnings.push(format!("{} lines (l) with fewer than 2 points are not drawn", self.short_lines));

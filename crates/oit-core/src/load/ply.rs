@@ -238,6 +238,27 @@ impl<R: Read> Input<R> {
         Ok(&self.token)
     }
 
+    /// After an item of ASCII data, the rest of its line: words past the header's properties
+    /// (some writers add a texture number and more) are not read as the next item.
+    fn end_item(&mut self, format: Format) -> Result<(), String> {
+        if format != Format::Ascii {
+            return Ok(());
+        }
+        loop {
+            self.fill(1)?;
+            if self.pos == self.end {
+                return Ok(());
+            }
+            let b = self.buf[self.pos];
+            self.pos += 1;
+            self.left = self.left.saturating_sub(1);
+            if b == b'\n' {
+                self.line += 1;
+                return Ok(());
+            }
+        }
+    }
+
     fn ascii(&mut self, s: Scalar) -> Result<f64, String> {
         let w = self.word()?;
         let text = std::str::from_utf8(w).unwrap_or("");
@@ -445,7 +466,7 @@ fn read_item<R: Read>(input: &mut Input<R>, e: &Element, format: Format, values:
             }
         }
     }
-    Ok(())
+    input.end_item(format)
 }
 
 /// A face: its vertex list into `list`, its other properties into `values`.
@@ -471,7 +492,7 @@ fn read_face<R: Read>(
             }
         }
     }
-    Ok(())
+    input.end_item(format)
 }
 
 /// Straight linear RGBA of an item: integer channels are sRGB scaled by their type's largest
