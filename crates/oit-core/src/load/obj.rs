@@ -606,7 +606,8 @@ impl Obj {
             };
             let radius = point_radius.unwrap_or_else(|| diagonal.map_or(1.0, |d| d * POINT_RADIUS_OF_DIAGONAL));
             let name = self.groups.first().map(|g| g.name.clone()).filter(|n| !n.is_empty()).unwrap_or_else(|| "points".into());
-            let mesh = Mesh::particles(self.positions.clone(), vec![radius], colors, true, Falloff::Hard).map_err(|e| format!("'{name}': {e}"))?;
+            let mesh =
+                Mesh::particles(self.positions.clone(), vec![radius], colors, true, Falloff::Hard).map_err(|e| format!("'{name}': {e}"))?;
             out.meshes.push(NamedMesh::new(name, mesh));
         }
         if !self.missing_mtl.is_empty() {
