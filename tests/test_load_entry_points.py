@@ -166,7 +166,7 @@ def test_a_broken_file_says_what_is_wrong_not_that_it_has_no_triangles(tmp_path)
 
 def test_a_file_without_anything_to_draw_says_so(tmp_path):
     path = tmp_path / "empty.obj"
-    path.write_text("# only a comment\nv 0 0 0\n")
+    path.write_text("# only a comment and a group\ng nothing\n")
     with pytest.raises(ValueError, match=re.escape("empty.obj")) as e:
         oit.Scene.from_file(path)
     assert "triangles" in str(e.value) or "nothing" in str(e.value)

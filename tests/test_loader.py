@@ -130,7 +130,7 @@ def test_cull_back_faces_on_the_gpu_and_in_the_reference(renderer, cull):
     ("x.fbx", b"", ValueError, "unknown file type '.fbx'"),
     ("bad.glb", b"glTF\x02\0\0\0junk", ValueError, "not a readable glTF"),
     ("bad.stl", b"\0" * 90, ValueError, "bad.stl"),
-    ("empty.obj", b"v 0 0 0\n", ValueError, "no triangles"),
+    ("empty.obj", b"# vertices only are a point cloud; none is nothing\no empty\n", ValueError, "no triangles"),
 ])
 def test_bad_files_say_what_to_do(tmp_path, name, data, error, match):
     if data is not None:

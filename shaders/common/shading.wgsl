@@ -20,23 +20,28 @@ const SAMPLER_MIN_LINEAR: u32 = 32u;
 const SAMPLER_MIPS: u32 = 64u;
 const SAMPLER_MIPS_LINEAR: u32 = 128u;
 
-// Texel `i` of a row of `n` brought into [0, n), as Vulkan addresses (Wrap::texel).
-fn wrap_texel(i: i32, n: i32, mode: u32) -> i32 {
-    if mode == 0u {
-        return ((i % n) + n) % n;
-    }
-    if mode == 2u {
-        return clamp(i, 0, n - 1);
-    }
-    let m = ((i % (2 * n)) + 2 * n) % (2 * n);
-    return select(2 * n - 1 - m, m, m < n);
+// Texel `i` of a row of `n` brought into [0, n), as Vulkan addresses (Wrap::texel), in float
+// (texel indices are integers far below 2^24, so every step is exact): selects rather than
+// branches, and no integer division, which llvmpipe runs lane by lane.
+fn wrap_texel(i: f32, n: f32, mode: u32) -> f32 {
+    let repeated = remainder(i, n);
+    let m = remainder(i, 2.0 * n);
+    let mirrored = select(2.0 * n - 1.0 - m, m, m < n);
+    return select(select(mirrored, clamp(i, 0.0, n - 1.0), mode == 2u), repeated, mode == 0u);
 }
 
-// One texel, linear: sRGB color decoded through the table at `srgb` in `surfaces` (256
-// values, four a vec4: exact, where an sRGB view's decoding is approximate on some adapters).
-fn atlas_texel(level: vec4<u32>, srgb: u32, size: vec2<i32>, wrap: u32, x: i32, y: i32) -> vec4<f32> {
-    let at = vec2<i32>(level.xy) + vec2<i32>(wrap_texel(x, size.x, wrap & 3u), wrap_texel(y, size.y, (wrap >> 2u) & 3u));
-    let t = textureLoad(atlas, at, level.z, 0);
+// i mod n in [0, n) for integer-valued floats below 2^24: the quotient's rounding, off by one
+// at most, put right.
+fn remainder(i: f32, n: f32) -> f32 {
+    let r = i - n * floor(i / n);
+    return select(select(r, r - n, r >= n), r + n, r < 0.0);
+}
+
+// One texel at atlas position `at` of `layer`, linear: sRGB color decoded through the table at
+// `srgb` in `surfaces` (256 values, four a vec4: exact, where an sRGB view's decoding is
+// approximate on some adapters).
+fn atlas_texel(at: vec2<i32>, layer: u32, srgb: u32) -> vec4<f32> {
+    let t = textureLoad(atlas, at, layer, 0);
     if srgb == 0u {
         return t;
     }
@@ -47,22 +52,23 @@ fn atlas_texel(level: vec4<u32>, srgb: u32, size: vec2<i32>, wrap: u32, x: i32, 
     return vec4<f32>(r, g, b, t.a);
 }
 
-// Level `l` of the image at `image` at `uv`, nearest or bilinear, texel centers at (i + 1/2) / w.
+// Level `l` of the image at `image` at `uv`, texel centers at (i + 1/2) / w: bilinear, or
+// nearest as the bilinear blend with weights (1, 0) at the texel under `uv` (the same bits,
+// and one path for llvmpipe to run).
 fn sample_level(image: u32, srgb: u32, l: u32, uv: vec2<f32>, linear: bool, wrap: u32) -> vec4<f32> {
     let level = bitcast<vec4<u32>>(surfaces[image + 1u + l]);
-    let size = vec2<i32>(i32(level.w & 0xffffu), i32(level.w >> 16u));
-    let p = uv * vec2<f32>(size);
-    if !linear {
-        let f = floor(p);
-        return atlas_texel(level, srgb, size, wrap, i32(f.x), i32(f.y));
-    }
-    let q = p - 0.5;
+    let size = vec2<f32>(f32(level.w & 0xffffu), f32(level.w >> 16u));
+    let p = uv * size;
+    let q = select(floor(p), p - 0.5, linear);
     let f = floor(q);
-    let t = q - f;
-    let x = i32(f.x);
-    let y = i32(f.y);
-    let top = atlas_texel(level, srgb, size, wrap, x, y) * (1.0 - t.x) + atlas_texel(level, srgb, size, wrap, x + 1, y) * t.x;
-    let bottom = atlas_texel(level, srgb, size, wrap, x, y + 1) * (1.0 - t.x) + atlas_texel(level, srgb, size, wrap, x + 1, y + 1) * t.x;
+    let t = select(vec2<f32>(0.0), q - f, linear);
+    let origin = vec2<i32>(level.xy);
+    let x0 = origin.x + i32(wrap_texel(f.x, size.x, wrap & 3u));
+    let x1 = origin.x + i32(wrap_texel(f.x + 1.0, size.x, wrap & 3u));
+    let y0 = origin.y + i32(wrap_texel(f.y, size.y, (wrap >> 2u) & 3u));
+    let y1 = origin.y + i32(wrap_texel(f.y + 1.0, size.y, (wrap >> 2u) & 3u));
+    let top = atlas_texel(vec2<i32>(x0, y0), level.z, srgb) * (1.0 - t.x) + atlas_texel(vec2<i32>(x1, y0), level.z, srgb) * t.x;
+    let bottom = atlas_texel(vec2<i32>(x0, y1), level.z, srgb) * (1.0 - t.x) + atlas_texel(vec2<i32>(x1, y1), level.z, srgb) * t.x;
     return top * (1.0 - t.y) + bottom * t.y;
 }
 
@@ -99,25 +105,23 @@ fn sample_map(material: u32, k: u32, uv_in: vec2<f32>, footprint: vec4<f32>) -> 
     let dy = vec2<f32>(m0.z * footprint.z + m0.w * footprint.w, m1.y * footprint.z + m1.z * footprint.w) * size;
     let lod = log2(max(length(dx), length(dy)));
     let wrap = bits & 15u;
-    if !(lod > 0.0) {
-        return sample_level(image, srgb, 0u, uv, (bits & SAMPLER_MAG_LINEAR) != 0u, wrap);
-    }
-    let min_linear = (bits & SAMPLER_MIN_LINEAR) != 0u;
-    if (bits & SAMPLER_MIPS) == 0u {
-        return sample_level(image, srgb, 0u, uv, min_linear, wrap);
-    }
+    // The level and the blend between levels without branches: λ <= 0 (and NaN) magnifies
+    // from level 0; without mips level 0; nearest mips round λ (ties down); linear mips blend
+    // floor(λ) and the next level, the last one holding.
+    let magnify = !(lod > 0.0);
+    let mips = (bits & SAMPLER_MIPS) != 0u && !magnify;
+    let mips_linear = mips && (bits & SAMPLER_MIPS_LINEAR) != 0u;
     let top = f32(header.x - 1u);
-    if (bits & SAMPLER_MIPS_LINEAR) == 0u {
-        let l = clamp(ceil(lod + 0.5) - 1.0, 0.0, top);
-        return sample_level(image, srgb, u32(l), uv, min_linear, wrap);
-    }
-    let base = min(floor(lod), top);
-    let t = select(lod - base, 0.0, base == top);
-    let a = sample_level(image, srgb, u32(base), uv, min_linear, wrap);
+    let lambda = select(0.0, lod, mips);
+    let base = min(floor(lambda), top);
+    let level = select(clamp(ceil(lambda + 0.5) - 1.0, 0.0, top), base, mips_linear);
+    let t = select(0.0, select(lambda - base, 0.0, base == top), mips_linear);
+    let linear = select((bits & SAMPLER_MIN_LINEAR) != 0u, (bits & SAMPLER_MAG_LINEAR) != 0u, magnify);
+    let a = sample_level(image, srgb, u32(level), uv, linear, wrap);
     if t == 0.0 {
         return a;
     }
-    return a * (1.0 - t) + sample_level(image, srgb, u32(base) + 1u, uv, min_linear, wrap) * t;
+    return a * (1.0 - t) + sample_level(image, srgb, u32(level) + 1u, uv, linear, wrap) * t;
 }
 
 //!endif
