@@ -93,5 +93,5 @@ wheel=$(ls dist/oit-*.whl)
 "$VENV/bin/python" -m pip install -q --force-reinstall --no-deps "$wheel"
 # Then its dependencies and extras (the same version is installed: pip adds only what is missing).
 echo "setup: installing the bench, peers and test extras from PyPI (matplotlib, FLIP, pygfx, VTK, pytest)"
-with_status "installing the extras" "$VENV/bin/python" -m pip install -q "${wheel}[bench,peers,test]"
+with_status "installing the extras" "$VENV/bin/python" -m pip install -q "${wheel}[bench,peers,pygfx,dask,test]"
 echo "setup: installed $(basename "$wheel") with the bench, peers and test extras"

@@ -31,7 +31,7 @@ from ._checks import (
 from ._load import read, warn
 from ._memory import available_memory
 from ._primitives import PrimitiveMethods
-from ._trimesh import trimesh_arrays
+from ._trimesh import trimesh_arrays, trimesh_camera, trimesh_path, trimesh_points
 from .imageio import encode_png
 
 
@@ -203,7 +203,7 @@ class Scene(PrimitiveMethods):
     @classmethod
     def from_trimesh(cls, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False,
                      *, shading: str = "smooth", specular: float = 0.0, shininess: float = 32.0,
-                     two_sided: bool = True) -> Scene:
+                     two_sided: bool = True, point_radius: float | None = None, line_width: float | None = None) -> Scene:
         """A scene from a trimesh Trimesh or Scene, lit (docs/shading.md). Colors come from
         vertex colors, face colors or the material (sRGB 8-bit colors are linearized; a PBR
         baseColorFactor is linear, as glTF has it); texture visuals bring their UVs and image
@@ -212,15 +212,22 @@ class Scene(PrimitiveMethods):
         and meshes without one are transparent. A Scene's geometry shared by nodes is uploaded once
         and drawn as instances under the nodes' transforms. `color` (RGB or RGBA) and `alpha` override
         the colors; `shading` ("smooth" with the mesh's vertex normals by default, "flat" or
-        "unlit"), `specular`, `shininess` and `two_sided` apply to every mesh."""
+        "unlit"), `specular`, `shininess` and `two_sided` apply to every mesh. A PointCloud is a
+        particle set (hard discs of `point_radius`) and a Path3D a strand set (each entity a strand,
+        `line_width` wide), both by default 1/200 of their box's diagonal, unlit, in their colors. A
+        Scene's camera, where it has one, is `scene.cameras[0]` (a perspective FileCamera)."""
         scene = cls()
         scene.add_trimesh(obj, alpha=alpha, color=color, opaque=opaque, shading=shading, specular=specular,
-                          shininess=shininess, two_sided=two_sided)
+                          shininess=shininess, two_sided=two_sided, point_radius=point_radius, line_width=line_width)
+        import trimesh
+
+        if isinstance(obj, trimesh.Scene) and obj.has_camera:
+            scene.cameras.append(FileCamera(*trimesh_camera(obj)))
         return scene
 
     def add_trimesh(self, obj: Any, alpha: float | None = None, color: Sequence[float] | None = None, opaque: bool = False,
                     *, shading: str = "smooth", specular: float = 0.0, shininess: float = 32.0,
-                    two_sided: bool = True) -> None:
+                    two_sided: bool = True, point_radius: float | None = None, line_width: float | None = None) -> None:
         import trimesh
 
         if shading not in SHADINGS:
@@ -234,20 +241,36 @@ class Scene(PrimitiveMethods):
             meshes = [(obj.geometry[name], np.stack(ts)) for name, ts in placements.items()]
         else:
             meshes = [(obj, None)]
-        for m, transforms in meshes:
-            if not isinstance(m, trimesh.Trimesh):
-                continue
-            t = trimesh_arrays(m)
-            colors = t.colors
+        def styled(colors: np.ndarray) -> np.ndarray:
             if color is not None:
                 c = np.asarray(color, dtype=np.float64)
                 if c.shape not in ((3,), (4,)):
                     raise ValueError(f"color must be RGB or RGBA, got shape {c.shape}")
-                colors = np.tile(np.append(c, colors[:, 3:4].mean() if c.shape == (3,) else c[3])[:4], (len(t.positions), 1))
+                colors = np.tile(np.append(c, colors[:, 3:4].mean() if c.shape == (3,) else c[3])[:4], (len(colors), 1))
             if alpha is not None:
                 if not 0.0 <= float(alpha) <= 1.0:
                     raise ValueError(f"alpha must be in [0, 1], got {alpha}")
                 colors[:, 3] = float(alpha)
+            return colors
+
+        for m, transforms in meshes:
+            if isinstance(m, (trimesh.PointCloud, trimesh.path.Path3D)):
+                # Points and polylines are placed on the CPU, once per node.
+                for t in [np.eye(4)] if transforms is None else transforms:
+                    if isinstance(m, trimesh.PointCloud):
+                        p = trimesh_points(m, t)
+                        size = point_radius if point_radius is not None else p.default_size
+                        self.add_particles(p.positions, size, styled(p.colors), opaque=opaque)
+                    else:
+                        p = trimesh_path(m, t)
+                        if len(p.counts):
+                            size = line_width if line_width is not None else p.default_size
+                            self.add_strands(p.positions, p.counts, size, styled(p.colors), opaque=opaque)
+                continue
+            if not isinstance(m, trimesh.Trimesh):
+                continue
+            t = trimesh_arrays(m)
+            colors = styled(t.colors)
             index = self.add_mesh(t.positions, t.faces, colors, opaque=opaque or t.opaque,
                                   normals=t.normals if shading == "smooth" else None, uvs=t.uvs, texture=t.texture,
                                   shading=shading, specular=specular, shininess=shininess, two_sided=two_sided)

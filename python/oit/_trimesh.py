@@ -128,3 +128,69 @@ def trimesh_arrays(m: Any) -> _TrimeshArrays:
     if not linear_rgb:
         rgba[:, :3] = srgb_to_linear(rgba[:, :3])
     return _TrimeshArrays(positions, faces, np.clip(rgba, 0.0, 1.0), normals, uvs, texture, opaque)
+
+
+@dataclass
+class _TrimeshPoints:
+    positions: np.ndarray  # (n, 3), placed
+    colors: np.ndarray  # linear straight RGBA per point
+    counts: np.ndarray  # points a strand (paths only)
+    default_size: float  # 1/200 of the box's diagonal: a radius or a width
+
+
+def _placed(points: np.ndarray, transform: np.ndarray) -> np.ndarray:
+    t = np.asarray(transform, dtype=np.float64)
+    return (np.asarray(points, dtype=np.float64) @ t[:3, :3].T + t[:3, 3]).astype(np.float32)
+
+
+def _default_size(points: np.ndarray) -> float:
+    diagonal = float(np.linalg.norm(points.max(0) - points.min(0))) if len(points) else 0.0
+    return diagonal / 200.0 if diagonal > 0 else 0.01
+
+
+def _rgba8_linear(c: Any, count: int) -> np.ndarray:
+    """sRGB 8-bit RGBA (n, 3|4) or None to linear RGBA; trimesh's default grey without colors."""
+    c = None if c is None else np.asarray(c, dtype=np.float64)
+    if c is None or c.ndim != 2 or len(c) != count or c.shape[1] not in (3, 4):
+        rgba = np.tile([0.8, 0.8, 0.8, 1.0], (count, 1))
+    else:
+        rgba = np.concatenate([c[:, :3], c[:, 3:4] if c.shape[1] == 4 else np.full((count, 1), 255.0)], 1) / 255.0
+    rgba[:, :3] = srgb_to_linear(rgba[:, :3])
+    return np.clip(rgba, 0.0, 1.0)
+
+
+def trimesh_points(cloud: Any, transform: np.ndarray) -> _TrimeshPoints:
+    """A PointCloud's points under `transform`, with its colors."""
+    positions = _placed(cloud.vertices, transform)
+    colors = _rgba8_linear(cloud.colors, len(positions))
+    return _TrimeshPoints(positions, colors, np.zeros(0, np.int64), _default_size(positions))
+
+
+def trimesh_path(path: Any, transform: np.ndarray) -> _TrimeshPoints:
+    """A Path3D's entities as polylines (each discretized: lines, arcs, curves) under `transform`,
+    each in its entity's color."""
+    vertices = np.asarray(path.vertices, dtype=np.float64)
+    colors = None if path.colors is None else np.asarray(path.colors)
+    lines, rows = [], []
+    for k, entity in enumerate(path.entities):
+        line = np.asarray(entity.discrete(vertices), dtype=np.float64)
+        if line.ndim == 2 and len(line) >= 2:
+            lines.append(line)
+            rows.append(np.full(len(line), k))
+    if not lines:
+        return _TrimeshPoints(np.zeros((0, 3), np.float32), np.zeros((0, 4)), np.zeros(0, np.int64), 0.01)
+    positions = _placed(np.concatenate(lines), transform)
+    per_entity = _rgba8_linear(colors, len(path.entities))
+    return _TrimeshPoints(positions, per_entity[np.concatenate(rows)], np.array([len(line) for line in lines], np.int64),
+                          _default_size(positions))
+
+
+def trimesh_camera(scene: Any) -> tuple[str, np.ndarray, dict[str, Any]]:
+    """(name, view, projection) of a trimesh Scene's camera, as `FileCamera` takes them: its
+    transform places it (looking down -z, y up), its fov (x, y degrees) gives yfov and aspect."""
+    cam = scene.camera
+    fx, fy = np.radians(np.asarray(cam.fov, dtype=np.float64))
+    view = np.linalg.inv(np.asarray(scene.camera_transform, dtype=np.float64))
+    projection = {"type": "perspective", "yfov": float(fy), "aspect": float(np.tan(fx / 2) / np.tan(fy / 2)),
+                  "near": float(cam.z_near), "far": float(cam.z_far)}
+    return str(getattr(cam, "name", None) or "camera"), view, projection

@@ -202,7 +202,8 @@ def _render(args: argparse.Namespace) -> int:
 def _add_compare(p: argparse.ArgumentParser) -> None:
     from .comparison import add_arguments
 
-    p.add_argument("file", help="a mesh file: OBJ (with its MTL), glTF, GLB, PLY or STL (docs/loading.md)")
+    p.add_argument("file", nargs="+", help="mesh files: OBJ (with its MTL), glTF, GLB, PLY or STL (docs/loading.md); "
+                                           "each row measures every view of every file")
     p.add_argument("--alpha", type=_unit_float, default=None,
                    help="make every mesh transparent at this alpha (default: the file's; 0.4 when nothing is transparent)")
     p.add_argument("--shading", choices=("smooth", "flat", "unlit"), default="smooth", help="(default: %(default)s)")
@@ -214,7 +215,12 @@ def _compare(args: argparse.Namespace) -> int:
     from .comparison import run_cli
     from .views import load_for_viewing
 
-    return run_cli(args, load_for_viewing(args))
+    files, scenes = args.file, []
+    for f in files:  # each loaded as `render` loads it, its alpha note said
+        args.file = f
+        scenes.append(load_for_viewing(args))
+    args.file = files
+    return run_cli(args, scenes)
 
 
 # ---- methods

@@ -134,6 +134,9 @@ fn bad_files_say_what_to_do() {
     assert!(e.contains("not a readable glTF"), "{e}");
     let e = load(&tmp("bad.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nend_header\nx\n")).unwrap_err().to_string();
     assert!(e.contains("bad.ply"), "{e}");
-    let e = load(&tmp("empty.obj", b"v 0 0 0\n")).unwrap_err().to_string();
+    let e = load(&tmp("empty.obj", b"# no vertices\no nothing\n")).unwrap_err().to_string();
     assert!(e.contains("no triangles"), "{e}");
+    // Vertices alone are a point cloud, as a PLY of points is.
+    let cloud = load(&tmp("cloud.obj", b"v 0 0 0\nv 1 0 0\n")).unwrap();
+    assert!(matches!(cloud.meshes[0].mesh.primitive, crate::primitive::Primitive::Particles { .. }));
 }
