@@ -111,6 +111,20 @@ def test_sampler_wrap_modes_reach_the_material(tmp_path, wrap, expect):
         assert np.allclose(row[column], colors[name], atol=1e-6), (column, row[column])
 
 
+def test_scene_materials_show_the_sampler_transform_emission_and_cutoff(tmp_path):
+    g, material = red_blue({"wrapS": 33648, "wrapT": 33071, "magFilter": 9728, "minFilter": 9985},
+                           extensions={"KHR_texture_transform": {"offset": [0.5, 0], "scale": [2, 1]}})
+    g.doc["materials"][material].update(alphaMode="MASK", alphaCutoff=0.3, emissiveFactor=[0.5, 0.25, 0])
+    g.doc["extensionsUsed"] = ["KHR_texture_transform"]
+    screen_quad(g, material, [[0, 1], [1, 1], [1, 0], [0, 0]])
+    (m,) = load(tmp_path, g).materials
+    assert m["alpha_cutoff"] == pytest.approx(0.3) and m["emissive"] == pytest.approx([0.5, 0.25, 0])
+    t = m["texture"]
+    assert t["size"] == (2, 1) and t["levels"] == 2
+    assert t["wrap"] == ("mirrored_repeat", "clamp_to_edge") and t["filters"] == ("nearest", "linear", "nearest")
+    assert np.allclose(t["transform"], [[2, 0, 0.5], [0, 1, 0]])
+
+
 def test_texture_transform_moves_the_uvs(tmp_path):
     nearest = {"wrapS": 33071, "magFilter": 9728, "minFilter": 9728}
     g, material = red_blue(nearest)

@@ -179,7 +179,9 @@ class Scene(PrimitiveMethods):
     @property
     def materials(self) -> list[dict[str, Any]]:
         """Per mesh: opaque, shading, textured, two_sided, cull_back_faces, has_normals, has_uvs,
-        the vertex alphas' range (alpha_min, alpha_max) and the mean vertex RGBA (color_mean)."""
+        the vertex alphas' range (alpha_min, alpha_max), the mean vertex RGBA (color_mean), the
+        emissive RGB, the alpha cutoff (None unless alpha-tested, as glTF's MASK), and the base
+        color texture's size, sampler and UV transform where there is one (texture: a dict)."""
         return self._native.mesh_materials()
 
     @classmethod

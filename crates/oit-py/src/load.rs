@@ -94,6 +94,27 @@ pub fn mesh_materials<'py>(py: Python<'py>, scene: &oit_core::Scene) -> PyResult
         d.set_item("color_mean", mean)?;
         d.set_item("has_normals", !m.normals.is_empty())?;
         d.set_item("has_uvs", !m.uvs.is_empty())?;
+        d.set_item("emissive", m.material.emissive)?;
+        d.set_item("alpha_cutoff", m.material.alpha_cutoff)?;
+        if let Some(t) = &m.material.texture {
+            let wrap = |w: oit_core::Wrap| match w {
+                oit_core::Wrap::Repeat => "repeat",
+                oit_core::Wrap::MirroredRepeat => "mirrored_repeat",
+                oit_core::Wrap::ClampToEdge => "clamp_to_edge",
+            };
+            let filter = |f: oit_core::Filter| match f {
+                oit_core::Filter::Nearest => "nearest",
+                oit_core::Filter::Linear => "linear",
+            };
+            let s = &t.sampler;
+            let texture = PyDict::new(py);
+            texture.set_item("size", (t.image.width, t.image.height))?;
+            texture.set_item("levels", t.image.levels().len())?;
+            texture.set_item("wrap", (wrap(s.wrap_u), wrap(s.wrap_v)))?;
+            texture.set_item("filters", (filter(s.mag), filter(s.min), s.mipmap.map(filter)))?;
+            texture.set_item("transform", t.transform)?;
+            d.set_item("texture", texture)?;
+        }
         out.append(d)?;
     }
     Ok(out)

@@ -1,6 +1,6 @@
 """The bench's command line (`python -m oit bench`, also `python -m oit.bench`): the main sweep
 (oit.bench.results) or, instead of it, the experiments (--temporal, --auto, --antialias, --scale,
---shading-cost, --load, --fuzz-load), and
+--shading-cost, --load, --fuzz-load, --gpu), and
 the tables and plots they write into --out."""
 
 from __future__ import annotations
