@@ -260,6 +260,30 @@ pub(crate) fn texture_map(width: u32, height: u32, rgba: Vec<u8>) -> std::result
     Ok(TextureMap::new(std::sync::Arc::new(image)))
 }
 
+/// A PNG or JPEG to 8-bit RGBA, with the decoder's allocation bounded (1 GiB); a decoder that
+/// panics on a broken image is an error, not a crash. Every format's images come through here.
+pub(crate) fn decode_image(bytes: &[u8]) -> std::result::Result<image::RgbaImage, String> {
+    let run = || -> std::result::Result<image::RgbaImage, String> {
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(1 << 30);
+        reader.limits(limits);
+        Ok(reader.decode().map_err(|e| format!("not an image oit reads (PNG or JPEG): {e}"))?.into_rgba8())
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|_| Err("the image decoder failed on it".to_string()))
+}
+
+/// `image` scaled to fit MAX_TEXTURE_SIZE a side, keeping its aspect, and whether it had to be.
+pub(crate) fn fit_texture(image: image::RgbaImage) -> (image::RgbaImage, bool) {
+    let (w, h) = (image.width(), image.height());
+    if w.max(h) <= MAX_TEXTURE_SIZE {
+        return (image, false);
+    }
+    let scale = MAX_TEXTURE_SIZE as f64 / w.max(h) as f64;
+    let side = |x: u32| ((x as f64 * scale).round() as u32).clamp(1, MAX_TEXTURE_SIZE);
+    (image::imageops::resize(&image, side(w), side(h), image::imageops::FilterType::Triangle), true)
+}
+
 /// The box around every mesh's instances (file cameras without a far plane, the viewer's fit);
 /// None when nothing is drawn.
 pub fn bounds(meshes: &[NamedMesh]) -> Option<(DVec3, DVec3)> {

@@ -11,7 +11,9 @@ use std::hash::{BuildHasherDefault, Hasher};
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
-use super::{named, srgb_to_linear, texture_map, LoadError, LoadedFile, NamedMesh, DEFAULT_RGB, MAX_TEXTURE_SIZE};
+use super::{
+    decode_image, fit_texture, named, srgb_to_linear, texture_map, LoadError, LoadedFile, NamedMesh, DEFAULT_RGB, MAX_TEXTURE_SIZE,
+};
 use crate::scene::Mesh;
 use crate::shading::{Falloff, Material, TextureMap};
 
@@ -716,9 +718,9 @@ fn load_texture(
         if !file.is_file() {
             return Err(LoadError::NotFound(format!("{at}: the image {} is not there", file.display())));
         }
-        let image =
-            image::open(file).map_err(|e| LoadError::Invalid(format!("{at}: the image {} is not readable ({e})", file.display())))?;
-        Ok(image.to_rgba8())
+        let unreadable = |e: String| LoadError::Invalid(format!("{at}: the image {} is not readable ({e})", file.display()));
+        let bytes = std::fs::read(file).map_err(|e| unreadable(e.to_string()))?;
+        decode_image(&bytes).map_err(unreadable)
     };
     let mask = dissolve.map(read).transpose()?;
     let mut image = match (diffuse, &mask) {
@@ -731,13 +733,7 @@ fn load_texture(
         let mask = image::imageops::resize(&mask, w, h, image::imageops::FilterType::Triangle);
         image.pixels_mut().zip(mask.pixels()).for_each(|(p, m)| p[3] = m[0]);
     }
-    let (w, h) = (image.width(), image.height());
-    let large = w.max(h) > MAX_TEXTURE_SIZE;
-    if large {
-        let s = MAX_TEXTURE_SIZE as f64 / w.max(h) as f64;
-        let (nw, nh) = (((w as f64 * s).round() as u32).max(1), ((h as f64 * s).round() as u32).max(1));
-        image = image::imageops::resize(&image, nw, nh, image::imageops::FilterType::Triangle);
-    }
+    let (image, large) = fit_texture(image);
     let at = diffuse.or(dissolve).map_or(String::new(), |x| x.1.clone());
     let map = texture_map(image.width(), image.height(), image.into_raw()).map_err(|e| format!("{at}: {e}"))?;
     Ok((Some(map), large))

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use super::data::{uri_bytes, Store};
 use super::json::Obj;
 use super::Notes;
-use crate::load::{LoadError, MAX_TEXTURE_SIZE};
+use crate::load::{decode_image, fit_texture, LoadError};
 use crate::shading::{Material, Sampler, Texture, TextureMap};
 
 /// glTF's alphaMode.
@@ -188,8 +188,8 @@ impl<'a> Looks<'a> {
             (None, Some(v)) => store.view_bytes(v, &o.at)?,
             (None, None) => return Err(format!("{} has neither a uri nor a bufferView: an image needs one", o.at).into()),
         };
-        let (w, h, rgba) = decode(bytes).map_err(|e| format!("{}: {e}", o.at))?;
-        self.texel_bytes += rgba.len() as u64;
+        let image = decode_image(bytes).map_err(|e| format!("{}: {e}", o.at))?;
+        self.texel_bytes += image.as_raw().len() as u64;
         if self.texel_bytes > MAX_TEXEL_BYTES {
             return Err(format!(
                 "{}: the images decoded so far take {} bytes, past the {MAX_TEXEL_BYTES} oit decodes from one file",
@@ -197,13 +197,10 @@ impl<'a> Looks<'a> {
             )
             .into());
         }
-        let (w, h, rgba) = if w.max(h) > MAX_TEXTURE_SIZE {
-            notes.downscaled += 1;
-            downscale(w, h, rgba)
-        } else {
-            (w, h, rgba)
-        };
-        let texture = Arc::new(Texture::from_rgba8(w, h, rgba, true).map_err(|e| format!("{}: {e}", o.at))?);
+        let (image, downscaled) = fit_texture(image);
+        notes.downscaled += downscaled as usize;
+        let texture =
+            Arc::new(Texture::from_rgba8(image.width(), image.height(), image.into_raw(), true).map_err(|e| format!("{}: {e}", o.at))?);
         self.decoded[i] = Some(texture.clone());
         Ok(texture)
     }
@@ -213,28 +210,4 @@ impl<'a> Looks<'a> {
 /// faces are culled.
 fn sides(double: bool) -> Material {
     Material { two_sided: double, cull_back_faces: !double, ..Default::default() }
-}
-
-/// A PNG or JPEG to 8-bit RGBA, with the decoder's allocation bounded; a decoder that panics
-/// on a broken image is an error, not a crash.
-fn decode(bytes: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
-    let run = || -> Result<(u32, u32, Vec<u8>), String> {
-        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
-        let mut limits = image::Limits::default();
-        limits.max_alloc = Some(1 << 30);
-        reader.limits(limits);
-        let image = reader.decode().map_err(|e| format!("not an image oit reads (PNG or JPEG): {e}"))?.into_rgba8();
-        Ok((image.width(), image.height(), image.into_raw()))
-    };
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|_| Err("the image decoder failed on it".to_string()))
-}
-
-/// An image whose larger side exceeds MAX_TEXTURE_SIZE, scaled to fit, keeping its aspect.
-fn downscale(w: u32, h: u32, rgba: Vec<u8>) -> (u32, u32, Vec<u8>) {
-    let scale = MAX_TEXTURE_SIZE as f64 / w.max(h) as f64;
-    let (nw, nh) =
-        (((w as f64 * scale).round() as u32).clamp(1, MAX_TEXTURE_SIZE), ((h as f64 * scale).round() as u32).clamp(1, MAX_TEXTURE_SIZE));
-    let Some(image) = image::RgbaImage::from_raw(w, h, rgba) else { return (w, h, Vec::new()) };
-    let small = image::imageops::resize(&image, nw, nh, image::imageops::FilterType::Triangle);
-    (nw, nh, small.into_raw())
 }
