@@ -252,14 +252,20 @@ pub struct Texture {
     levels: Vec<Level>,
 }
 
-/// 8-bit sRGB to linear, as the shaders' sRGB views decode it.
+/// 8-bit sRGB to linear in float64, from a table of the 256 codes built once (the reference reads
+/// it for every texel it filters; `srgb_table` is the shaders' float32 copy).
 fn srgb_decode(c: u8) -> f64 {
-    let c = c as f64 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+    static TABLE: std::sync::LazyLock<[f64; 256]> = std::sync::LazyLock::new(|| {
+        std::array::from_fn(|c| {
+            let c = c as f64 / 255.0;
+            if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        })
+    });
+    TABLE[c as usize]
 }
 
 /// The linear value of each 8-bit sRGB code, in float32: what the shaders decode texels with.

@@ -690,8 +690,9 @@ fn shelves(rects: &[(usize, usize, u32, u32)], side: u32) -> (Vec<[u32; 4]>, u32
 }
 
 /// The scene's images with their mip chains, packed level by level into the layers of one
-/// 8-bit RGBA 2D array texture (shelves of rectangles, tallest first), read through an sRGB
-/// 4 bytes a texel plus a third for the mips, and what packing leaves.
+/// 8-bit RGBA 2D array texture (shelves of rectangles, tallest first), read as stored (sRGB
+/// color decoded in the shader): 4 bytes a texel plus a third for the mips, and what packing
+/// leaves.
 pub struct Atlas {
     pub view: wgpu::TextureView,
     /// Bytes of the texture (0 for the placeholder of a scene without textures).
