@@ -85,3 +85,13 @@ def shared_data() -> Path:
         pytest.skip("optional mesh data not found ($OIT_DATA, or a shared/data folder above the working directory): "
                     "tests that need it are skipped")
     return found
+
+
+@pytest.fixture
+def box_obj(tmp_path: Path) -> Path:
+    """A 1 x 0.6 x 0.4 box written as OBJ by trimesh (the command-line tests' file)."""
+    import trimesh
+
+    path = tmp_path / "box.obj"
+    trimesh.creation.box(extents=(1.0, 0.6, 0.4)).export(path)
+    return path

@@ -9,7 +9,6 @@ import sys
 from pathlib import Path
 
 import pytest
-import trimesh
 
 import oit
 from oit import cli, scenes
@@ -27,13 +26,6 @@ def png_size(path: Path) -> tuple:
     length, kind = struct.unpack(">I4s", data[8:16])
     assert kind == b"IHDR" and length == 13
     return struct.unpack(">II", data[16:24])
-
-
-@pytest.fixture
-def box_obj(tmp_path: Path) -> Path:
-    path = tmp_path / "box.obj"
-    trimesh.creation.box(extents=(1.0, 0.6, 0.4)).export(path)
-    return path
 
 
 def test_render_writes_a_png_of_the_requested_size(tmp_path, box_obj):

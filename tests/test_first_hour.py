@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import trimesh
 
 import oit
 from oit import cli
@@ -22,13 +21,6 @@ def run_oit(*args: str, cwd: Path, block: str = "") -> subprocess.CompletedProce
     """`python -m oit ARGS`; `block` names modules made unimportable first (an install without them)."""
     code = f"import sys\nfor m in {block.split()!r}: sys.modules[m] = None\nfrom oit.cli import main\nsys.exit(main(sys.argv[1:]))"
     return subprocess.run([sys.executable, "-c", code, *args], cwd=cwd, capture_output=True, text=True, timeout=300)
-
-
-@pytest.fixture
-def box_obj(tmp_path: Path) -> Path:
-    path = tmp_path / "box.obj"
-    trimesh.creation.box(extents=(1.0, 0.6, 0.4)).export(path)
-    return path
 
 
 @pytest.mark.parametrize(("output", "block", "install"), [("x.gif", "PIL", "pip install pillow"),

@@ -454,22 +454,11 @@ fn header<R: Read>(input: &mut Input<R>) -> Result<(Format, Vec<Element>), Strin
 
 /// One item into `values` (lists read and dropped).
 fn read_item<R: Read>(input: &mut Input<R>, e: &Element, format: Format, values: &mut [f64], list: &mut Vec<f64>) -> Result<(), String> {
-    for (k, (_, kind)) in e.props.iter().enumerate() {
-        match *kind {
-            Kind::Scalar(s) => values[k] = input.value(s, format)?,
-            Kind::List { count, item } => {
-                let n = input.list_len(count, item, format)?;
-                list.clear();
-                for _ in 0..n {
-                    list.push(input.value(item, format)?);
-                }
-            }
-        }
-    }
-    input.end_item(format)
+    read_face(input, e, format, values, list, usize::MAX)
 }
 
-/// A face: its vertex list into `list`, its other properties into `values`.
+/// An item: its list property `list_at` into `list` (none past the properties), its other
+/// lists read and dropped, its scalars into `values`.
 fn read_face<R: Read>(
     input: &mut Input<R>,
     e: &Element,
