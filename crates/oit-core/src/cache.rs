@@ -63,10 +63,12 @@ pub enum Layout {
     Targets,
     /// Group 1 of a coverage-mask frame: per-sample opaque layers.
     SampleTargets,
-    /// `n` read-write storage buffers at bindings 0..n.
-    Storage(u32),
-    /// Unfilterable float textures at these bindings (accumulation targets a resolve reads).
-    Textures(&'static [u32]),
+    /// Read-write storage buffers at bindings 0, 1, ..., by the names their WGSL declares
+    /// (tests/bindings.rs checks each name against the shader's variable at that binding).
+    Storage(&'static [&'static str]),
+    /// Unfilterable float textures (accumulation targets a resolve reads), by WGSL name and
+    /// binding.
+    Textures(&'static [(&'static str, u32)]),
     /// The prefix sum's group (scan.rs): the data and block sums, read-write, and its uniform.
     Scan,
     /// Group 0 of the expansion of strands and particles (shaders/expand.wgsl): the scene's,
@@ -82,10 +84,30 @@ impl Layout {
             Layout::Scene => bindings::scene_entries(),
             Layout::Targets => bindings::opaque_entries(wgpu::TextureViewDimension::D2),
             Layout::SampleTargets => bindings::opaque_entries(wgpu::TextureViewDimension::D2Array),
-            Layout::Storage(n) => (0..n).map(bindings::storage_entry).collect(),
-            Layout::Textures(at) => at.iter().map(|&b| bindings::float_texture_entry(b)).collect(),
+            Layout::Storage(names) => (0..names.len() as u32).map(bindings::storage_entry).collect(),
+            Layout::Textures(at) => at.iter().map(|&(_, b)| bindings::float_texture_entry(b)).collect(),
             Layout::Scan => bindings::scan_entries(),
             Layout::Expand => bindings::expand_entries(),
+        }
+    }
+
+    /// The binding each of the layout's names is at; None for the shared layouts, which are
+    /// bound by their owners (upload.rs, targets.rs, scan.rs).
+    pub fn named(self) -> Option<Vec<(&'static str, u32)>> {
+        match self {
+            Layout::Storage(names) => Some(names.iter().zip(0..).map(|(&n, b)| (n, b)).collect()),
+            Layout::Textures(at) => Some(at.to_vec()),
+            _ => None,
+        }
+    }
+
+    /// What the device's layout object depends on: the entries, not the names (layouts that
+    /// differ only in names share one).
+    fn shape(self) -> Shape {
+        match self {
+            Layout::Storage(names) => Shape::Storage(names.len() as u32),
+            Layout::Textures(at) => Shape::Textures(at.iter().map(|&(_, b)| b).collect()),
+            other => Shape::Shared(other),
         }
     }
 
@@ -100,6 +122,39 @@ impl Layout {
         };
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &self.entries() })
     }
+}
+
+/// A layout's key in the cache (`Layout::shape`).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Shape {
+    Storage(u32),
+    Textures(Vec<u32>),
+    Shared(Layout),
+}
+
+/// A bind group of `layout` over `resources` given by the names the layout declares, each
+/// name once: the binding each resource lands at comes from the layout, never from the order
+/// the caller lists them in.
+pub fn bind_named(
+    device: &wgpu::Device,
+    cache: &PipelineCache,
+    layout: Layout,
+    label: &str,
+    resources: &[(&str, wgpu::BindingResource<'_>)],
+) -> wgpu::BindGroup {
+    let named = layout.named().unwrap_or_else(|| panic!("{layout:?} is bound by its owner, not by name"));
+    let mut entries = Vec::with_capacity(named.len());
+    for &(name, binding) in &named {
+        let mut given = resources.iter().filter(|(n, _)| *n == name);
+        let (_, resource) = given.next().unwrap_or_else(|| panic!("{label}: no resource named '{name}' for {layout:?}"));
+        assert!(given.next().is_none(), "{label}: '{name}' given twice for {layout:?}");
+        entries.push(wgpu::BindGroupEntry { binding, resource: resource.clone() });
+    }
+    if let Some((extra, _)) = resources.iter().find(|(n, _)| !named.iter().any(|(d, _)| d == n)) {
+        panic!("{label}: {layout:?} declares no binding named '{extra}'");
+    }
+    let layout = cache.layout(device, layout);
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout: &layout, entries: &entries })
 }
 
 /// What a render pipeline draws.
@@ -205,7 +260,7 @@ pub fn spec(table: &'static [PipelineSpec], entry: &str) -> &'static PipelineSpe
 #[derive(Default)]
 pub struct PipelineCache {
     modules: Mutex<HashMap<ShaderKey, wgpu::ShaderModule>>,
-    layouts: Mutex<HashMap<Layout, wgpu::BindGroupLayout>>,
+    layouts: Mutex<HashMap<Shape, wgpu::BindGroupLayout>>,
     render: Mutex<HashMap<RenderDesc, wgpu::RenderPipeline>>,
     compute: Mutex<HashMap<ComputeDesc, wgpu::ComputePipeline>>,
 }
@@ -216,7 +271,7 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
 
 impl PipelineCache {
     pub fn layout(&self, device: &wgpu::Device, layout: Layout) -> wgpu::BindGroupLayout {
-        lock(&self.layouts).entry(layout).or_insert_with(|| layout.create(device)).clone()
+        lock(&self.layouts).entry(layout.shape()).or_insert_with(|| layout.create(device)).clone()
     }
 
     fn module(&self, device: &wgpu::Device, key: &ShaderKey) -> wgpu::ShaderModule {
@@ -236,7 +291,7 @@ impl PipelineCache {
         let layout = self.pipeline_layout(device, &desc.groups);
         let built = match &desc.draw {
             Draw::Geometry { depth, samples } => {
-                pipeline::geometry_samples(device, desc.entry, &module, &layout, desc.entry, &desc.targets, depth.clone(), *samples)
+                pipeline::geometry_samples(device, &module, &layout, desc.entry, &desc.targets, depth.clone(), *samples)
             }
             Draw::Fullscreen => pipeline::fullscreen_targets(device, desc.entry, &module, &layout, desc.entry, &desc.targets),
         };
@@ -274,14 +329,17 @@ pub fn resolve_targets(bound: bool) -> Vec<Option<wgpu::ColorTargetState>> {
 pub const OPAQUE: PipelineSpec = PipelineSpec::geometry("opaque.wgsl", "fs_opaque", &[Layout::Scene]);
 /// The census by blending into the count target.
 pub const CENSUS_BLEND: PipelineSpec = PipelineSpec::geometry("census.wgsl", "fs_count", &[Layout::Scene]);
+/// The census's counts buffer (shaders/common/census_counts.wgsl), group 2 of its atomic passes.
+pub const COUNTS: Layout = Layout::Storage(&["counts"]);
 /// The census with an atomic a fragment into the counts buffer.
-pub const CENSUS_ATOMIC: PipelineSpec =
-    PipelineSpec::geometry("census.wgsl", "fs_census", &[Layout::Scene, Layout::Targets, Layout::Storage(1)]);
+pub const CENSUS_ATOMIC: PipelineSpec = PipelineSpec::geometry("census.wgsl", "fs_census", &[Layout::Scene, Layout::Targets, COUNTS]);
 /// The census of a coverage-mask frame, at each sample's coverage.
 pub const CENSUS_SAMPLES: PipelineSpec =
-    PipelineSpec::geometry("census_samples.wgsl", "fs_census", &[Layout::Scene, Layout::SampleTargets, Layout::Storage(1)]);
-pub const BLIT: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit", &[Layout::Textures(&[0])]);
-pub const BLIT_SRGB: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit_srgb", &[Layout::Textures(&[0])]);
+    PipelineSpec::geometry("census_samples.wgsl", "fs_census", &[Layout::Scene, Layout::SampleTargets, COUNTS]);
+/// The blit's one group: the picture it copies.
+pub const BLIT_SOURCE: &[Layout] = &[Layout::Textures(&[("source", 0)])];
+pub const BLIT: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit", BLIT_SOURCE);
+pub const BLIT_SRGB: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit_srgb", BLIT_SOURCE);
 pub const SCAN_BLOCKS: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_scan_blocks", &[Layout::Scan]);
 pub const SCAN_ADD: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_add_blocks", &[Layout::Scan]);
 /// Strands and particles facing the eye, before a frame's geometry passes (upload.rs), an

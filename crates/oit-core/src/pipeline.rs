@@ -3,6 +3,10 @@
 
 use crate::bindings::DEPTH_FORMAT;
 
+/// Fixed-function additive blending: src + dst.
+pub(crate) const ADD: wgpu::BlendComponent =
+    wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
+
 /// Depth state of passes that draw the nearest surface: test and write (the opaque pass,
 /// screen_door's).
 pub fn depth_write() -> Option<wgpu::DepthStencilState> {
@@ -42,11 +46,9 @@ pub fn layout(device: &wgpu::Device, groups: &[&wgpu::BindGroupLayout]) -> wgpu:
 }
 
 /// A pipeline drawing scene triangles with `vs_main` and the fragment entry `fs`, rasterized
-/// at `samples` samples a pixel (above 1 the shader reads the coverage mask).
-#[allow(clippy::too_many_arguments)]
+/// at `samples` samples a pixel (above 1 the shader reads the coverage mask), labelled `fs`.
 pub fn geometry_samples(
     device: &wgpu::Device,
-    label: &str,
     module: &wgpu::ShaderModule,
     layout: &wgpu::PipelineLayout,
     fs: &str,
@@ -55,7 +57,7 @@ pub fn geometry_samples(
     samples: u32,
 ) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
+        label: Some(fs),
         layout: Some(layout),
         vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },

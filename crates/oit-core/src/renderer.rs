@@ -3,10 +3,13 @@
 //! tiles; the executor (`execute.rs`) runs the opaque pass, the census and the method tile by
 //! tile.
 
+mod census;
 mod execute;
 mod into;
+mod opaque;
 mod plan;
 
+use execute::Job;
 pub use into::Target;
 
 use std::collections::HashMap;
@@ -55,7 +58,6 @@ pub struct Frame {
 struct Shared {
     scene_layout: wgpu::BindGroupLayout,
     targets_layout: wgpu::BindGroupLayout,
-    counts_layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
 }
 
@@ -64,14 +66,13 @@ impl Shared {
         let d = &gpu.device;
         let scene_layout = gpu.cache.layout(d, Layout::Scene);
         let targets_layout = gpu.cache.layout(d, Layout::Targets);
-        let counts_layout = gpu.cache.layout(d, Layout::Storage(1));
         let uniform = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniform"),
             size: std::mem::size_of::<FrameUniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self { scene_layout, targets_layout, counts_layout, uniform }
+        Self { scene_layout, targets_layout, uniform }
     }
 }
 
@@ -262,7 +263,7 @@ impl Renderer {
             }
         }
         if offsets.len() == 1 || coverage {
-            let mut frame = self.render_sample(camera, info, &params, background, coverage)?;
+            let mut frame = self.render_sample(&Job { camera, info, params: &params, background, coverage })?;
             frame.stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
             frame.stats.antialias = antialias;
             frame.stats.antialias_mode = if coverage { AntialiasMode::Coverage } else { mode };
@@ -277,7 +278,7 @@ impl Renderer {
         let mut extra = ExtraMerge::default();
         for (i, offset) in offsets.iter().enumerate() {
             let jittered = camera.jittered(*offset, self.width, self.height);
-            let f = self.render_sample(&jittered, info, &params, background, false)?;
+            let f = self.render_sample(&Job { camera: &jittered, info, params: &params, background, coverage: false })?;
             image.iter_mut().zip(&f.image).for_each(|(a, &v)| *a += v as f64);
             if let Some(b) = &f.error_bound {
                 let sum = bound.get_or_insert_with(|| vec![0.0; pixels]);

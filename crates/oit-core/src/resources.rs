@@ -2,7 +2,7 @@
 //! their sizes change (`StorageGroup`), atomic counters with their readback (`Counter`), and
 //! readbacks (`Readback`). Pipelines and layouts come from the device's `cache::PipelineCache`.
 
-use crate::cache::Layout;
+use crate::cache::{bind_named, Layout};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::targets::{read_buffer, storage_buffer};
@@ -61,36 +61,40 @@ impl Counter {
     }
 }
 
-/// Storage buffers bound together as one group (bindings 0..n in order, then the counters'),
-/// reallocated only when their sizes change. Its layout, `Layout::Storage` of them all, is
-/// the one the method's pipeline table declares at group 2.
+/// Storage buffers bound together as one group of a `Layout::Storage` (the one the method's
+/// pipeline table declares at group 2), each by its binding's name, reallocated only when
+/// their sizes change.
 pub struct StorageGroup {
     sizes: Vec<u64>,
+    /// The buffers in the order `ensure` was given them.
     pub buffers: Vec<wgpu::Buffer>,
     pub group: wgpu::BindGroup,
 }
 
 impl StorageGroup {
-    /// The group in `slot`, made anew when `buffers` ((label, bytes) per binding) differ in size
-    /// from what it holds; `counters` follow them at the next bindings.
+    /// The group of `layout` in `slot`, made anew when `buffers` ((binding name, bytes) each)
+    /// differ in size from what it holds; `counters` fill the bindings of their names.
     pub fn ensure<'s>(
         slot: &'s mut Option<StorageGroup>,
         gpu: &GpuContext,
-        buffers: &[(&str, u64)],
-        counters: &[&Counter],
+        layout: Layout,
+        buffers: &[(&'static str, u64)],
+        counters: &[(&'static str, &Counter)],
     ) -> &'s StorageGroup {
         let sizes: Vec<u64> = buffers.iter().map(|(_, b)| *b).collect();
         if slot.as_ref().is_none_or(|g| g.sizes != sizes) {
             *slot = None; // free the old buffers first
             let d = &gpu.device;
             let made: Vec<wgpu::Buffer> =
-                buffers.iter().map(|(label, bytes)| storage_buffer(d, label, *bytes, wgpu::BufferUsages::COPY_SRC)).collect();
-            let all: Vec<&wgpu::Buffer> = made.iter().chain(counters.iter().map(|c| &c.buffer)).collect();
-            let layout = gpu.cache.layout(d, Layout::Storage(all.len() as u32));
-            let entries: Vec<wgpu::BindGroupEntry> =
-                all.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
-            let group =
-                d.create_bind_group(&wgpu::BindGroupDescriptor { label: buffers.first().map(|b| b.0), layout: &layout, entries: &entries });
+                buffers.iter().map(|(name, bytes)| storage_buffer(d, name, *bytes, wgpu::BufferUsages::COPY_SRC)).collect();
+            let named: Vec<(&str, wgpu::BindingResource<'_>)> = buffers
+                .iter()
+                .zip(&made)
+                .map(|((name, _), b)| (*name, b.as_entire_binding()))
+                .chain(counters.iter().map(|(name, c)| (*name, c.buffer.as_entire_binding())))
+                .collect();
+            let label = buffers.first().map_or("storage", |b| b.0);
+            let group = bind_named(&gpu.device, &gpu.cache, layout, label, &named);
             *slot = Some(StorageGroup { sizes, buffers: made, group });
         }
         slot.as_ref().expect("made above")

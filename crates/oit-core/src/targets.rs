@@ -72,7 +72,7 @@ fn opaque_group(
 }
 
 impl Targets {
-    pub fn new(gpu: &GpuContext, width: u32, height: u32, layout: &wgpu::BindGroupLayout, counts_layout: &wgpu::BindGroupLayout) -> Self {
+    pub fn new(gpu: &GpuContext, width: u32, height: u32, layout: &wgpu::BindGroupLayout) -> Self {
         let d = &gpu.device;
         use wgpu::TextureUsages as U;
         let base_texture = texture(d, "base", width, height, COLOR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC);
@@ -90,11 +90,8 @@ impl Targets {
         let counts = storage_buffer(d, "census counts", pixels * 4, wgpu::BufferUsages::COPY_SRC);
         let count_texture = texture(d, "census count", width, height, COUNT_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
         let count = count_texture.create_view(&Default::default());
-        let counts_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("census"),
-            layout: counts_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: counts.as_entire_binding() }],
-        });
+        let counts_group =
+            crate::cache::bind_named(d, &gpu.cache, crate::cache::COUNTS, "census", &[("counts", counts.as_entire_binding())]);
         let readback = |label, size| {
             d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),

@@ -79,8 +79,11 @@ fn shader_kind(module: &naga::Module, var: &naga::GlobalVariable) -> Kind {
 }
 
 fn reflect(path: &str, consts: &[Const]) -> (naga::Module, ModuleInfo) {
-    let src = compose(path, consts);
-    let module = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{path}: {}", e.emit_to_string(&src)));
+    reflect_source(path, &compose(path, consts))
+}
+
+fn reflect_source(path: &str, src: &str) -> (naga::Module, ModuleInfo) {
+    let module = naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{path}: {}", e.emit_to_string(src)));
     let info = Validator::new(ValidationFlags::all(), Capabilities::all()).validate(&module).unwrap_or_else(|e| panic!("{path}: {e:?}"));
     (module, info)
 }
@@ -119,6 +122,13 @@ fn mismatches(owner: &str, spec: &PipelineSpec, module: &naga::Module, info: &Mo
                 wrong.push(format!("{what}: {layout:?} has no binding {}", rb.binding));
                 continue;
             };
+            if let Some(named) = layout.named() {
+                let declared = named.iter().find(|(_, b)| *b == rb.binding).map(|(n, _)| *n);
+                let name = var.name.as_deref().unwrap_or("?");
+                if declared != Some(name) {
+                    wrong.push(format!("{what}: {layout:?} names binding {} {declared:?}, the shader '{name}'", rb.binding));
+                }
+            }
             let (shader, rust) = (shader_kind(module, var), layout_kind(entry));
             if shader != rust {
                 wrong.push(format!("{what}: the shader binds {shader:?}, {layout:?} declares {rust:?}"));
@@ -162,7 +172,9 @@ fn every_binding_of_a_method_group_is_declared_by_a_shader() {
                 continue;
             }
             let key = (format!("{layout:?}"), g);
-            wanted.insert(key.clone(), layout.entries().iter().map(|e| e.binding).collect());
+            // A binding named "_" is bound for the group's shape, and no shader of it reads it.
+            let named = layout.named().expect("a method's own group is bound by name");
+            wanted.insert(key.clone(), named.iter().filter(|(n, _)| *n != "_").map(|(_, b)| *b).collect());
             let (module, _) = modules.entry(spec.shader).or_insert_with(|| reflect(spec.shader, DEFAULT_CONSTS));
             let bound = module.global_variables.iter().filter_map(|(_, v)| v.binding.as_ref()).filter(|b| b.group as usize == g);
             declared_at.entry(key).or_default().extend(bound.map(|b| b.binding));
@@ -195,4 +207,24 @@ fn no_binding_or_struct_is_written_twice() {
             }
         }
     }
+}
+
+/// Two bindings of one type swapped in a shader (`ktab` and `vis` of hybrid.wgsl, both
+/// `array<atomic<u32>>`) bind the wrong buffers with every type check passing: the names catch
+/// it, without a GPU.
+#[test]
+fn swapping_two_bindings_of_one_type_is_caught_by_name() {
+    let owner = oit_core::methods().iter().find(|m| m.name == "hybrid").expect("hybrid is registered");
+    let spec = owner.pipelines.iter().flat_map(|t| t.iter()).find(|p| p.entry == "fs_store").expect("hybrid's store pass");
+    let src = compose(spec.shader, DEFAULT_CONSTS);
+    let (ktab, vis) = ("@group(2) @binding(0) var<storage, read_write> ktab", "@group(2) @binding(1) var<storage, read_write> vis");
+    assert!(src.contains(ktab) && src.contains(vis), "hybrid.wgsl's declarations moved: update this test");
+    let (module, info) = reflect_source(spec.shader, &src);
+    assert!(mismatches("hybrid", spec, &module, &info).is_empty(), "the shader as written agrees with its declaration");
+    // The binding numbers trade places (hybrid.wgsl declares `vis` twice, by its variant).
+    let swapped = src.replace(ktab, &ktab.replace("binding(0)", "binding(1)")).replace(vis, &vis.replace("binding(1)", "binding(0)"));
+    let (module, info) = reflect_source(spec.shader, &swapped);
+    let wrong = mismatches("hybrid", spec, &module, &info);
+    // The store pass reads ktab (vis only later passes): it is named where vis is declared.
+    assert!(wrong.iter().any(|w| w.contains("names binding 1 Some(\"vis\"), the shader 'ktab'")), "the swap went unseen: {wrong:?}");
 }

@@ -1,6 +1,6 @@
 """The bench's command line (`python -m oit bench`, also `python -m oit.bench`): the main sweep
 (oit.bench.results) or, instead of it, the experiments (--temporal, --auto, --antialias, --scale,
---shading-cost, --load, --fuzz-load, --gpu), and
+--shading-cost, --load, --fuzz-load, --gpu) or every command of docs/results.md (--report), and
 the tables and plots they write into --out."""
 
 from __future__ import annotations
@@ -114,6 +114,12 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="instead of the method sweep: what may turn on a GPU, about 6 minutes on a hardware adapter (never "
                          "lavapipe), each part under a time limit (gpu.md, gpu.json; scripts/gpu-bench.sh, oit.bench.gpu)")
     ap.add_argument("--small", action="store_true", help="--gpu: the same on any adapter at tiny sizes (seconds)")
+    ap.add_argument("--report", action="store_true",
+                    help="instead of the method sweep: every command docs/results.md prints above its tables, each "
+                         "into <out>/NN/ (default out: out/report); with --quick at the smoke test's sizes")
+    ap.add_argument("--list", "--dry-run", dest="list_only", action="store_true",
+                    help="--report: only print the commands")
+    ap.add_argument("--doc", default=None, help="--report: the results doc (default: the repository's docs/results.md)")
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -137,6 +143,13 @@ def _plots_missing(a: argparse.Namespace) -> bool:
 
 def run_cli(a: argparse.Namespace) -> int:
     repeat = 1 if a.quick else max(1, a.repeat)
+    if a.report:
+        from .report import run_report
+
+        ap = argparse.ArgumentParser(prog="python -m oit bench", exit_on_error=False)
+        add_arguments(ap)
+        a.out = "out/report" if a.out == "out/bench" else a.out
+        return run_report(a, ap)
     if a.gpu:
         return run_gpu(a.out, a.small)
     if a.load or a.fuzz_load:

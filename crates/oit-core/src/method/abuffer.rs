@@ -1,7 +1,7 @@
 //! `abuffer`: the exact A-buffer as per-pixel linked lists (Yang et al. 2010), resolved by
 //! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
-use super::frame::{FrameCtx, Limits, Method, MethodReport};
+use super::frame::{FrameCtx, Limits, Method, Outcome};
 use super::info::{never, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, Tiling};
 use super::list_pipelines::{swept, FRAME, SAMPLES};
 use super::lists::{state_words, Aux, ListLayout, ListMethod, COUNTED_PIXEL_BYTES, STATE_WORDS};
@@ -59,7 +59,7 @@ impl ABuffer {
 }
 
 impl Method for ABuffer {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         match cx.coverage {
             Some(c) => {
                 let lists = self.coverage.get_or_insert_with(|| {

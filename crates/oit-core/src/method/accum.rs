@@ -9,8 +9,7 @@ use crate::cache::Layout;
 pub(crate) const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub(crate) const AUX_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
-pub(crate) const ADD: wgpu::BlendComponent =
-    wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
+pub(crate) use crate::pipeline::ADD;
 
 /// dst * (1 - src): revealage, the product of (1 - alpha).
 pub(crate) const REVEAL: wgpu::BlendComponent = wgpu::BlendComponent {
@@ -56,7 +55,8 @@ pub fn memory_bytes(pixels: u64) -> u64 {
 pub(crate) struct FloatTargets {
     size: (u32, u32),
     views: Vec<wgpu::TextureView>,
-    /// The targets as textures at `bindings` (the layout `Layout::Textures(bindings)`).
+    /// The targets as textures at `bindings` (the layout `Layout::Textures(bindings)`, in the
+    /// order of the formats).
     pub group: wgpu::BindGroup,
 }
 
@@ -67,7 +67,7 @@ impl FloatTargets {
         slot: &'s mut Option<FloatTargets>,
         cx: &FrameCtx<'_>,
         formats: &[wgpu::TextureFormat],
-        bindings: &'static [u32],
+        bindings: &'static [(&'static str, u32)],
     ) -> &'s FloatTargets {
         let size = (cx.targets.width, cx.targets.height);
         if slot.as_ref().is_none_or(|t| t.size != size) {
@@ -78,7 +78,8 @@ impl FloatTargets {
                     crate::targets::texture(&cx.gpu.device, "float target", size.0, size.1, f, usage).create_view(&Default::default())
                 })
                 .collect();
-            let resources: Vec<wgpu::BindingResource<'_>> = views.iter().map(wgpu::BindingResource::TextureView).collect();
+            let resources: Vec<(&str, wgpu::BindingResource<'_>)> =
+                bindings.iter().zip(&views).map(|((name, _), v)| (*name, wgpu::BindingResource::TextureView(v))).collect();
             let group = cx.group(Layout::Textures(bindings), &resources);
             *slot = Some(FloatTargets { size, views, group });
         }
@@ -102,7 +103,11 @@ impl FloatTargets {
     }
 
     /// The blended methods' two targets: accumulated color and the companion.
-    pub fn accumulation<'s>(slot: &'s mut Option<FloatTargets>, cx: &FrameCtx<'_>, bindings: &'static [u32]) -> &'s FloatTargets {
+    pub fn accumulation<'s>(
+        slot: &'s mut Option<FloatTargets>,
+        cx: &FrameCtx<'_>,
+        bindings: &'static [(&'static str, u32)],
+    ) -> &'s FloatTargets {
         Self::ensure(slot, cx, &[ACCUM_FORMAT, AUX_FORMAT], bindings)
     }
 

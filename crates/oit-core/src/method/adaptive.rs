@@ -3,7 +3,7 @@
 //! full-screen pass that builds a visibility function of at most `nodes` steps in submission
 //! order and composites every fragment by it (shaders/adaptive_lists.wgsl).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::list_pipelines::{single, FRAME};
 use super::lists::{check_replay_budget, Aux, ListLayout, ListMethod};
@@ -56,7 +56,7 @@ pub const INFO: MethodInfo = MethodInfo {
 struct Adaptive(ListMethod);
 
 impl Method for Adaptive {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let nodes = cx.params.int("nodes") as u32;
         // Per fragment: an insertion and a lookup of up to `nodes` steps each.
         check_replay_budget(cx, "adaptive_lists", "nodes", nodes, 4 * nodes as u64)?;

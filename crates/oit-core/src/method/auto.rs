@@ -8,7 +8,7 @@
 //! slots once, and then the exact A-buffer is rendered. When some pixel has no k ≤ 32
 //! predicted to meet t, the A-buffer is rendered directly.
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::ktab::{self, KTab, Slots};
 use super::params::{ParamInfo, ParamKind, Params};
@@ -20,8 +20,8 @@ use crate::resources::{Readback, StorageGroup};
 use crate::targets::read_region;
 
 /// The estimate pass, into its sums (group 2); the frame itself is the k-TAB engine's.
-const PIPELINES: &[PipelineSpec] =
-    &[PipelineSpec::geometry("auto_estimate.wgsl", "fs_estimate", &[Layout::Scene, Layout::Targets, Layout::Storage(1)])];
+const OWN: Layout = Layout::Storage(&["sums"]);
+const PIPELINES: &[PipelineSpec] = &[PipelineSpec::geometry("auto_estimate.wgsl", "fs_estimate", &[Layout::Scene, Layout::Targets, OWN])];
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "auto",
@@ -77,10 +77,10 @@ impl Auto {
     }
 
     /// Runs the estimate pass; returns its sums per pixel.
-    fn measure(&mut self, cx: &mut FrameCtx<'_>) -> Result<Vec<Sums>> {
+    fn measure(&mut self, cx: &mut FrameCtx<'_>) -> Result<Vec<PixelSums>> {
         let bytes = cx.pixels() * WORDS * 4;
         cx.check_per_pixel("auto's estimate", WORDS * 4)?;
-        let b = StorageGroup::ensure(&mut self.estimate, cx.gpu, &[("auto estimate", bytes)], &[]);
+        let b = StorageGroup::ensure(&mut self.estimate, cx.gpu, OWN, &[("sums", bytes)], &[]);
         if self.readback.as_ref().is_none_or(|(n, _)| *n != bytes) {
             self.readback = Some((bytes, Readback::new(cx.gpu, "auto estimate readback", bytes)));
         }
@@ -95,7 +95,7 @@ impl Auto {
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&raw);
         Ok(words
             .chunks_exact(WORDS as usize)
-            .map(|w| Sums {
+            .map(|w| PixelSums {
                 tau: w[0] as f64 / TAU_SCALE,
                 tau2: w[1] as f64 / TAU2_SCALE,
                 quant: w[2] as f64 / QUANT_SCALE,
@@ -120,7 +120,7 @@ const SPREAD: f64 = 3.0;
 /// Σ −ln(1 − α), its square Σ ln²(1 − α), Σ |α − q(α)| (q: hybrid's 8-bit alpha), and the
 /// range of the color channels of the fragments and the base behind them.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Sums {
+pub struct PixelSums {
     pub tau: f64,
     pub tau2: f64,
     pub quant: f64,
@@ -134,7 +134,7 @@ pub struct Sums {
 /// twice its mean, T' falling at the mean rate) and D², the rounding, and T_core times the
 /// range of the colors behind it where a tail exists. An estimate, not a bound — fragments sorted thin-first break it — which is why auto
 /// checks the rendered bound.
-pub fn predicted_bound(n: u32, s: Sums, k: u32) -> f64 {
+pub fn predicted_bound(n: u32, s: PixelSums, k: u32) -> f64 {
     if n == 0 {
         return 0.0;
     }
@@ -158,7 +158,7 @@ pub fn predicted_bound(n: u32, s: Sums, k: u32) -> f64 {
 
 /// Each pixel's smallest k ≤ min(32, its fragments) predicted to meet `tolerance` (0 where it
 /// has no fragments); None when some pixel has no such k.
-pub fn choose_slots(counts: &[u32], sums: &[Sums], tolerance: f64) -> Option<Vec<u32>> {
+pub fn choose_slots(counts: &[u32], sums: &[PixelSums], tolerance: f64) -> Option<Vec<u32>> {
     counts
         .iter()
         .zip(sums)
@@ -185,7 +185,7 @@ fn widen(slots: &[u32], counts: &[u32], bound: &[f32], tolerance: f64) -> Option
 }
 
 impl Method for Auto {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let tolerance = cx.params.float("tolerance");
         let (t, tile) = (cx.targets, cx.tile);
         let pixels = cx.pixels();
@@ -199,7 +199,7 @@ impl Method for Auto {
         let mut slots = predicted;
         while let Some(current) = slots.take() {
             attempts += 1;
-            let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current), ktab::Sums::Exact)?;
+            let mut report = self.hybrid.render_slots(cx, Slots::PerPixel(&current), ktab::TailSums::Exact)?;
             let bound = read_region(cx.gpu, &t.bound_texture, &t.bound_readback, 4, tile.local())?;
             let worst = bound.iter().copied().fold(0.0f32, f32::max) as f64;
             hybrid_bytes = report.memory_bytes;
@@ -215,13 +215,17 @@ impl Method for Auto {
                     ("auto_exact", 0.0),
                     ("auto_attempts", attempts as f64),
                 ]);
-                return Ok(report);
+                return Ok(Outcome::Done(report));
             }
             if attempts < 2 {
                 slots = widen(&current, counts, &bound, tolerance);
             }
         }
-        let mut report = self.exact.render(&mut cx.with_params(&Params::default()))?;
+        // The exact A-buffer's pool may need to grow or its tile to shrink: the executor sees to it.
+        let mut report = match self.exact.render(&mut cx.with_params(&Params::default()))? {
+            Outcome::Done(report) => report,
+            other => return Ok(other),
+        };
         // Exact up to float32 compositing: (n + 2) roundings of at most 2^-24 each, doubled.
         let rounding = (cx.max_depth_complexity as f64 + 2.0) * ROUNDING;
         // The tile's bound, written from here (the exact resolve writes none).
@@ -247,7 +251,7 @@ impl Method for Auto {
             ("auto_exact", 1.0),
             ("auto_attempts", (attempts + 1) as f64),
         ]);
-        Ok(report)
+        Ok(Outcome::Done(report))
     }
 }
 
@@ -255,9 +259,9 @@ impl Method for Auto {
 mod tests {
     use super::*;
 
-    fn alike(n: u32, alpha: f64) -> Sums {
+    fn alike(n: u32, alpha: f64) -> PixelSums {
         let tau = -(1.0 - alpha).ln();
-        Sums { tau: n as f64 * tau, tau2: n as f64 * tau * tau, quant: 0.0, range: 1.0 }
+        PixelSums { tau: n as f64 * tau, tau2: n as f64 * tau * tau, quant: 0.0, range: 1.0 }
     }
 
     #[test]
@@ -270,14 +274,14 @@ mod tests {
     #[test]
     fn spread_makes_the_prediction_more_careful() {
         let even = alike(20, 0.3);
-        let uneven = Sums { tau2: even.tau2 * 1.5, ..even };
+        let uneven = PixelSums { tau2: even.tau2 * 1.5, ..even };
         assert!(predicted_bound(20, uneven, 8) > predicted_bound(20, even, 8));
     }
 
     #[test]
     fn each_pixel_gets_the_smallest_k_that_meets_the_tolerance() {
         let counts = [10, 0, 3];
-        let sums = [alike(10, 0.5), Sums::default(), alike(3, 0.5)];
+        let sums = [alike(10, 0.5), PixelSums::default(), alike(3, 0.5)];
         // 0.5^k <= 0.01 first at k = 7; three fragments fit in three slots (no tail); none, none.
         assert_eq!(choose_slots(&counts, &sums, 0.01), Some(vec![7, 0, 3]));
         // 100 fragments of optical depth 0.01 each: 32 slots leave e^-0.32, no k meets 0.01.

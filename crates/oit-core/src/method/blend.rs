@@ -1,7 +1,7 @@
 //! `unsorted` and `sorted`: fixed-function over-blending onto the opaque image, in
 //! submission order or per mesh back to front by centroid (docs/methods.md).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use crate::bindings::COLOR_FORMAT;
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -26,7 +26,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES],
-    create: |_, _| Box::new(Blend { kind: Kind::Unsorted }),
+    create: |_, _| Box::new(Blend { kind: Blending::Unsorted }),
 };
 
 pub const SORTED: MethodInfo = MethodInfo {
@@ -34,7 +34,7 @@ pub const SORTED: MethodInfo = MethodInfo {
     summary: "per-mesh back-to-front sort by centroid, then over-blending (wrong for interpenetrating meshes)",
     passes: &["sort meshes (CPU)", "blend"],
     order: Order::Submission,
-    create: |_, _| Box::new(Blend { kind: Kind::Sorted }),
+    create: |_, _| Box::new(Blend { kind: Blending::Sorted }),
     ..UNSORTED
 };
 
@@ -43,7 +43,7 @@ pub const ADDITIVE: MethodInfo = MethodInfo {
     summary: "additive blending (RTR 5.5): C = sum(alpha c) + background; brightens, never attenuates",
     passes: &["blend"],
     order: Order::Rounding,
-    create: |_, _| Box::new(Blend { kind: Kind::Additive }),
+    create: |_, _| Box::new(Blend { kind: Blending::Additive }),
     ..UNSORTED
 };
 
@@ -52,12 +52,12 @@ pub const FILTER: MethodInfo = MethodInfo {
     summary: "colored transmission (RTR 5.5): the scene behind multiplied by each surface's 1 - alpha (1 - c)",
     passes: &["blend"],
     order: Order::Rounding,
-    create: |_, _| Box::new(Blend { kind: Kind::Filter }),
+    create: |_, _| Box::new(Blend { kind: Blending::Filter }),
     ..UNSORTED
 };
 
 #[derive(Clone, Copy, PartialEq)]
-enum Kind {
+enum Blending {
     Unsorted,
     Sorted,
     Additive,
@@ -71,19 +71,19 @@ const fn component(src_factor: wgpu::BlendFactor, dst_factor: wgpu::BlendFactor)
 /// Coverage accumulates as a + (1 - a) * A for every blend method.
 const COVERAGE: wgpu::BlendComponent = component(wgpu::BlendFactor::One, wgpu::BlendFactor::OneMinusSrcAlpha);
 
-impl Kind {
+impl Blending {
     fn blend(self) -> wgpu::BlendState {
         use wgpu::BlendFactor as F;
         let color = match self {
-            Kind::Unsorted | Kind::Sorted => component(F::SrcAlpha, F::OneMinusSrcAlpha),
-            Kind::Additive => component(F::SrcAlpha, F::One),
-            Kind::Filter => component(F::Zero, F::Src),
+            Blending::Unsorted | Blending::Sorted => component(F::SrcAlpha, F::OneMinusSrcAlpha),
+            Blending::Additive => component(F::SrcAlpha, F::One),
+            Blending::Filter => component(F::Zero, F::Src),
         };
         wgpu::BlendState { color, alpha: COVERAGE }
     }
 
     fn entry(self) -> &'static str {
-        if self == Kind::Filter {
+        if self == Blending::Filter {
             "fs_filter"
         } else {
             "fs_blend"
@@ -97,16 +97,16 @@ const PIPELINES: &[PipelineSpec] = &[
 ];
 
 struct Blend {
-    kind: Kind,
+    kind: Blending,
 }
 
 impl Method for Blend {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let target = wgpu::ColorTargetState { format: COLOR_FORMAT, blend: Some(self.kind.blend()), write_mask: wgpu::ColorWrites::ALL };
         let pipeline = cx.draw_pipeline(spec(PIPELINES, self.kind.entry()), &[], vec![Some(target)], pipeline::depth_test_only());
         let geo = &cx.scene.transparent;
         let mut order: Vec<usize> = (0..geo.placements.len()).collect();
-        if self.kind == Kind::Sorted {
+        if self.kind == Blending::Sorted {
             let vp = cx.camera.matrix_f32();
             // Far to near: larger NDC depth first; instances behind the eye (w <= 0) go first.
             let key = |i: usize| {
@@ -124,13 +124,13 @@ impl Method for Blend {
         {
             let mut pass = passes::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.tile, cx.timer.render_pass("blend"));
             pass.set_pipeline(&pipeline);
-            if self.kind == Kind::Sorted {
+            if self.kind == Blending::Sorted {
                 order.iter().for_each(|&i| geo.draw_placement(&mut pass, &geo.placements[i]));
             } else {
                 geo.draw_all(&mut pass);
             }
         }
         cx.gpu.queue.submit([enc.finish()]);
-        Ok(MethodReport::default())
+        Ok(Outcome::Done(MethodReport::default()))
     }
 }

@@ -2,7 +2,7 @@
 //! per pixel from a uniform split of its depth range, the nearest fragment of each bucket
 //! kept, the others dropped and counted (shaders/bucket_peeling.wgsl).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -37,7 +37,8 @@ pub fn memory_bytes(pixels: u64, buckets: u64) -> u64 {
 
 const SHADER: &str = "bucket_peeling.wgsl";
 /// Group 2: bounds, keys, bucket colors, then the dropped counter.
-const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(4)];
+const OWN: Layout = Layout::Storage(&["bounds", "keys", "bucket_colors", "dropped"]);
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
 const PIPELINES: &[PipelineSpec] = &[
     PipelineSpec::geometry(SHADER, "fs_bounds", GROUPS),
     PipelineSpec::geometry(SHADER, "fs_keys", GROUPS),
@@ -51,14 +52,13 @@ struct Buckets {
 }
 
 impl Method for Buckets {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let buckets = cx.params.int("buckets") as u32;
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("bucket_peeling with {buckets} buckets"), 16 * buckets as u64)?;
         let dropped = self.dropped.get_or_insert_with(|| Counter::new(cx.gpu, "bucket dropped"));
-        let sizes =
-            [("bucket bounds", pixels * 8), ("bucket keys", pixels * buckets as u64 * 8), ("bucket colors", pixels * buckets as u64 * 16)];
-        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[dropped]);
+        let sizes = [("bounds", pixels * 8), ("keys", pixels * buckets as u64 * 8), ("bucket_colors", pixels * buckets as u64 * 16)];
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("dropped", dropped)]);
         let consts = [Const::U32("BUCKETS", buckets)];
         let mut enc = cx.encoder();
         b.clear(&mut enc);
@@ -70,6 +70,10 @@ impl Method for Buckets {
         dropped.copy(&mut enc);
         cx.submit(enc);
         let dropped = dropped.read(cx.gpu)?;
-        Ok(MethodReport { memory_bytes: memory_bytes(pixels, buckets as u64), overflow_fragments: dropped, ..Default::default() })
+        Ok(Outcome::Done(MethodReport {
+            memory_bytes: memory_bytes(pixels, buckets as u64),
+            overflow_fragments: dropped,
+            ..Default::default()
+        }))
     }
 }

@@ -3,16 +3,18 @@
 //! normals, material and UVs: 176 bytes) is written once by a compute pass and the resolve
 //! shades each fragment from it, deferred (shaders/compact_abuffer.wgsl, docs/shading.md).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::list_pipelines::{swept_after, FRAME};
+use super::list_pipelines::{pool_layout, swept_after};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{COUNTED_PIXEL_BYTES, STATE_WORDS};
-use crate::cache::PipelineSpec;
+use crate::cache::{Layout, PipelineSpec};
 use crate::error::Result;
 use crate::gpu_types::{CompactNode, PrimShading};
 
-const PIPELINES: &[PipelineSpec] = &swept_after(PipelineSpec::compute("compact_abuffer.wgsl", "cs_allocate", FRAME));
+/// Group 2: the node pool, with shading at binding 7.
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, pool_layout!("shading")];
+const PIPELINES: &[PipelineSpec] = &swept_after(PipelineSpec::compute("compact_abuffer.wgsl", "cs_allocate", GROUPS));
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "compact_abuffer",
@@ -51,7 +53,7 @@ pub const INFO: MethodInfo = MethodInfo {
 struct Compact(ListMethod);
 
 impl Method for Compact {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         self.0.render(cx)
     }
 

@@ -128,7 +128,7 @@ impl<'a> FrameCtx<'a> {
         self.check_targets(spec);
         let mut targets = resolve_targets(true);
         if let Some(Some(out)) = targets.first_mut() {
-            out.blend = Some(wgpu::BlendState { color: super::accum::ADD, alpha: super::accum::ADD });
+            out.blend = Some(wgpu::BlendState { color: pipeline::ADD, alpha: pipeline::ADD });
         }
         self.render_pipeline(spec.render(consts, Draw::Fullscreen, targets))
     }
@@ -141,16 +141,9 @@ impl<'a> FrameCtx<'a> {
         self.gpu.cache.compute(&self.gpu.device, &desc)
     }
 
-    /// A bind group of `layout` over `resources` at bindings 0, 1, ... (or the layout's own).
-    pub fn group(&self, layout: Layout, resources: &[wgpu::BindingResource<'_>]) -> wgpu::BindGroup {
-        let bindings: Vec<u32> = match layout {
-            Layout::Textures(b) => b.to_vec(),
-            _ => (0..resources.len() as u32).collect(),
-        };
-        let entries: Vec<wgpu::BindGroupEntry> =
-            bindings.iter().zip(resources).map(|(&binding, r)| wgpu::BindGroupEntry { binding, resource: r.clone() }).collect();
-        let layout = self.gpu.cache.layout(&self.gpu.device, layout);
-        self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &layout, entries: &entries })
+    /// A bind group of `layout` over `resources`, each given by its binding's name.
+    pub fn group(&self, layout: Layout, resources: &[(&str, wgpu::BindingResource<'_>)]) -> wgpu::BindGroup {
+        crate::cache::bind_named(&self.gpu.device, &self.gpu.cache, layout, "method group", resources)
     }
 
     /// Records a geometry pass of `pipeline` over the transparent geometry (timed as `label`),
@@ -168,8 +161,13 @@ impl<'a> FrameCtx<'a> {
         own: &wgpu::BindGroup,
         colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
     ) {
-        let (depth, targets, scene) = (self.raster_depth(), self.targets_group(), self.scene);
-        capture_pass(enc, label, depth, colors, targets, scene, self.tile, self.timer.render_pass(label), pipeline, own);
+        let bound = self.bound();
+        bound.capture(enc, label, colors, self.timer.render_pass(label), pipeline, own);
+    }
+
+    /// What every pass of this tile binds besides the method's own groups.
+    fn bound(&self) -> TileBindings<'a> {
+        TileBindings { scene: self.scene, targets: self.targets_group(), depth: self.raster_depth(), tile: self.tile }
     }
 
     /// [`FrameCtx::capture`] inside a span the caller times (per-layer passes).
@@ -180,7 +178,7 @@ impl<'a> FrameCtx<'a> {
         pipeline: &wgpu::RenderPipeline,
         own: &wgpu::BindGroup,
     ) {
-        capture_pass(enc, label, self.raster_depth(), &[], self.targets_group(), self.scene, self.tile, None, pipeline, own);
+        self.bound().capture(enc, label, &[], None, pipeline, own);
     }
 
     /// Binds the shared groups, `own` and `pipeline` to `pass` and dispatches one invocation
@@ -198,7 +196,7 @@ impl<'a> FrameCtx<'a> {
         own: &wgpu::BindGroup,
         dispatch: Dispatch<'_>,
     ) {
-        record_dispatch(pass, self.scene, self.targets_group(), self.tile, pipeline, own, dispatch);
+        self.bound().dispatch(pass, pipeline, own, dispatch);
     }
 
     /// Records a full-screen pass of `pipeline` into the output (and the error bound, with
@@ -260,10 +258,10 @@ impl<'a> FrameCtx<'a> {
         own: &wgpu::BindGroup,
         dispatch: Dispatch<'_>,
     ) {
-        let (tile, targets, scene) = (self.tile, self.targets_group(), self.scene);
+        let bound = self.bound();
         let timestamp_writes = self.timer.compute_pass(label);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
-        record_dispatch(&mut pass, scene, targets, tile, pipeline, own, dispatch);
+        bound.dispatch(&mut pass, pipeline, own, dispatch);
     }
 
     pub fn encoder(&self) -> wgpu::CommandEncoder {
@@ -275,25 +273,49 @@ impl<'a> FrameCtx<'a> {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn capture_pass(
-    enc: &mut wgpu::CommandEncoder,
-    label: &str,
-    depth: &wgpu::TextureView,
-    colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
-    targets: &wgpu::BindGroup,
-    scene: &GpuScene,
+/// What every pass of a tile binds besides the method's own groups: the scene (group 0), the
+/// frame's targets (group 1), the depth its geometry passes test against, and the tile they are
+/// scissored or dispatched to.
+#[derive(Clone, Copy)]
+struct TileBindings<'a> {
+    scene: &'a GpuScene,
+    targets: &'a wgpu::BindGroup,
+    depth: &'a wgpu::TextureView,
     tile: Tile,
-    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    pipeline: &wgpu::RenderPipeline,
-    own: &wgpu::BindGroup,
-) {
-    let mut pass = passes::capture_into(enc, label, depth, colors, timestamps);
-    tile.scissor(&mut pass);
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(1, targets, &[]);
-    pass.set_bind_group(2, own, &[]);
-    scene.transparent.draw_all(&mut pass);
+}
+
+impl TileBindings<'_> {
+    /// Records a geometry pass of `pipeline` over the transparent geometry, blending into
+    /// `colors`, with `own` at group 2.
+    fn capture(
+        self,
+        enc: &mut wgpu::CommandEncoder,
+        label: &str,
+        colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+        pipeline: &wgpu::RenderPipeline,
+        own: &wgpu::BindGroup,
+    ) {
+        let mut pass = passes::capture_into(enc, label, self.depth, colors, timestamps);
+        self.tile.scissor(&mut pass);
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(1, self.targets, &[]);
+        pass.set_bind_group(2, own, &[]);
+        self.scene.transparent.draw_all(&mut pass);
+    }
+
+    /// Records a dispatch of `pipeline` with the shared groups and `own` bound.
+    fn dispatch(self, pass: &mut wgpu::ComputePass<'_>, pipeline: &wgpu::ComputePipeline, own: &wgpu::BindGroup, dispatch: Dispatch<'_>) {
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, self.scene.transparent.group(), &[]);
+        pass.set_bind_group(1, self.targets, &[]);
+        pass.set_bind_group(2, own, &[]);
+        match dispatch {
+            Dispatch::Pixels => pass.dispatch_workgroups(self.tile.width.div_ceil(8), self.tile.height.div_ceil(8), 1),
+            Dispatch::One => pass.dispatch_workgroups(1, 1, 1),
+            Dispatch::Indirect(args, offset) => pass.dispatch_workgroups_indirect(args, offset),
+        }
+    }
 }
 
 /// The workgroups of a compute dispatch.
@@ -304,27 +326,6 @@ pub enum Dispatch<'a> {
     One,
     /// The three workgroup counts a buffer holds at an offset, written by an earlier pass.
     Indirect(&'a wgpu::Buffer, u64),
-}
-
-#[allow(clippy::too_many_arguments)]
-fn record_dispatch(
-    pass: &mut wgpu::ComputePass<'_>,
-    scene: &GpuScene,
-    targets: &wgpu::BindGroup,
-    tile: Tile,
-    pipeline: &wgpu::ComputePipeline,
-    own: &wgpu::BindGroup,
-    dispatch: Dispatch<'_>,
-) {
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, scene.transparent.group(), &[]);
-    pass.set_bind_group(1, targets, &[]);
-    pass.set_bind_group(2, own, &[]);
-    match dispatch {
-        Dispatch::Pixels => pass.dispatch_workgroups(tile.width.div_ceil(8), tile.height.div_ceil(8), 1),
-        Dispatch::One => pass.dispatch_workgroups(1, 1, 1),
-        Dispatch::Indirect(args, offset) => pass.dispatch_workgroups_indirect(args, offset),
-    }
 }
 
 impl FrameCtx<'_> {
@@ -382,16 +383,31 @@ pub struct MethodReport {
     pub extra: Vec<(&'static str, f64)>,
     /// Whether the method wrote a per-pixel error bound into `targets.bound`.
     pub error_bound: bool,
-    /// The tile needed this many times the nodes its pool can hold: nothing was rendered, and
-    /// the renderer plans smaller tiles.
-    pub pool_short: Option<f64>,
     /// Each pixel's transparent fragments (row-major), where the method counted them in its own
     /// capture in place of the census (`Method::counts_in_capture`).
     pub counts: Option<Vec<u32>>,
 }
 
+/// What became of a tile a method was asked to render: the executor (renderer/execute.rs)
+/// acts on each.
+#[derive(Debug)]
+pub(crate) enum Outcome {
+    /// The tile is in the frame's targets.
+    Done(MethodReport),
+    /// Nothing usable was rendered: the method's storage proved too small and has grown to
+    /// what the tile needs; the executor renders the tile again (the memory budget is held to
+    /// what the tile then reports, as for any tile).
+    Grow,
+    /// Nothing was rendered: the tile needs `factor` times the storage one binding holds (more
+    /// nodes than the census planned for); the executor plans smaller tiles.
+    Retile { factor: f64 },
+    /// Nothing was rendered: a frame the method counted itself (`Method::counts_in_capture`)
+    /// does not fit one pool; the executor runs the census and plans tiles from it.
+    NeedCensus,
+}
+
 pub(crate) trait Method: Send {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport>;
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome>;
 
     /// Whether the next whole, one-sample frame can go without the census because the method
     /// counts each pixel's fragments in its own capture and reports them

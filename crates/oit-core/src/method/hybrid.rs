@@ -1,9 +1,9 @@
 //! `hybrid` (Maule et al. 2013, Algorithm 1) and `ktab`, its core alone with the tail
 //! discarded: the k-TAB engine (ktab.rs) with the `k` parameter.
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::ktab::{compact_memory_bytes, memory_bytes, KTab, Slots, Sums};
+use super::ktab::{compact_memory_bytes, memory_bytes, KTab, Slots, TailSums};
 use super::params::{ParamInfo, ParamKind, ParamValue};
 use crate::error::Result;
 
@@ -68,10 +68,10 @@ const MEMORY: Memory = Memory::Frame {
 struct Hybrid(KTab);
 
 impl Method for Hybrid {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let k = cx.params.int("k") as u32;
         // ktab has no tail, and sums its core as hybrid's default does.
-        let sums = if cx.params.0.contains_key("tail") { Sums::from_param(cx.params.choice("tail")) } else { Sums::Exact };
-        self.0.render_slots(cx, Slots::Uniform(k), sums)
+        let sums = if cx.params.0.contains_key("tail") { TailSums::from_param(cx.params.choice("tail")) } else { TailSums::Exact };
+        self.0.render_slots(cx, Slots::Uniform(k), sums).map(Outcome::Done)
     }
 }

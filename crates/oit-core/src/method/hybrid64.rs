@@ -4,7 +4,7 @@
 //! result does not suffice); the word pushed off the table joins the tail in the same pass.
 //! One geometry pass and one full-screen resolve (shaders/hybrid64.wgsl).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -37,7 +37,8 @@ pub const INFO: MethodInfo = MethodInfo {
 };
 
 /// Group 2: the k-TAB words, the tail accumulators, then the tail counter.
-const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(3)];
+const OWN: Layout = Layout::Storage(&["ktab", "tail_words", "overflow"]);
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
 const PIPELINES: &[PipelineSpec] =
     &[PipelineSpec::geometry("hybrid64.wgsl", "fs_insert", GROUPS), PipelineSpec::fullscreen("hybrid64.wgsl", "fs_resolve", GROUPS)];
 
@@ -55,13 +56,13 @@ struct Hybrid64 {
 }
 
 impl Method for Hybrid64 {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let k = cx.params.int("k") as u32;
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("hybrid64 with k = {k}"), (8 * k as u64).max(4 * ACCUM_WORDS))?;
         let tail = self.tail.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid64 tail count"));
-        let sizes = [("hybrid64 k-TAB", pixels * k as u64 * 8), ("hybrid64 tail", pixels * ACCUM_WORDS * 4)];
-        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[tail]);
+        let sizes = [("ktab", pixels * k as u64 * 8), ("tail_words", pixels * ACCUM_WORDS * 4)];
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("overflow", tail)]);
         let consts = [Const::U32("K", k)];
         let insert = cx.capture_pipeline(spec(PIPELINES, "fs_insert"), &consts);
         let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, true);
@@ -73,12 +74,12 @@ impl Method for Hybrid64 {
         tail.copy(&mut enc);
         cx.submit(enc);
         let tail = tail.read(cx.gpu)?;
-        Ok(MethodReport {
+        Ok(Outcome::Done(MethodReport {
             memory_bytes: memory_bytes(pixels, k as u64),
             overflow_fragments: tail,
             extra: vec![("tail_fragments", tail as f64)],
             error_bound: true,
             ..Default::default()
-        })
+        }))
     }
 }

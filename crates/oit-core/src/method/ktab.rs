@@ -35,7 +35,7 @@ const COUNTER_BYTES: u64 = 4;
 const COMPACT_TAIL_WORDS: u64 = 2;
 const COMPACT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The binding fs_final_compact reads the compact tail's sums at (group 3).
-const COMPACT_BINDINGS: &[u32] = &[4];
+const COMPACT_BINDINGS: &[(&str, u32)] = &[("compact_sums", 4)];
 
 /// Bytes with each pixel's own slot count (`slots` in all): k-TAB and visibility (a word
 /// each per slot), the accumulators and sums, the per-pixel offsets (pixels + 1 words) and
@@ -59,7 +59,10 @@ const SUMS: usize = 4;
 const SHADER: &str = "hybrid.wgsl";
 /// Group 2: k-TAB, core visibility, accumulators, slot offsets, sums, then the overflow
 /// counter.
-const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(6)];
+const OWN: Layout = Layout::Storage(&["ktab", "vis", "accum", "offsets", "tail_words", "overflow"]);
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
+/// The buffers tail = "compact" keeps (its group binds the census counts at "accum").
+const COMPACT_OWN: Layout = Layout::Storage(&["ktab", "vis", "offsets"]);
 
 /// The k-TAB engine's pipelines (hybrid, ktab, auto).
 pub(crate) const PIPELINES: &[PipelineSpec] = &[
@@ -69,23 +72,15 @@ pub(crate) const PIPELINES: &[PipelineSpec] = &[
     PipelineSpec::fullscreen(SHADER, "fs_final", GROUPS),
     PipelineSpec::geometry(SHADER, "fs_shade_blend", GROUPS),
     // The blended sums at group 3.
-    PipelineSpec::fullscreen(
-        SHADER,
-        "fs_final_blend",
-        &[Layout::Scene, Layout::Targets, Layout::Storage(6), Layout::Textures(BLEND_BINDINGS)],
-    ),
+    PipelineSpec::fullscreen(SHADER, "fs_final_blend", &[Layout::Scene, Layout::Targets, OWN, Layout::Textures(BLEND_BINDINGS)]),
     PipelineSpec::fullscreen(SHADER, "fs_clear", GROUPS),
     PipelineSpec::geometry(SHADER, "fs_shade_compact", GROUPS),
-    PipelineSpec::fullscreen(
-        SHADER,
-        "fs_final_compact",
-        &[Layout::Scene, Layout::Targets, Layout::Storage(6), Layout::Textures(COMPACT_BINDINGS)],
-    ),
+    PipelineSpec::fullscreen(SHADER, "fs_final_compact", &[Layout::Scene, Layout::Targets, OWN, Layout::Textures(COMPACT_BINDINGS)]),
 ];
 
 /// How the second geometry pass sums the core and the tail.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Sums {
+pub(crate) enum TailSums {
     /// Fixed-point storage atomics: bit-identical under any fragment order.
     Exact,
     /// Fixed-function additive (and max) blending into float targets, as Maule et al. do:
@@ -96,12 +91,12 @@ pub(crate) enum Sums {
     Compact,
 }
 
-impl Sums {
+impl TailSums {
     pub(crate) fn from_param(name: &str) -> Self {
         match name {
-            "blend" => Sums::Blend,
-            "compact" => Sums::Compact,
-            _ => Sums::Exact,
+            "blend" => TailSums::Blend,
+            "compact" => TailSums::Compact,
+            _ => TailSums::Exact,
         }
     }
 }
@@ -111,7 +106,7 @@ impl Sums {
 /// minus its smallest (max).
 const BLEND_FORMATS: [wgpu::TextureFormat; 4] =
     [wgpu::TextureFormat::Rgba32Float, wgpu::TextureFormat::Rgba32Float, wgpu::TextureFormat::Rgba32Float, wgpu::TextureFormat::R32Float];
-const BLEND_BINDINGS: &[u32] = &[0, 1, 2, 3];
+const BLEND_BINDINGS: &[(&str, u32)] = &[("shade_core", 0), ("shade_tail", 1), ("shade_quant", 2), ("shade_low", 3)];
 
 /// Bytes a frame pixel of the blended sums' targets.
 pub const BLEND_BYTES_PER_PIXEL: u64 = 3 * 16 + 4;
@@ -170,15 +165,15 @@ impl KTab {
     }
 
     /// One frame with the k-TAB slots `slots` gives each pixel, its sums made as `sums` says.
-    pub(crate) fn render_slots(&mut self, cx: &mut FrameCtx<'_>, slots: Slots<'_>, sums: Sums) -> Result<MethodReport> {
-        if sums != Sums::Exact && !cx.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
+    pub(crate) fn render_slots(&mut self, cx: &mut FrameCtx<'_>, slots: Slots<'_>, sums: TailSums) -> Result<MethodReport> {
+        if sums != TailSums::Exact && !cx.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
             return Err(OitError::Unsupported(
                 "tail = 'blend' and 'compact' blend into float32 targets, which this adapter cannot (FLOAT32_BLENDABLE): use \
                  tail = 'exact'"
                     .into(),
             ));
         }
-        if sums == Sums::Compact {
+        if sums == TailSums::Compact {
             // Checked by its own words: it keeps no accumulators, which `plan` counts.
             return self.render_compact(cx, &slots);
         }
@@ -186,13 +181,13 @@ impl KTab {
         let pixels = cx.pixels();
         let overflow = self.overflow.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid overflow"));
         let sizes = [
-            ("k-TAB", total.max(1) * 4),
-            ("core visibility", total.max(1) * 4),
-            ("hybrid accumulators", pixels * ACCUM_WORDS * 4),
-            ("slot offsets", if per_pixel { (pixels + 1) * 4 } else { 4 }),
-            ("hybrid sums", pixels * SUM_WORDS * 4),
+            ("ktab", total.max(1) * 4),
+            ("vis", total.max(1) * 4),
+            ("accum", pixels * ACCUM_WORDS * 4),
+            ("offsets", if per_pixel { (pixels + 1) * 4 } else { 4 }),
+            ("tail_words", pixels * SUM_WORDS * 4),
         ];
-        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[overflow]);
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("overflow", overflow)]);
         if let Slots::PerPixel(s) = slots {
             write_offsets(cx, &b.buffers[OFFSETS], s);
         }
@@ -210,12 +205,12 @@ impl KTab {
         cx.capture(&mut enc, "store", &cx.capture_pipeline(spec(PIPELINES, "fs_store"), &consts), &b.group);
         cx.dispatch(&mut enc, "visibility", &cx.compute_pipeline(spec(PIPELINES, "cs_visibility"), &consts), &b.group);
         match sums {
-            Sums::Exact => {
+            TailSums::Exact => {
                 cx.capture(&mut enc, "shade", &cx.capture_pipeline(spec(PIPELINES, "fs_shade"), &consts), &b.group);
                 cx.resolve(&mut enc, "final", &cx.resolve_pipeline(spec(PIPELINES, "fs_final"), &consts, true), &b.group, true);
             }
-            Sums::Compact => unreachable!("render_compact"),
-            Sums::Blend => {
+            TailSums::Compact => unreachable!("render_compact"),
+            TailSums::Blend => {
                 let targets = FloatTargets::ensure(&mut self.blend, cx, &BLEND_FORMATS, BLEND_BINDINGS);
                 let shade_blend = spec(PIPELINES, "fs_shade_blend");
                 let shade = cx.draw_pipeline(shade_blend, &consts, blend_targets(), crate::pipeline::depth_test_only());
@@ -230,7 +225,7 @@ impl KTab {
         // What the frame allocated: the formulas above name each buffer, and the tests hold
         // these bytes to them.
         let mut memory = b.bytes() + COUNTER_BYTES;
-        if sums == Sums::Blend {
+        if sums == TailSums::Blend {
             memory += BLEND_BYTES_PER_PIXEL * cx.targets.width as u64 * cx.targets.height as u64;
         }
         Ok(MethodReport {
@@ -253,20 +248,20 @@ impl KTab {
         cx.check_per_pixel(&format!("hybrid with k = {k}"), 4 * k as u64)?;
         let pixels = cx.pixels();
         let overflow = self.overflow.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid overflow"));
-        let sizes = [("k-TAB", pixels * k as u64 * 4), ("core visibility", pixels * k as u64 * 4), ("slot offsets", 4)];
-        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[]);
+        let sizes = [("ktab", pixels * k as u64 * 4), ("vis", pixels * k as u64 * 4), ("offsets", 4)];
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, COMPACT_OWN, &sizes, &[]);
         let counts = &cx.targets.counts;
         cx.gpu.queue.write_buffer(counts, 0, bytemuck::cast_slice(cx.depth_complexity));
         let resources = [
-            b.buffers[0].as_entire_binding(),
-            b.buffers[1].as_entire_binding(),
-            counts.as_entire_binding(),
-            b.buffers[2].as_entire_binding(),
+            ("ktab", b.buffers[0].as_entire_binding()),
+            ("vis", b.buffers[1].as_entire_binding()),
+            ("accum", counts.as_entire_binding()),
+            ("offsets", b.buffers[2].as_entire_binding()),
             // No sums: the unused slot offsets fill their binding too (never accessed).
-            b.buffers[2].as_entire_binding(),
-            overflow.buffer.as_entire_binding(),
+            ("tail_words", b.buffers[2].as_entire_binding()),
+            ("overflow", overflow.buffer.as_entire_binding()),
         ];
-        let group = cx.group(Layout::Storage(6), &resources);
+        let group = cx.group(OWN, &resources);
         // ATOMIC64 0: the sums' binding holds the 4-byte slot-offset placeholder, which the 32-bit
         // pairs' declaration accepts (a 64-bit array would need 8 bytes); nothing reads it.
         let consts =

@@ -3,11 +3,11 @@
 //! resolve. The pool follows the scene: it grows to the counted fragments and the frame is
 //! rendered again when the atomic counter says the pool overflowed (docs/methods.md).
 
-use super::frame::{Dispatch, FrameCtx, Limits, MethodReport};
-use super::list_pipelines::{POOL_LAYOUT, SWEEPS};
+use super::frame::{Dispatch, FrameCtx, Limits, MethodReport, Outcome};
+use super::list_pipelines::SWEEPS;
 pub(crate) use super::sweep_costs::{pixel_bytes, state_words, COUNTED_PIXEL_BYTES, PIXEL_BYTES, STATE_WORDS};
 pub use super::sweep_costs::{resolve_dispatches, step_budget, StepCosts};
-use crate::cache::{spec, PipelineSpec};
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::Alloc;
@@ -74,14 +74,22 @@ pub(crate) struct NodePool {
     counts: wgpu::Buffer,
     counts_readback: Option<wgpu::Buffer>,
     counting: bool,
-    pub layout: wgpu::BindGroupLayout,
+    /// The group's layout, by the names of the method's shader (its table's group 2).
+    pub layout: Layout,
     pub group: Option<wgpu::BindGroup>,
 }
 
 impl NodePool {
-    pub fn new(gpu: &GpuContext, limits: &Limits, node_bytes: u64, state_words: u64, aux_kind: Aux, counting: bool) -> Self {
+    pub fn new(
+        gpu: &GpuContext,
+        limits: &Limits,
+        node_bytes: u64,
+        state_words: u64,
+        aux_kind: Aux,
+        counting: bool,
+        layout: Layout,
+    ) -> Self {
         let d = &gpu.device;
-        let layout = gpu.cache.layout(d, POOL_LAYOUT);
         let alloc = storage_buffer(d, "alloc", ALLOC_BYTES, wgpu::BufferUsages::COPY_SRC);
         let alloc_readback = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("alloc readback"),
@@ -204,18 +212,12 @@ impl NodePool {
             changed = true;
         }
         if changed {
-            let mut entries = vec![
-                wgpu::BindGroupEntry { binding: 0, resource: self.heads.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: self.alloc.as_entire_binding() },
-            ];
-            entries.extend(
-                self.pools.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: 2 + i as u32, resource: b.as_entire_binding() }),
-            );
-            entries.push(wgpu::BindGroupEntry { binding: 2 + POOL_BINDINGS as u32, resource: self.state.as_entire_binding() });
-            entries.push(wgpu::BindGroupEntry { binding: 3 + POOL_BINDINGS as u32, resource: self.aux.as_entire_binding() });
-            entries.push(wgpu::BindGroupEntry { binding: 4 + POOL_BINDINGS as u32, resource: self.counts.as_entire_binding() });
-            self.group =
-                Some(d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("node pool"), layout: &self.layout, entries: &entries }));
+            let Some(names) = self.layout.named() else { unreachable!("a storage layout") };
+            // Heads, allocator, pools, state, binding 7, counts: in the layout's order.
+            let buffers = [&self.heads, &self.alloc].into_iter().chain(&self.pools).chain([&self.state, &self.aux, &self.counts]);
+            let entries: Vec<(&str, wgpu::BindingResource<'_>)> =
+                names.iter().zip(buffers).map(|((name, _), b)| (*name, b.as_entire_binding())).collect();
+            self.group = Some(crate::cache::bind_named(&gpu.device, &gpu.cache, self.layout, "node pool", &entries));
         }
         Ok(())
     }
@@ -274,6 +276,10 @@ pub(crate) struct ListMethod {
     /// The prefix sum over binding 7, for `Aux::PixelOffsets`, and the pixels it is for.
     scan: Option<(u64, Scan)>,
     shades_at_resolve: bool,
+    /// The nodes the pool grew to after the last render of this tile proved it short
+    /// (`Outcome::Grow`), and how many times it grew for this tile.
+    grown: Option<u64>,
+    regrown: u32,
 }
 
 /// The storage layout of a list method.
@@ -311,11 +317,21 @@ impl ListMethod {
         Self {
             pipelines: layout.pipelines,
             consts: Vec::new(),
-            pool: NodePool::new(gpu, limits, layout.node_bytes, layout.state_words, layout.aux, layout.counts_in_capture),
+            pool: NodePool::new(
+                gpu,
+                limits,
+                layout.node_bytes,
+                layout.state_words,
+                layout.aux,
+                layout.counts_in_capture,
+                layout.pipelines[0].groups[2],
+            ),
             sweeps: (layout.state_words > 0).then_some(layout.samples),
             shades_at_resolve: layout.shades_at_resolve,
             aux: layout.aux,
             scan: None,
+            grown: None,
+            regrown: 0,
         }
     }
 
@@ -482,14 +498,8 @@ impl ListMethod {
     }
 
     /// The report of a frame whose capture asked for `count` nodes.
-    fn report(
-        &mut self,
-        cx: &FrameCtx<'_>,
-        count: u64,
-        regrown: f64,
-        sweeps: Option<[u32; 3]>,
-        counts: Option<Vec<u32>>,
-    ) -> Result<MethodReport> {
+    fn report(&mut self, cx: &FrameCtx<'_>, count: u64, sweeps: Option<[u32; 3]>, counts: Option<Vec<u32>>) -> Result<Outcome> {
+        let regrown = std::mem::take(&mut self.regrown) as f64;
         let memory = self.pool.bytes() + self.scan.as_ref().map_or(0, |(_, s)| s.bytes);
         // Shrink for the next frame when this one used little of the pool.
         if count < self.pool.capacity / 4 {
@@ -504,10 +514,19 @@ impl ListMethod {
         if self.pool.counting {
             extra.push(("counted_in_capture", counts.is_some() as u32 as f64));
         }
-        Ok(MethodReport { memory_bytes: memory, extra, counts, ..Default::default() })
+        Ok(Outcome::Done(MethodReport { memory_bytes: memory, extra, counts, ..Default::default() }))
     }
 
-    pub fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    /// Grows the pool to `nodes` for the next render of this tile (`Outcome::Grow`).
+    fn grow(&mut self, cx: &FrameCtx<'_>, nodes: u64) -> Result<Outcome> {
+        let triangles = cx.scene.transparent.triangles as u64;
+        self.pool.reserve(cx.gpu, nodes, cx.pixels(), triangles, !cx.tile.is_whole())?;
+        self.grown = Some(nodes);
+        self.regrown += 1;
+        Ok(Outcome::Grow)
+    }
+
+    pub fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let tile = cx.tile;
         let pixels = cx.pixels();
         cx.check_per_pixel(
@@ -531,71 +550,67 @@ impl ListMethod {
         // not again after an overflow). Where nodes are not fragments (pall's are its triangles'
         // bounds) the capture's own count still regrows the pool below.
         let tiled = !tile.is_whole();
-        let initial = if tiled { cx.fragments } else { self.pool.capacity.max(cx.fragments) }.clamp(1, self.pool.max_nodes());
+        let planned = if tiled { cx.fragments } else { self.pool.capacity.max(cx.fragments) };
+        let initial = self.grown.take().unwrap_or(planned).clamp(1, self.pool.max_nodes());
         let triangles = cx.scene.transparent.triangles as u64;
         self.pool.reserve(cx.gpu, initial, pixels, triangles, tiled)?;
         if self.aux == Aux::PixelOffsets && self.scan.as_ref().is_none_or(|(p, _)| *p != pixels) {
             self.scan = Some((pixels, Scan::new(cx.gpu, &self.pool.aux, pixels + 1)));
         }
-        let mut regrown = 0.0;
-        loop {
-            cx.timer.reset();
-            let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-            if counting {
-                // The capture alone, with the largest run in its constants (they do not change
-                // its code, and so its pipeline stays the same from frame to frame); then the
-                // counts plan the resolve.
-                let capture = self.capture_pipelines(cx, &self.consts_for(RUN, StepCosts::default(), 1, true));
-                self.record_capture(cx, &mut enc, &capture, pixels, true);
-                cx.gpu.queue.submit([enc.finish()]);
-                let (alloc, counts) = self.pool.read_counts(cx.gpu)?;
-                let count = alloc.count as u64;
-                if count > self.pool.capacity {
-                    if count > self.pool.max_nodes() {
-                        // More than one pool holds: the renderer plans tiles from a census.
-                        return Ok(MethodReport { pool_short: Some(count as f64 / self.pool.max_nodes() as f64), ..Default::default() });
-                    }
-                    self.pool.reserve(cx.gpu, count, pixels, triangles, tiled)?;
-                    regrown += 1.0;
-                    continue;
+        let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
+        if counting {
+            // The capture alone, with the largest run in its constants (they do not change
+            // its code, and so its pipeline stays the same from frame to frame); then the
+            // counts plan the resolve.
+            let capture = self.capture_pipelines(cx, &self.consts_for(RUN, StepCosts::default(), 1, true));
+            self.record_capture(cx, &mut enc, &capture, pixels, true);
+            cx.gpu.queue.submit([enc.finish()]);
+            let (alloc, counts) = self.pool.read_counts(cx.gpu)?;
+            let count = alloc.count as u64;
+            if count > self.pool.capacity {
+                if count > self.pool.max_nodes() {
+                    // More than one pool holds: the renderer plans tiles from a census.
+                    self.regrown = 0;
+                    return Ok(Outcome::NeedCensus);
                 }
-                // The capture's allocator is the frame's: the resolve allocates nothing, so the
-                // frame is reported without waiting for it (the renderer waits for the image).
-                let deepest = counts.iter().copied().max().unwrap_or(0);
-                let (consts, sweeps) = self.resolve_plan(cx, deepest, true)?;
-                let p = self.resolve_pipelines(cx, &consts);
-                let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
-                self.record_resolve(cx, &mut enc, &p, sweeps);
-                cx.gpu.queue.submit([enc.finish()]);
-                return self.report(cx, count, regrown, self.sweeps.is_some().then_some(sweeps), Some(counts));
+                return self.grow(cx, count);
             }
-            let (consts, sweeps) = self.resolve_plan(cx, cx.max_depth_complexity, false)?;
-            let capture = self.capture_pipelines(cx, &consts);
-            self.record_capture(cx, &mut enc, &capture, pixels, false);
+            // The capture's allocator is the frame's: the resolve allocates nothing, so the
+            // frame is reported without waiting for it (the renderer waits for the image).
+            let deepest = counts.iter().copied().max().unwrap_or(0);
+            let (consts, sweeps) = self.resolve_plan(cx, deepest, true)?;
             let p = self.resolve_pipelines(cx, &consts);
+            let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
             self.record_resolve(cx, &mut enc, &p, sweeps);
             cx.gpu.queue.submit([enc.finish()]);
-            let alloc = self.pool.read_alloc(cx.gpu)?;
-            if alloc.escaped > 0 {
-                return Err(OitError::Device(format!(
-                    "{} fragments fell outside their triangle's allocation (a bound that should be conservative \
-                     was not); please report this with the scene",
-                    alloc.escaped
-                )));
-            }
-            let count = alloc.count as u64;
-            let sweeps = self.sweeps.is_some().then_some(sweeps);
-            if count <= self.pool.capacity {
-                return self.report(cx, count, regrown, sweeps, None);
-            }
-            if count > self.pool.max_nodes() && cx.tile.pixels() > 1 {
-                // More nodes than the census planned for (pall's bounding boxes): the renderer
-                // plans smaller tiles. A single pixel past the pool is refused by reserve.
-                return Ok(MethodReport { pool_short: Some(count as f64 / self.pool.max_nodes() as f64), ..Default::default() });
-            }
-            self.pool.reserve(cx.gpu, count, pixels, triangles, tiled)?;
-            regrown += 1.0;
+            return self.report(cx, count, self.sweeps.is_some().then_some(sweeps), Some(counts));
         }
+        let (consts, sweeps) = self.resolve_plan(cx, cx.max_depth_complexity, false)?;
+        let capture = self.capture_pipelines(cx, &consts);
+        self.record_capture(cx, &mut enc, &capture, pixels, false);
+        let p = self.resolve_pipelines(cx, &consts);
+        self.record_resolve(cx, &mut enc, &p, sweeps);
+        cx.gpu.queue.submit([enc.finish()]);
+        let alloc = self.pool.read_alloc(cx.gpu)?;
+        if alloc.escaped > 0 {
+            return Err(OitError::Device(format!(
+                "{} fragments fell outside their triangle's allocation (a bound that should be conservative \
+                     was not); please report this with the scene",
+                alloc.escaped
+            )));
+        }
+        let count = alloc.count as u64;
+        let sweeps = self.sweeps.is_some().then_some(sweeps);
+        if count <= self.pool.capacity {
+            return self.report(cx, count, sweeps, None);
+        }
+        if count > self.pool.max_nodes() && cx.tile.pixels() > 1 {
+            // More nodes than the census planned for (pall's bounding boxes): the renderer
+            // plans smaller tiles. A single pixel past the pool is refused by reserve.
+            self.regrown = 0;
+            return Ok(Outcome::Retile { factor: count as f64 / self.pool.max_nodes() as f64 });
+        }
+        self.grow(cx, count)
     }
 }
 

@@ -6,7 +6,7 @@
 //! The list versions they replace are `adaptive_lists` and `mlab_lists`.
 
 use super::accum::{blended, FloatTargets, ACCUM_FORMAT, ADD};
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind, Params};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -15,10 +15,13 @@ use crate::resources::{Readback, StorageGroup};
 use crate::shader::Const;
 
 /// Group 2: the entries, the lock words, and the two lock counts.
-const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(3)];
+const ADAPTIVE_OWN: Layout = Layout::Storage(&["nodes", "locks", "lock_stats"]);
+const MLAB_OWN: Layout = Layout::Storage(&["layers", "locks", "lock_stats"]);
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, ADAPTIVE_OWN];
+const MLAB_GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, MLAB_OWN];
 /// adaptive's resolve also reads the shading pass's sums at group 3.
-const SUMS: &[u32] = &[0];
-const RESOLVE: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(3), Layout::Textures(SUMS)];
+const SUMS: &[(&str, u32)] = &[("accum_tex", 0)];
+const RESOLVE: &[Layout] = &[Layout::Scene, Layout::Targets, ADAPTIVE_OWN, Layout::Textures(SUMS)];
 
 const ADAPTIVE_SHADER: &str = "adaptive.wgsl";
 const ADAPTIVE_PIPELINES: &[PipelineSpec] = &[
@@ -29,7 +32,7 @@ const ADAPTIVE_PIPELINES: &[PipelineSpec] = &[
 
 const MLAB_SHADER: &str = "mlab.wgsl";
 const MLAB_PIPELINES: &[PipelineSpec] =
-    &[PipelineSpec::geometry(MLAB_SHADER, "fs_insert", GROUPS), PipelineSpec::fullscreen(MLAB_SHADER, "fs_resolve", GROUPS)];
+    &[PipelineSpec::geometry(MLAB_SHADER, "fs_insert", MLAB_GROUPS), PipelineSpec::fullscreen(MLAB_SHADER, "fs_resolve", MLAB_GROUPS)];
 
 /// Bytes of a pixel's lock word (with its entry count), and of the two lock counts.
 const LOCK_BYTES: u64 = 4;
@@ -109,7 +112,7 @@ impl Locked {
 }
 
 impl Method for Locked {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let (param, entry_bytes) = match self.kind {
             Kind::Adaptive => ("nodes", NODE_BYTES),
             Kind::Mlab => ("layers", LAYER_BYTES),
@@ -122,9 +125,12 @@ impl Method for Locked {
             Kind::Adaptive => vec![Const::U32("NODES", n), Const::U32("NODES_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)],
             Kind::Mlab => vec![Const::U32("LAYERS", n), Const::U32("LAYERS_PLUS_ONE", n + 1)],
         };
-        let sizes =
-            [("locked entries", pixels * entry_bytes * n as u64), ("pixel locks", pixels * LOCK_BYTES), ("lock counts", LOCK_STATS_BYTES)];
-        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[]);
+        let (own, entries) = match self.kind {
+            Kind::Adaptive => (ADAPTIVE_OWN, "nodes"),
+            Kind::Mlab => (MLAB_OWN, "layers"),
+        };
+        let sizes = [(entries, pixels * entry_bytes * n as u64), ("locks", pixels * LOCK_BYTES), ("lock_stats", LOCK_STATS_BYTES)];
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, own, &sizes, &[]);
         let readback = self.lock_stats.get_or_insert_with(|| Readback::new(cx.gpu, "lock counts", LOCK_STATS_BYTES));
         let mut enc = cx.encoder();
         enc.clear_buffer(&b.buffers[1], 0, None);
@@ -156,12 +162,12 @@ impl Method for Locked {
         let raw = readback.read(cx.gpu)?;
         let count = |i: usize| u32::from_le_bytes(raw[4 * i..4 * i + 4].try_into().expect("4 bytes")) as u64;
         let (failures, waits) = (count(0), count(1));
-        Ok(MethodReport {
+        Ok(Outcome::Done(MethodReport {
             memory_bytes: memory,
             // A fragment that gave up on its pixel's lock is one the structure did not take.
             overflow_fragments: failures,
             extra: vec![("lock_failures", failures as f64), ("lock_waits", waits as f64)],
             ..Default::default()
-        })
+        }))
     }
 }

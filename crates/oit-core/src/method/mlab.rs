@@ -2,7 +2,7 @@
 //! order over captured lists: the proof of concept beside the bounded `mlab` (locked.rs); memory is that of
 //! the lists, unbounded (shaders/mlab_lists.wgsl).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::list_pipelines::{single, FRAME};
 use super::lists::check_replay_budget;
@@ -52,7 +52,7 @@ pub const INFO: MethodInfo = MethodInfo {
 struct Mlab(ListMethod);
 
 impl Method for Mlab {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let layers = cx.params.int("layers") as u32;
         // Per fragment: an insertion shifting up to `layers` entries.
         check_replay_budget(cx, "mlab_lists", "layers", layers, layers as u64 + 2)?;

@@ -27,7 +27,7 @@ mod sweep_costs;
 mod weighted;
 
 pub use frame::MethodReport;
-pub(crate) use frame::{check_per_pixel, FrameCtx, Limits, Method};
+pub(crate) use frame::{check_per_pixel, FrameCtx, Limits, Method, Outcome};
 pub use info::*;
 pub use params::{ParamInfo, ParamKind, ParamValue, Params};
 

@@ -3,16 +3,18 @@
 //! conservative bound of its fragments); fragments then link nodes of their triangle's
 //! block without a global atomic. Resolved exactly like `abuffer` (shaders/pall.wgsl).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::list_pipelines::{swept_after, FRAME};
+use super::list_pipelines::{pool_layout, swept_after};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{PIXEL_BYTES, STATE_WORDS};
-use crate::cache::PipelineSpec;
+use crate::cache::{Layout, PipelineSpec};
 use crate::error::Result;
 use crate::gpu_types::{PallBlock, PoolNode};
 
-const PIPELINES: &[PipelineSpec] = &swept_after(PipelineSpec::compute("pall.wgsl", "cs_allocate", FRAME));
+/// Group 2: the node pool, with blocks at binding 7.
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, pool_layout!("blocks")];
+const PIPELINES: &[PipelineSpec] = &swept_after(PipelineSpec::compute("pall.wgsl", "cs_allocate", GROUPS));
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "pall",
@@ -51,7 +53,7 @@ pub const INFO: MethodInfo = MethodInfo {
 struct Pall(ListMethod);
 
 impl Method for Pall {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         self.0.render(cx)
     }
 }

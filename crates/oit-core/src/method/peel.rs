@@ -3,7 +3,7 @@
 //! atomic min/max over (depth, triangle) keys, so coplanar fragments peel one by one
 //! (shaders/peel.wgsl, docs/methods.md).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -47,7 +47,8 @@ pub const DUAL_DEPTH_PEELING: MethodInfo = MethodInfo {
 
 const SHADER: &str = "peel.wgsl";
 /// Group 2: keys, layer colors, accumulators, then the peeled counter.
-const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(4)];
+const OWN: Layout = Layout::Storage(&["keys", "layers", "acc", "peeled"]);
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
 const PIPELINES: &[PipelineSpec] = &[
     PipelineSpec::compute(SHADER, "cs_init", GROUPS),
     PipelineSpec::geometry(SHADER, "fs_peel", GROUPS),
@@ -73,13 +74,13 @@ struct Peel {
 }
 
 impl Method for Peel {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let pixels = cx.pixels();
         let name = if self.dual { "dual_depth_peeling" } else { "depth_peeling" };
         cx.check_per_pixel(name, 4 * PEEL_WORDS.max(8))?;
         let peeled = self.peeled.get_or_insert_with(|| Counter::new(cx.gpu, "peeled count"));
-        let sizes = [("peel keys", pixels * 32), ("peel layers", pixels * 32), ("peel accumulators", pixels * PEEL_WORDS * 4)];
-        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, &sizes, &[peeled]);
+        let sizes = [("keys", pixels * 32), ("layers", pixels * 32), ("acc", pixels * PEEL_WORDS * 4)];
+        let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("peeled", peeled)]);
         let limit = cx.params.int("layers") as u64;
         let n = cx.max_depth_complexity as u64;
         let layers = if limit == 0 { n } else { limit.min(n) };
@@ -107,11 +108,11 @@ impl Method for Peel {
         peeled.copy(&mut enc);
         cx.submit(enc);
         let peeled = peeled.read(cx.gpu)?;
-        Ok(MethodReport {
+        Ok(Outcome::Done(MethodReport {
             memory_bytes: memory_bytes(pixels),
             overflow_fragments: cx.fragments.saturating_sub(peeled),
             extra: vec![("geometry_passes", passes as f64), ("peeled_fragments", peeled as f64)],
             ..Default::default()
-        })
+        }))
     }
 }

@@ -3,16 +3,18 @@
 //! contiguous per-pixel ranges (compute), capture into them, and resolve like `abuffer`.
 //! The pool holds exactly the counted fragments (shaders/sbuffer.wgsl).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::list_pipelines::{swept_after, FRAME};
+use super::list_pipelines::{pool_layout, swept_after};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{PIXEL_BYTES, STATE_WORDS};
-use crate::cache::PipelineSpec;
+use crate::cache::{Layout, PipelineSpec};
 use crate::error::Result;
 use crate::gpu_types::PoolNode;
 
-const PIPELINES: &[PipelineSpec] = &swept_after(PipelineSpec::geometry("sbuffer.wgsl", "fs_count", FRAME));
+/// Group 2: the node pool, with offsets at binding 7.
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, pool_layout!("offsets")];
+const PIPELINES: &[PipelineSpec] = &swept_after(PipelineSpec::geometry("sbuffer.wgsl", "fs_count", GROUPS));
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "sbuffer",
@@ -51,7 +53,7 @@ pub const INFO: MethodInfo = MethodInfo {
 struct SBuffer(ListMethod);
 
 impl Method for SBuffer {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         self.0.render(cx)
     }
 }

@@ -2,7 +2,7 @@
 //! geometry pass that draws the nearest fragment whose alpha beats its pixel's threshold,
 //! opaque (shaders/screen_door.wgsl).
 
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -43,7 +43,7 @@ struct ScreenDoor {
 }
 
 impl Method for ScreenDoor {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let d = &cx.gpu.device;
         let t = cx.targets;
         let pipeline = cx.draw_pipeline(spec(PIPELINES, "fs_door"), &[], vec![Some(COLOR_FORMAT.into())], pipeline::depth_write());
@@ -71,6 +71,6 @@ impl Method for ScreenDoor {
             cx.scene.transparent.draw_all(&mut pass);
         }
         cx.gpu.queue.submit([enc.finish()]);
-        Ok(MethodReport { memory_bytes: memory_bytes(size.0 as u64 * size.1 as u64), ..Default::default() })
+        Ok(Outcome::Done(MethodReport { memory_bytes: memory_bytes(size.0 as u64 * size.1 as u64), ..Default::default() }))
     }
 }

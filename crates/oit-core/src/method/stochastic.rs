@@ -3,7 +3,7 @@
 //! an accumulation pass and a resolve (shaders/stochastic.wgsl). Deterministic for a seed.
 
 use super::accum::{accumulation_targets, Aux, FloatTargets};
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -46,9 +46,10 @@ pub const INFO: MethodInfo = MethodInfo {
 
 const SHADER: &str = "stochastic.wgsl";
 /// Group 2 of the geometry passes: the per-pixel depth samples.
-const SAMPLES: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Storage(1)];
+const OWN: Layout = Layout::Storage(&["samples"]);
+const SAMPLES: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
 /// The bindings the resolve reads the accumulation targets at (group 2).
-const TEXTURES: &[u32] = &[1, 2];
+const TEXTURES: &[(&str, u32)] = &[("accum_tex", 1), ("aux_tex", 2)];
 const PIPELINES: &[PipelineSpec] = &[
     PipelineSpec::geometry(SHADER, "fs_depth", SAMPLES),
     PipelineSpec::geometry(SHADER, "fs_accum", SAMPLES),
@@ -66,12 +67,12 @@ struct Stochastic {
 }
 
 impl Method for Stochastic {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let samples = cx.params.int("samples") as u32;
         let seed = cx.params.int("seed") as u32;
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("stochastic with {samples} samples"), 4 * samples as u64)?;
-        let b = StorageGroup::ensure(&mut self.samples, cx.gpu, &[("stochastic samples", pixels * samples as u64 * 4)], &[]);
+        let b = StorageGroup::ensure(&mut self.samples, cx.gpu, OWN, &[("samples", pixels * samples as u64 * 4)], &[]);
         // The accumulation targets are read only by the resolve.
         let w = FloatTargets::accumulation(&mut self.targets, cx, TEXTURES);
         let consts = [Const::U32("SAMPLES", samples)];
@@ -90,6 +91,6 @@ impl Method for Stochastic {
         // The samples are the tile's; the targets are the frame's, shared by its tiles.
         let frame_pixels = cx.targets.width as u64 * cx.targets.height as u64;
         let memory = pixels * samples as u64 * 4 + frame_pixels * super::accum::TARGET_BYTES;
-        Ok(MethodReport { memory_bytes: memory, ..Default::default() })
+        Ok(Outcome::Done(MethodReport { memory_bytes: memory, ..Default::default() }))
     }
 }

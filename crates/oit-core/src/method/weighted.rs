@@ -2,7 +2,7 @@
 //! multiplicative) blending into two float targets, then a full-screen resolve.
 
 use super::accum::{accumulation_targets, memory_bytes, Aux, FloatTargets};
-use super::frame::{FrameCtx, Method, MethodReport};
+use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -12,7 +12,7 @@ use crate::shader::Const;
 
 const SHADER: &str = "weighted.wgsl";
 /// The bindings the resolves read the two targets at (group 2).
-const TEXTURES: &[u32] = &[0, 1];
+const TEXTURES: &[(&str, u32)] = &[("accum_tex", 0), ("aux_tex", 1)];
 const RESOLVE: &[Layout] = &[Layout::Scene, Layout::Targets, Layout::Textures(TEXTURES)];
 const PIPELINES: &[PipelineSpec] = &[
     PipelineSpec::geometry(SHADER, "fs_sum", &[Layout::Scene]),
@@ -23,7 +23,7 @@ const PIPELINES: &[PipelineSpec] = &[
 ];
 
 #[derive(Clone, Copy, PartialEq)]
-enum Kind {
+enum Weighting {
     Sum,
     Average,
     Blended,
@@ -46,14 +46,14 @@ pub const WSUM: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES],
-    create: |_, _| Box::new(Weighted::new(Kind::Sum)),
+    create: |_, _| Box::new(Weighted::new(Weighting::Sum)),
 };
 
 pub const WAVG: MethodInfo = MethodInfo {
     name: "wavg",
     summary: "weighted average (Bavoil & Myers 2008): average color, transmittance (1 - mean alpha)^n",
     params: &[],
-    create: |_, _| Box::new(Weighted::new(Kind::Average)),
+    create: |_, _| Box::new(Weighted::new(Weighting::Average)),
     ..WSUM
 };
 
@@ -68,32 +68,32 @@ pub const WBOIT: MethodInfo = MethodInfo {
         kind: ParamKind::Choice { choices: WBOIT_WEIGHTS, default: "eq10" },
         doc: "weight function (paper's eq. 7-10); eq7-9 use the view distance, eq10 the window depth",
     }],
-    create: |_, _| Box::new(Weighted::new(Kind::Blended)),
+    create: |_, _| Box::new(Weighted::new(Weighting::Blended)),
     ..WSUM
 };
 
 const MEMORY: Memory = Memory::Frame { formula: "W·H·20", bytes: |px, _| memory_bytes(px) };
 
 struct Weighted {
-    kind: Kind,
+    kind: Weighting,
     targets: Option<FloatTargets>,
 }
 
 impl Weighted {
-    fn new(kind: Kind) -> Self {
+    fn new(kind: Weighting) -> Self {
         Self { kind, targets: None }
     }
 }
 
 impl Method for Weighted {
-    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<MethodReport> {
-        let weight = if self.kind == Kind::Blended { cx.params.choice("weight") } else { "eq10" };
+    fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
+        let weight = if self.kind == Weighting::Blended { cx.params.choice("weight") } else { "eq10" };
         let eq = weight.trim_start_matches("eq").parse::<u32>().expect("choices are eqN");
         let consts = [Const::U32("WEIGHT", eq)];
         let (fs, resolve_fs, aux) = match self.kind {
-            Kind::Sum => ("fs_sum", "fs_resolve_wsum", Aux::Sum),
-            Kind::Average => ("fs_sum", "fs_resolve_wavg", Aux::Sum),
-            Kind::Blended => ("fs_wboit", "fs_resolve_wboit", Aux::Reveal),
+            Weighting::Sum => ("fs_sum", "fs_resolve_wsum", Aux::Sum),
+            Weighting::Average => ("fs_sum", "fs_resolve_wavg", Aux::Sum),
+            Weighting::Blended => ("fs_wboit", "fs_resolve_wboit", Aux::Reveal),
         };
         let accumulate = cx.draw_pipeline(spec(PIPELINES, fs), &consts, accumulation_targets(aux), pipeline::depth_test_only());
         let resolve = cx.resolve_pipeline(spec(PIPELINES, resolve_fs), &consts, false);
@@ -102,6 +102,6 @@ impl Method for Weighted {
         w.accumulate(cx, &mut enc, aux, &accumulate, &[]);
         cx.resolve(&mut enc, "resolve", &resolve, &w.group, false);
         cx.submit(enc);
-        Ok(MethodReport { memory_bytes: memory_bytes(cx.pixels()), ..Default::default() })
+        Ok(Outcome::Done(MethodReport { memory_bytes: memory_bytes(cx.pixels()), ..Default::default() }))
     }
 }

@@ -1,85 +1,56 @@
 //! The executor: runs a frame tile by tile as the planner says (`plan.rs`). Per tile it draws the
-//! opaque pass into the tile-sized targets, runs the method, and streams the tile's pixels into
-//! the frame's arrays; the census runs first, in bands of rows that the targets hold. Reports of
-//! the tiles merge by declared rules (`stats::Merge`).
+//! opaque pass into the tile-sized targets, asks the method for the tile and acts on its
+//! `Outcome` (done, grown, retile, census needed), and streams the tile's pixels into the
+//! frame's arrays; the census (census.rs) runs first where the frame needs it. Reports of the
+//! tiles merge by declared rules (`stats::Merge`).
 
 use std::time::Instant;
 
 use super::{Frame, Renderer, COVERAGE_SAMPLES};
-use crate::antialias;
-use crate::bindings::{COLOR_FORMAT, COUNT_FORMAT};
-use crate::cache::{Draw, Layout, CENSUS_ATOMIC, CENSUS_BLEND, CENSUS_SAMPLES, EXPAND_PARTICLES, EXPAND_STRANDS, OPAQUE};
-use crate::context::GpuContext;
+use crate::cache::Layout;
 use crate::error::{OitError, Result};
-use crate::gpu_types::{FrameUniform, GpuLight};
-use crate::method::{AntialiasMode, FrameCtx, MethodInfo, MethodReport, Params};
-use crate::passes;
-use crate::pipeline;
+use crate::method::{AntialiasMode, FrameCtx, Method, MethodInfo, MethodReport, Outcome, Params};
 use crate::scene::Camera;
-use crate::shader::SceneVariant;
-use crate::shading::{Lighting, MAX_LIGHTS};
 use crate::stats::{ExtraMerge, Stats};
-use crate::targets::{read_buffer, read_region, SampleTargets, Targets};
+use crate::targets::{read_region, SampleTargets, Targets};
 use crate::tiles::Tile;
-use crate::upload::GpuScene;
 
-/// The opaque pass's pipeline for `variant`: straight color, writes depth.
-fn opaque_pipeline(gpu: &GpuContext, variant: SceneVariant) -> wgpu::RenderPipeline {
-    let desc =
-        OPAQUE.render(&variant.consts(), Draw::Geometry { depth: pipeline::depth_write(), samples: 1 }, vec![Some(COLOR_FORMAT.into())]);
-    gpu.cache.render(&gpu.device, &desc)
+/// One frame as the executor runs it: what is drawn with which method, and in which mode.
+pub(super) struct Job<'a> {
+    pub camera: &'a Camera,
+    pub info: &'static MethodInfo,
+    pub params: &'a Params,
+    pub background: [f32; 3],
+    /// A coverage-mask frame at COVERAGE_SAMPLES samples a pixel: the executor draws the
+    /// opaque pass per sample and hands the method the per-sample targets (`FrameCtx::coverage`).
+    pub coverage: bool,
 }
 
-/// How the census counts: by blending into the count target where the adapter blends float32
-/// (one pass, no atomics), else with an atomic a fragment into the counts buffer; a
-/// coverage-mask frame counts with atomics at each sample's coverage.
-#[derive(Clone, Copy, PartialEq)]
-enum CensusKind {
-    Blend,
-    Atomic,
-    Samples,
+/// Where a frame's fragment counts come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Counting {
+    /// No counts: the method plans from none and the caller asked for none.
+    Off,
+    /// The census runs before the method.
+    Census,
+    /// The method counts each pixel's fragments in its own capture (`Method::counts_in_capture`)
+    /// and reports them; a frame that does not fit one tile needs the census after all.
+    InCapture,
 }
 
-/// The census pipeline of `kind`. The census reads only positions: its variant is the unlit
-/// one, or for a scene with a material table (`shaded`) the shaded one without lights, whose
-/// vertex shader drops the back faces a material culls (common/scene.wgsl); instanced where the
-/// scene is.
-fn census_pipeline(gpu: &GpuContext, kind: CensusKind, scene: &GpuScene) -> wgpu::RenderPipeline {
-    let variant = SceneVariant {
-        shaded: scene.shaded,
-        instanced: scene.instanced,
-        primitives: scene.primitives,
-        sets_only: scene.sets_only,
-        ..Default::default()
-    }
-    .consts();
-    let add = wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    };
-    let desc = match kind {
-        CensusKind::Blend => CENSUS_BLEND.render(
-            &variant,
-            Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 },
-            vec![Some(wgpu::ColorTargetState {
-                format: COUNT_FORMAT,
-                blend: Some(wgpu::BlendState { color: add, alpha: add }),
-                write_mask: wgpu::ColorWrites::RED,
-            })],
-        ),
-        CensusKind::Atomic => CENSUS_ATOMIC.render(&variant, Draw::Geometry { depth: pipeline::depth_test_only(), samples: 1 }, vec![]),
-        CensusKind::Samples => {
-            CENSUS_SAMPLES.render(&variant, Draw::Geometry { depth: pipeline::raster_only(), samples: COVERAGE_SAMPLES }, vec![])
-        }
-    };
-    gpu.cache.render(&gpu.device, &desc)
+/// The tiles of a frame once rendered: how many, their merged report, their pass times, and
+/// the frame's pixels.
+struct Rendered {
+    tiles: u32,
+    report: MethodReport,
+    pass_times: Option<Vec<(&'static str, f64)>>,
+    arrays: FrameArrays,
 }
 
 /// What a coverage-mask frame needs besides the frame targets: the per-sample targets (the
 /// census is multisampled: `census_pipeline`), at the tile size.
 pub(super) struct Coverage {
-    targets: SampleTargets,
+    pub(super) targets: SampleTargets,
     size: (u32, u32),
 }
 
@@ -116,38 +87,33 @@ impl FrameArrays {
 }
 
 impl Renderer {
-    /// One frame with the pixel centers where `camera` puts them (the scene is uploaded); with
-    /// `coverage`, a coverage-mask frame at COVERAGE_SAMPLES samples a pixel.
-    pub(super) fn render_sample(
-        &mut self,
-        camera: &Camera,
-        info: &'static MethodInfo,
-        params: &Params,
-        background: [f32; 3],
-        coverage: bool,
-    ) -> Result<Frame> {
-        match self.render_counted(camera, info, params, background, coverage, true)? {
+    /// One frame of `job` with the pixel centers where its camera puts them (the scene is
+    /// uploaded).
+    pub(super) fn render_sample(&mut self, job: &Job<'_>) -> Result<Frame> {
+        match self.run_frame(job, true)? {
             Some(frame) => Ok(frame),
             // The method's own count did not fit one pool in one tile: the census plans tiles.
-            None => Ok(self.render_counted(camera, info, params, background, coverage, false)?.expect("a census frame is rendered")),
+            None => Ok(self.run_frame(job, false)?.expect("a frame with the census is rendered")),
         }
     }
 
-    /// `render_sample`; with `self_count`, a method that counts its fragments in its own
-    /// capture (`Method::counts_in_capture`) does so in place of the census, where the frame
-    /// is whole, one sample and without a budget. None: that frame did not fit one tile, and
-    /// needs the census after all.
-    fn render_counted(
-        &mut self,
-        camera: &Camera,
-        info: &'static MethodInfo,
-        params: &Params,
-        background: [f32; 3],
-        coverage: bool,
-        self_count: bool,
-    ) -> Result<Option<Frame>> {
+    /// Where this frame's counts come from; a method may count in its own capture (where
+    /// `self_count`) in a whole, one-sample frame without a budget.
+    fn counting(&self, job: &Job<'_>, method: &dyn Method, self_count: bool) -> Counting {
+        let needs = job.info.needs_census(job.params);
+        let in_capture = self_count && needs && !self.census && !job.coverage && self.memory_budget.is_none() && method.counts_in_capture();
+        match () {
+            _ if in_capture => Counting::InCapture,
+            _ if needs || self.census => Counting::Census,
+            _ => Counting::Off,
+        }
+    }
+
+    /// `render_sample`; None where the method counted in its capture and the frame needs the
+    /// census after all (`Outcome::NeedCensus`).
+    fn run_frame(&mut self, job: &Job<'_>, self_count: bool) -> Result<Option<Frame>> {
         let start = Instant::now();
-        let gpu = self.gpu.clone();
+        let info = job.info;
         let (w, h) = (self.width, self.height);
         if self.memory_budget.is_some() {
             // Under a budget no method keeps storage between frames: what the frame allocates
@@ -156,65 +122,41 @@ impl Renderer {
         }
         let limits = self.limits;
         // Out of the map while it renders, so that the loop can set each tile's uniform.
-        let mut method = self.methods.remove(info.name).unwrap_or_else(|| info.instantiate(&gpu, &limits));
-        // A method that counts in its capture reports the counts the census would have.
-        let self_counted = self_count
-            && info.needs_census(params)
-            && !self.census
-            && !coverage
-            && self.memory_budget.is_none()
-            && method.counts_in_capture();
-        let census = (info.needs_census(params) && !self_counted) || self.census;
-        let expand_times = self.expand_primitives(camera, background)?;
-        // The census, in bands of rows the targets hold; `drawn` is the tile whose opaque pass
-        // the targets hold.
-        let mut counts = Vec::new();
-        let mut drawn = None;
-        if census {
-            let rows = self.census_rows(coverage)?;
-            counts = vec![0u32; w as usize * h as usize];
-            for y in (0..h).step_by(rows as usize) {
-                let mut band = Tile { x: 0, y, width: w, height: rows.min(h - y), frame: (w, h), origin: (0, 0) };
-                if rows < h {
-                    band = band.own_targets();
-                }
-                self.ensure_targets(w, rows, coverage)?;
-                self.draw_opaque(band, camera, background, coverage, true);
-                let values = self.read_census(band, coverage)?;
-                counts[(y * w) as usize..(y * w) as usize + values.len()].copy_from_slice(&values);
-                drawn = Some(band);
-            }
-        }
-        let result = self.run_tiles(&mut *method, camera, info, params, background, coverage, &counts, drawn, self_counted);
+        let mut method = self.methods.remove(info.name).unwrap_or_else(|| info.instantiate(&self.gpu, &limits));
+        let counting = self.counting(job, &*method, self_count);
+        let expand_times = self.expand_primitives(job.camera, job.background)?;
+        let (mut counts, drawn) = match counting {
+            Counting::Census => self.count_fragments(job)?,
+            _ => (Vec::new(), None),
+        };
+        let result = self.run_tiles(&mut *method, job, counting, &counts, drawn);
         if self.memory_budget.is_none() {
             self.methods.insert(info.name, method);
         }
-        let Some((tiles, mut report, mut pass_times, arrays)) = result? else {
+        let Some(Rendered { tiles, mut report, mut pass_times, arrays }) = result? else {
             return Ok(None);
         };
         if let Some(c) = report.counts.take() {
             counts = c;
         }
-        let max_depth_complexity = counts.iter().copied().max().unwrap_or(0);
-        let fragments: u64 = counts.iter().map(|&c| c as u64).sum();
         if let (Some(p), Some(mut e)) = (pass_times.as_mut(), expand_times) {
             e.append(p);
             *p = e;
         }
         if let (Some(into), Some(t)) = (&self.into, &self.targets) {
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
             self.blit(&mut enc, &t.out, &into.color, wgpu::ColorWrites::COLOR, into.encode_srgb);
-            gpu.queue.submit([enc.finish()]);
+            self.gpu.queue.submit([enc.finish()]);
         }
         let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
-        self.set_uniform(camera, gpu_scene, background, Tile::frame(w, h));
+        self.set_uniform(job.camera, gpu_scene, job.background, Tile::frame(w, h));
         let target_bytes = self.held_target_bytes();
         let stats = Stats {
             method: info.name.to_string(),
-            params: params.clone(),
-            census: census || self_counted,
-            fragments,
-            max_depth_complexity,
+            params: job.params.clone(),
+            census: counting != Counting::Off,
+            fragments: counts.iter().map(|&c| c as u64).sum(),
+            max_depth_complexity: counts.iter().copied().max().unwrap_or(0),
             memory_bytes: report.memory_bytes,
             target_bytes,
             scene_bytes: gpu_scene.bytes().iter().sum(),
@@ -228,7 +170,7 @@ impl Renderer {
             extra: report.extra,
             antialias: 1,
             antialias_mode: AntialiasMode::Frames,
-            tiles: tiles.len() as u32,
+            tiles,
             geometry_chunks: gpu_scene.transparent.chunks.len() as u32,
             instances: gpu_scene.instances,
             peak_memory_bytes: report.memory_bytes + target_bytes,
@@ -237,44 +179,40 @@ impl Renderer {
         Ok(Some(Frame { width: w, height: h, image: arrays.image, depth_complexity: counts, error_bound: arrays.bound, stats }))
     }
 
-    /// Renders `method` over the planned tiles, each into the targets and then into the frame's
-    /// arrays. A method whose storage proves larger than planned (pall's pool follows its
-    /// triangles' bounding boxes, not the fragments) is planned again with the budget divided by
-    /// how far it went over. With `self_counted` (no census ran: the method counts in its own
-    /// capture), None where the frame would need more than one tile or pool.
-    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    /// Renders the method over the planned tiles, each into the targets and then into the
+    /// frame's arrays, acting on each tile's `Outcome`. A method whose storage proves larger
+    /// than planned (pall's pool follows its triangles' bounding boxes, not the fragments), or a
+    /// frame past the memory budget, is planned again with the budget divided by how far it went
+    /// over. None where the method counts in its capture (no census ran) and the frame would
+    /// need more than one tile or pool.
     fn run_tiles(
         &mut self,
-        method: &mut dyn crate::method::Method,
-        camera: &Camera,
-        info: &'static MethodInfo,
-        params: &Params,
-        background: [f32; 3],
-        coverage: bool,
+        method: &mut dyn Method,
+        job: &Job<'_>,
+        counting: Counting,
         counts: &[u32],
         mut drawn: Option<Tile>,
-        self_counted: bool,
-    ) -> Result<Option<(Vec<Tile>, MethodReport, Option<Vec<(&'static str, f64)>>, FrameArrays)>> {
-        let gpu = self.gpu.clone();
+    ) -> Result<Option<Rendered>> {
         let (w, h) = (self.width, self.height);
-        let frame_max_depth_complexity = counts.iter().copied().max().unwrap_or(0);
+        let in_capture = counting == Counting::InCapture;
         let mut squeeze = 1.0f64;
         loop {
-            let plan = self.plan_tiles(info, params, counts, coverage, squeeze, self_counted)?;
+            let plan = self.plan_tiles(job.info, job.params, counts, job.coverage, squeeze, in_capture)?;
             if self.into.is_some() && plan.targets != (w, h) {
                 return Err(self.target_refused());
             }
             let tiles = plan.tiles;
-            if self_counted && !(tiles.len() == 1 && tiles[0].is_whole()) {
+            if in_capture && !(tiles.len() == 1 && tiles[0].is_whole()) {
                 return Ok(None);
             }
-            if self.ensure_targets(plan.targets.0, plan.targets.1, coverage)? {
+            if self.ensure_targets(plan.targets.0, plan.targets.1, job.coverage)? {
                 drawn = None;
             }
             let mut report = MethodReport::default();
             let mut extra = ExtraMerge::default();
             let mut pass_times: Option<Vec<(&'static str, f64)>> = None;
             let mut arrays = FrameArrays::new(w, h);
+            let mut retile = None;
             for tile in &tiles {
                 let tile_counts: std::borrow::Cow<[u32]> = match tiles.len() {
                     _ if counts.is_empty() => (&[] as &[u32]).into(),
@@ -282,39 +220,20 @@ impl Renderer {
                     _ => tile.crop(counts, w).into(),
                 };
                 if drawn != Some(*tile) {
-                    self.draw_opaque(*tile, camera, background, coverage, false);
+                    self.draw_opaque(*tile, job, false);
                 }
                 drawn = None; // the method's passes overwrite what the next tile would reuse
-                let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
-                self.set_uniform(camera, gpu_scene, background, *tile);
-                self.timer.reset();
-                let variant = self.variant(gpu_scene);
-                let mut cx = FrameCtx {
-                    gpu: &gpu,
-                    scene: gpu_scene,
-                    camera,
-                    targets: self.targets.as_ref().expect("made above"),
-                    timer: &mut self.timer,
-                    params,
-                    tile: *tile,
-                    max_depth_complexity: tile_counts.iter().copied().max().unwrap_or(0),
-                    frame_max_depth_complexity,
-                    fragments: tile_counts.iter().map(|&c| c as u64).sum(),
-                    depth_complexity: &tile_counts,
-                    frame_uniform: &self.shared.uniform,
-                    limits: self.limits,
-                    coverage: self.coverage.as_ref().filter(|_| coverage).map(|c| &c.targets),
-                    variant,
+                let r = match self.render_tile(method, job, *tile, &tile_counts, counts)? {
+                    Outcome::Done(r) if in_capture && r.counts.is_none() => return Ok(None),
+                    Outcome::Done(r) => r,
+                    Outcome::NeedCensus => return Ok(None),
+                    Outcome::Retile { factor } => {
+                        retile = Some(factor);
+                        break;
+                    }
+                    Outcome::Grow => unreachable!("render_tile renders a grown tile again"),
                 };
-                let r = method.render(&mut cx)?;
-                if self_counted && (r.pool_short.is_some() || r.counts.is_none()) {
-                    return Ok(None);
-                }
-                if let Some(short) = r.pool_short {
-                    report.pool_short = Some(short);
-                    break;
-                }
-                if let Some(t) = self.timer.read(&gpu)? {
+                if let Some(t) = self.timer.read(&self.gpu)? {
                     pass_times.get_or_insert_with(Vec::new).extend(t);
                 }
                 report.memory_bytes = report.memory_bytes.max(r.memory_bytes);
@@ -324,9 +243,9 @@ impl Renderer {
                 self.read_tile(*tile, r.error_bound, &mut arrays)?;
             }
             report.extra = extra.finish();
-            if let Some(short) = report.pool_short {
+            if let Some(factor) = retile {
                 if squeeze < 1e6 {
-                    squeeze *= 1.25 * short;
+                    squeeze *= 1.25 * factor;
                     continue;
                 }
             }
@@ -339,10 +258,50 @@ impl Renderer {
                     return Err(OitError::OutOfMemory(format!(
                         "'{}' needed {peak} bytes in its smallest tiles (its storage and the frame's targets), past the \
                          memory_budget of {budget} bytes: raise memory_budget or use a bounded method (e.g. hybrid)",
-                        info.name
+                        job.info.name
                     )));
                 }
-                _ => return Ok(Some((tiles, report, pass_times, arrays))),
+                _ => return Ok(Some(Rendered { tiles: tiles.len() as u32, report, pass_times, arrays })),
+            }
+        }
+    }
+
+    /// The method's outcome for `tile` (its pixels' counts `tile_counts`, the frame's
+    /// `frame_counts`): rendered again for as long as the method grows its storage.
+    fn render_tile(
+        &mut self,
+        method: &mut dyn Method,
+        job: &Job<'_>,
+        tile: Tile,
+        tile_counts: &[u32],
+        frame_counts: &[u32],
+    ) -> Result<Outcome> {
+        let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
+        self.set_uniform(job.camera, gpu_scene, job.background, tile);
+        let variant = self.variant(gpu_scene);
+        loop {
+            self.timer.reset();
+            let mut cx = FrameCtx {
+                gpu: &self.gpu,
+                scene: gpu_scene,
+                camera: job.camera,
+                targets: self.targets.as_ref().expect("made by ensure_targets"),
+                timer: &mut self.timer,
+                params: job.params,
+                tile,
+                max_depth_complexity: tile_counts.iter().copied().max().unwrap_or(0),
+                frame_max_depth_complexity: frame_counts.iter().copied().max().unwrap_or(0),
+                fragments: tile_counts.iter().map(|&c| c as u64).sum(),
+                depth_complexity: tile_counts,
+                frame_uniform: &self.shared.uniform,
+                limits: self.limits,
+                coverage: self.coverage.as_ref().filter(|_| job.coverage).map(|c| &c.targets),
+                variant,
+            };
+            match method.render(&mut cx)? {
+                // The storage grew to what the tile needs: the tile again, over the same opaque pass.
+                Outcome::Grow => continue,
+                outcome => return Ok(outcome),
             }
         }
     }
@@ -358,7 +317,7 @@ impl Renderer {
         let mut made = false;
         if self.targets.as_ref().is_none_or(|t| (t.width, t.height) != (width, height)) {
             self.targets = None; // free the old ones first
-            self.targets = Some(Targets::new(&self.gpu, width, height, &self.shared.targets_layout, &self.shared.counts_layout));
+            self.targets = Some(Targets::new(&self.gpu, width, height, &self.shared.targets_layout));
             made = true;
         }
         if !coverage {
@@ -392,199 +351,4 @@ impl Renderer {
         }
         Ok(())
     }
-
-    /// How this frame's census counts (`CensusKind`).
-    fn census_kind(&self, coverage: bool) -> CensusKind {
-        match coverage {
-            true => CensusKind::Samples,
-            false if !self.atomic_census && self.gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) => CensusKind::Blend,
-            false => CensusKind::Atomic,
-        }
-    }
-
-    /// The census's per-pixel counts of `tile`, row-major.
-    fn read_census(&self, tile: Tile, coverage: bool) -> Result<Vec<u32>> {
-        let t = self.targets.as_ref().expect("made by ensure_targets");
-        Ok(match self.census_kind(coverage) {
-            // Whole numbers below 2^24, exact in float32.
-            CensusKind::Blend => {
-                read_region(&self.gpu, &t.count_texture, &t.counts_readback, 4, tile.local())?.iter().map(|&c| c as u32).collect()
-            }
-            _ => bytemuck::pod_collect_to_vec(&read_buffer(&self.gpu, &t.counts_readback, tile.pixels() * 4)?),
-        })
-    }
-
-    /// Builds the strand and particle corners under `camera` (shaders/expand.wgsl), once a
-    /// frame before any pass draws them; nothing where the scene has none, or where the corners
-    /// in `expanded` were built for this scene under the same matrices (a still camera, or
-    /// another method of `oit compare` on the same view: no pass "expand" then).
-    /// Its time is the frame's pass "expand": the wall time of its submission, waited for, and
-    /// not timestamps, because on lavapipe a compute pass's timestamp queries make the draws
-    /// after it up to twice as slow (docs/results.md, "Strands against triangle ribbons").
-    fn expand_primitives(&mut self, camera: &Camera, bg: [f32; 3]) -> Result<Option<Vec<(&'static str, f64)>>> {
-        let (w, h) = (self.width, self.height);
-        let Some((_, scene)) = self.scene.as_ref().filter(|(_, s)| s.primitives) else { return Ok(None) };
-        // The corners depend on the uploaded scene and on the two matrices the uniform carries;
-        // a scene that changes is uploaded again (GpuScene::new, which forgets the view).
-        let view = expansion_view(camera);
-        if scene.expanded_view.get() == Some(view) {
-            return Ok(None);
-        }
-        self.set_uniform(camera, scene, bg, Tile::frame(w, h));
-        let consts = self.variant(scene).consts();
-        // Compiled for the kinds the scene has (the cache keeps them).
-        let pipeline = |strands: bool| {
-            let spec = if strands { &EXPAND_STRANDS } else { &EXPAND_PARTICLES };
-            self.gpu.cache.compute(&self.gpu.device, &spec.compute_desc(&consts))
-        };
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("expand"), timestamp_writes: None });
-            scene.transparent.expand(&mut pass, pipeline);
-            scene.opaque.expand(&mut pass, pipeline);
-        }
-        scene.expanded_view.set(Some(view));
-        if !self.timer.enabled() {
-            self.gpu.queue.submit([enc.finish()]);
-            return Ok(None);
-        }
-        let start = Instant::now();
-        self.gpu.queue.submit([enc.finish()]);
-        self.gpu.wait()?;
-        Ok(Some(vec![("expand", start.elapsed().as_secs_f64() * 1e3)]))
-    }
-
-    /// Writes the frame uniform for `camera` and the screen tile `tile`.
-    pub(super) fn set_uniform(&self, camera: &Camera, scene: &GpuScene, bg: [f32; 3], tile: Tile) {
-        let lighting = Lighting::new(&self.lights.0, self.lights.1, camera.view_direction());
-        let mut lights = [GpuLight::default(); MAX_LIGHTS as usize];
-        for (g, (l, radiance)) in lights.iter_mut().zip(&lighting.lights) {
-            g.to_light = l.as_vec3().extend(0.0).to_array();
-            g.radiance = radiance.as_vec3().extend(0.0).to_array();
-        }
-        let a = lighting.ambient.as_vec3();
-        let uniform = FrameUniform {
-            view_proj: camera.matrix_f32().to_cols_array_2d(),
-            background: [bg[0], bg[1], bg[2], 0.0],
-            size: [self.width, self.height],
-            triangle_count: scene.transparent.triangles,
-            seed: 0,
-            tile_origin: [tile.x - tile.origin.0, tile.y - tile.origin.1],
-            tile_size: [tile.width, tile.height],
-            target_origin: [tile.origin.0, tile.origin.1],
-            pad: [0; 2],
-            inv_view_proj: camera.view_proj.inverse().as_mat4().to_cols_array_2d(),
-            ambient: [a.x, a.y, a.z, 0.0],
-            lights,
-        };
-        self.gpu.queue.write_buffer(&self.shared.uniform, 0, bytemuck::bytes_of(&uniform));
-    }
-
-    /// Opaque geometry into a base color and depth target over `tile` (under the current
-    /// uniform), over the background or, in a frame into a caller's texture with its depth, over
-    /// the caller's picture and depth.
-    fn opaque_pass(&self, enc: &mut wgpu::CommandEncoder, tile: Tile, color: &wgpu::TextureView, depth: &wgpu::TextureView, bg: [f32; 3]) {
-        let (_, scene) = self.scene.as_ref().expect("uploaded by the caller");
-        let over = self.into.as_ref().and_then(|i| i.depth.as_ref().map(|d| (&i.color, d)));
-        let (color_load, depth_load) = match over {
-            Some((picture, caller_depth)) => {
-                let t = self.targets.as_ref().expect("made by ensure_targets");
-                enc.copy_texture_to_texture(caller_depth.as_image_copy(), t.depth_texture.as_image_copy(), caller_depth.size());
-                self.blit(enc, &picture.create_view(&Default::default()), &t.base_texture, wgpu::ColorWrites::ALL, false);
-                (wgpu::LoadOp::Load, wgpu::LoadOp::Load)
-            }
-            None => {
-                (wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 0.0 }), wgpu::LoadOp::Clear(1.0))
-            }
-        };
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("opaque"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: color,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: color_load, store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations { load: depth_load, store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        tile.scissor(&mut pass);
-        pass.set_pipeline(&opaque_pipeline(&self.gpu, self.variant(scene)));
-        scene.opaque.draw_all(&mut pass);
-    }
-
-    /// The opaque pass of `tile` under `camera` (for a coverage-mask frame, one per sample
-    /// position into the sample targets), then with `census` the untimed fragment census,
-    /// copied to its readback.
-    fn draw_opaque(&self, tile: Tile, camera: &Camera, bg: [f32; 3], coverage: bool, census: bool) {
-        let t = self.targets.as_ref().expect("made by ensure_targets");
-        let (_, scene) = self.scene.as_ref().expect("uploaded by the caller");
-        let cov = self.coverage.as_ref().filter(|_| coverage);
-        if let Some(c) = cov {
-            let offsets = antialias::sample_offsets(c.targets.samples).expect("a supported sample count");
-            for (s, offset) in offsets.iter().enumerate() {
-                self.set_uniform(&camera.jittered(*offset, self.width, self.height), scene, bg, tile);
-                let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-                self.opaque_pass(&mut enc, tile, &c.targets.base_layers[s], &c.targets.depth_layers[s], bg);
-                self.gpu.queue.submit([enc.finish()]);
-            }
-        }
-        self.set_uniform(camera, scene, bg, tile);
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        if cov.is_none() {
-            self.opaque_pass(&mut enc, tile, &t.base, &t.depth, bg);
-        }
-        if census {
-            match self.census_kind(coverage) {
-                CensusKind::Blend => {
-                    let count = wgpu::RenderPassColorAttachment {
-                        view: &t.count,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
-                    };
-                    let mut pass = passes::capture_into(&mut enc, "census", &t.depth, &[Some(count)], None);
-                    tile.scissor(&mut pass);
-                    pass.set_pipeline(&census_pipeline(&self.gpu, CensusKind::Blend, scene));
-                    scene.transparent.draw_all(&mut pass);
-                }
-                kind => {
-                    enc.clear_buffer(&t.counts, 0, None);
-                    let (group, depth) = match cov {
-                        Some(c) => (&c.targets.group, &c.targets.raster_depth),
-                        None => (&t.group, &t.depth),
-                    };
-                    {
-                        let mut pass = passes::capture_pass(&mut enc, "census", depth, None);
-                        tile.scissor(&mut pass);
-                        pass.set_pipeline(&census_pipeline(&self.gpu, kind, scene));
-                        pass.set_bind_group(1, group, &[]);
-                        pass.set_bind_group(2, &t.counts_group, &[]);
-                        scene.transparent.draw_all(&mut pass);
-                    }
-                    let bytes = (tile.pixels() * 4).min(t.counts.size()).min(t.counts_readback.size());
-                    enc.copy_buffer_to_buffer(&t.counts, 0, &t.counts_readback, 0, bytes);
-                }
-            }
-        }
-        self.gpu.queue.submit([enc.finish()]);
-    }
-}
-
-/// What the expansion reads of the camera, as the frame uniform carries it: the view-projection
-/// and its inverse, float32 bits (their equality is the corners').
-fn expansion_view(camera: &Camera) -> [u32; 32] {
-    let mut bits = [0u32; 32];
-    let a = camera.matrix_f32().to_cols_array();
-    let b = camera.view_proj.inverse().as_mat4().to_cols_array();
-    for (o, v) in bits.iter_mut().zip(a.iter().chain(&b)) {
-        *o = v.to_bits();
-    }
-    bits
 }

@@ -4,7 +4,7 @@
 
 use super::Renderer;
 use crate::bindings::DEPTH_FORMAT;
-use crate::cache::{Draw, BLIT, BLIT_SRGB};
+use crate::cache::{bind_named, Draw, BLIT, BLIT_SRGB};
 use crate::error::{invalid, Result};
 use crate::method::ParamValue;
 use crate::scene::{Camera, Scene};
@@ -80,7 +80,7 @@ impl Renderer {
         }
         let (info, params) = self.prepare(scene, method_name, params, background)?;
         self.into = Some(IntoTarget { color: target.color.clone(), depth: target.depth.cloned(), encode_srgb: target.encode_srgb });
-        let frame = self.render_sample(camera, info, &params, background, false);
+        let frame = self.render_sample(&super::execute::Job { camera, info, params: &params, background, coverage: false });
         self.into = None;
         let mut stats = frame?.stats;
         stats.finish(&self.gpu.info.name, None);
@@ -101,12 +101,13 @@ impl Renderer {
         let color = wgpu::ColorTargetState { format: target.format(), blend: None, write_mask: mask };
         let spec = if encode_srgb { &BLIT_SRGB } else { &BLIT };
         let pipeline = self.gpu.cache.render(d, &spec.render(&[], Draw::Fullscreen, vec![Some(color)]));
-        let layout = self.gpu.cache.layout(d, BLIT.groups[0]);
-        let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("blit"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(source) }],
-        });
+        let group = bind_named(
+            &self.gpu.device,
+            &self.gpu.cache,
+            BLIT.groups[0],
+            "blit",
+            &[("source", wgpu::BindingResource::TextureView(source))],
+        );
         let view = target.create_view(&Default::default());
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("blit"),
