@@ -20,7 +20,7 @@ pub(crate) const REVEAL: wgpu::BlendComponent = wgpu::BlendComponent {
 
 /// How the companion target blends and what it starts from.
 #[derive(Clone, Copy, PartialEq)]
-pub(crate) enum Aux {
+pub(crate) enum Companion {
     /// Summed from zero (a count or an alpha sum).
     Sum,
     /// Multiplied down from one (revealage).
@@ -37,8 +37,8 @@ pub(crate) fn blended(format: wgpu::TextureFormat, blend: wgpu::BlendComponent) 
 }
 
 /// The two color targets of the accumulation pass (`Accum` of shaders/common/accum_targets.wgsl).
-pub(crate) fn accumulation_targets(aux: Aux) -> Vec<Option<wgpu::ColorTargetState>> {
-    vec![blended(ACCUM_FORMAT, ADD), blended(AUX_FORMAT, if aux == Aux::Reveal { REVEAL } else { ADD })]
+pub(crate) fn accumulation_targets(aux: Companion) -> Vec<Option<wgpu::ColorTargetState>> {
+    vec![blended(ACCUM_FORMAT, ADD), blended(AUX_FORMAT, if aux == Companion::Reveal { REVEAL } else { ADD })]
 }
 
 /// Bytes a pixel of the two targets.
@@ -118,11 +118,11 @@ impl FloatTargets {
         &self,
         cx: &mut FrameCtx<'_>,
         enc: &mut wgpu::CommandEncoder,
-        aux: Aux,
+        aux: Companion,
         pipeline: &wgpu::RenderPipeline,
         groups: &[&wgpu::BindGroup],
     ) {
-        let aux_clear = if aux == Aux::Reveal { wgpu::Color::WHITE } else { wgpu::Color::TRANSPARENT };
+        let aux_clear = if aux == Companion::Reveal { wgpu::Color::WHITE } else { wgpu::Color::TRANSPARENT };
         let attachments = self.attachments(&[wgpu::Color::TRANSPARENT, aux_clear]);
         let (depth, scene) = (&cx.targets.depth, cx.scene);
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -2,7 +2,7 @@
 //! `samples` coverage samples per pixel kept in a storage buffer: a stochastic depth pass,
 //! an accumulation pass and a resolve (shaders/stochastic.wgsl). Deterministic for a seed.
 
-use super::accum::{accumulation_targets, Aux, FloatTargets};
+use super::accum::{accumulation_targets, Companion, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
@@ -78,14 +78,14 @@ impl Method for Stochastic {
         let consts = [Const::U32("SAMPLES", samples)];
         let depth = cx.capture_pipeline(spec(PIPELINES, "fs_depth"), &consts);
         let accumulate =
-            cx.draw_pipeline(spec(PIPELINES, "fs_accum"), &consts, accumulation_targets(Aux::Reveal), pipeline::depth_test_only());
+            cx.draw_pipeline(spec(PIPELINES, "fs_accum"), &consts, accumulation_targets(Companion::Reveal), pipeline::depth_test_only());
         let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, false);
         let offset = std::mem::offset_of!(FrameUniform, seed) as u64;
         cx.gpu.queue.write_buffer(cx.frame_uniform, offset, bytemuck::bytes_of(&seed));
         let mut enc = cx.encoder();
         b.clear(&mut enc);
         cx.capture(&mut enc, "depth", &depth, &b.group);
-        w.accumulate(cx, &mut enc, Aux::Reveal, &accumulate, &[&cx.targets.group, &b.group]);
+        w.accumulate(cx, &mut enc, Companion::Reveal, &accumulate, &[&cx.targets.group, &b.group]);
         cx.resolve(&mut enc, "resolve", &resolve, &w.group, false);
         cx.submit(enc);
         // The samples are the tile's; the targets are the frame's, shared by its tiles.

@@ -1,7 +1,7 @@
 //! `wsum`, `wavg` and `wboit`: one geometry pass with additive (and, for wboit's revealage,
 //! multiplicative) blending into two float targets, then a full-screen resolve.
 
-use super::accum::{accumulation_targets, memory_bytes, Aux, FloatTargets};
+use super::accum::{accumulation_targets, memory_bytes, Companion, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::params::{ParamInfo, ParamKind};
@@ -91,9 +91,9 @@ impl Method for Weighted {
         let eq = weight.trim_start_matches("eq").parse::<u32>().expect("choices are eqN");
         let consts = [Const::U32("WEIGHT", eq)];
         let (fs, resolve_fs, aux) = match self.kind {
-            Weighting::Sum => ("fs_sum", "fs_resolve_wsum", Aux::Sum),
-            Weighting::Average => ("fs_sum", "fs_resolve_wavg", Aux::Sum),
-            Weighting::Blended => ("fs_wboit", "fs_resolve_wboit", Aux::Reveal),
+            Weighting::Sum => ("fs_sum", "fs_resolve_wsum", Companion::Sum),
+            Weighting::Average => ("fs_sum", "fs_resolve_wavg", Companion::Sum),
+            Weighting::Blended => ("fs_wboit", "fs_resolve_wboit", Companion::Reveal),
         };
         let accumulate = cx.draw_pipeline(spec(PIPELINES, fs), &consts, accumulation_targets(aux), pipeline::depth_test_only());
         let resolve = cx.resolve_pipeline(spec(PIPELINES, resolve_fs), &consts, false);
