@@ -38,10 +38,9 @@ ORDER_TIES = [n for n in NAMES if INFO[n]["order"] == "bitwise_except_ties"]
 SUBMISSION_TIES = [n for n in EXACT if n in ORDER_TIES]
 
 # The registry's `order` (docs/methods.md, "Guarantees"): the exact methods and those
-# bit-identical under any submission order ("bitwise") with a CPU model of one pixel's stack
-# here (screen_door's model depends on the pixel, bucket_peeling keeps a bucket's nearest).
+# bit-identical under any submission order ("bitwise").
 BIT_ORDER_INDEPENDENT = sorted(n for n in NAMES if (INFO[n]["exact"] and INFO[n]["order_independent"])
-                               or (INFO[n]["order"] == "bitwise" and n in models.MODELS))
+                               or INFO[n]["order"] == "bitwise")
 # Commutative float accumulation (additive or multiplicative blending): a reordered
 # submission changes only the last bits.
 SUM_ORDER_INDEPENDENT = sorted(n for n in NAMES if INFO[n]["order"] == "rounding")
@@ -68,12 +67,24 @@ def over_blend(rgb: np.ndarray, alpha: np.ndarray, bg: Sequence[float], bg_a: fl
     return np.append(c, a)
 
 
+# The plain blends, modelled here (over_blend) rather than in oit.models.
+LOCAL_MODELS = ("unsorted", "sorted")
+
+
+def has_model(name: str) -> bool:
+    """Whether expected() has a CPU model of `name`: every registered method must."""
+    return INFO[name]["exact"] or name in LOCAL_MODELS or name in models.MODELS
+
+
 def expected(name: str, z, rgb, alpha, bg=BG, bg_a: float = 0.0, mesh_per_fragment: bool = False,
-             pixel=(0, 0), **params) -> np.ndarray | None:
-    """RGBA that `name` should return on one pixel's stack given in submission order, or None
-    when there is no CPU model of it. `mesh_per_fragment`: each fragment is its own mesh
-    (what `sorted` sorts); otherwise all of them are one mesh, drawn in submission order.
-    `pixel` (row, col) goes to models that depend on it (screen_door's dither)."""
+             pixel=(0, 0), size=(1, 1), prims=None, **params) -> np.ndarray:
+    """RGBA that `name` should return on one pixel's stack given in submission order.
+    `mesh_per_fragment`: each fragment is its own mesh (what `sorted` sorts); otherwise all of
+    them are one mesh, drawn in submission order. `pixel` (row, col) of a `size` (w, h) frame and
+    `prims` (each fragment's triangle index) go to models that depend on them (screen_door's
+    dither, stochastic's noise). A method with no model raises LookupError, never a skip."""
+    if not has_model(name):
+        raise LookupError(f"no CPU model of {name!r}: add one to oit.models.MODELS")
     z, rgb, alpha = np.asarray(z, np.float64), np.asarray(rgb, np.float64).reshape(-1, 3), np.asarray(alpha, np.float64)
     if INFO[name]["exact"]:
         return models.exact(z, rgb, alpha, bg, bg_a)
@@ -82,21 +93,32 @@ def expected(name: str, z, rgb, alpha, bg=BG, bg_a: float = 0.0, mesh_per_fragme
     if name == "sorted":
         back_to_front = np.argsort(-z, kind="stable")
         return over_blend(rgb[back_to_front], alpha[back_to_front], bg, bg_a)
-    if name not in models.MODELS:
-        return None
     p = dict(params)
     if name == "wboit":
         p = {"eq": int(str(p.get("weight", "eq10"))[2:])}
     model = models.MODELS[name]
-    if "pixel" in inspect.signature(model).parameters:
-        p["pixel"] = tuple(pixel)
+    wants = inspect.signature(model).parameters
+    p.update({k: v for k, v in (("pixel", tuple(pixel)), ("size", tuple(size)), ("prims", prims)) if k in wants})
     return model(z, rgb, alpha, bg, bg_a, **p)
 
 
-def expected_image(name: str, width: int, height: int, z, rgb, alpha, bg=BG, **kw) -> np.ndarray | None:
-    """(h, w, 4) expected image of one stack drawn on every pixel (full-screen layers)."""
-    out = [expected(name, z, rgb, alpha, bg, pixel=(r, c), **kw) for r in range(height) for c in range(width)]
-    return None if out[0] is None else np.array(out).reshape(height, width, 4)
+def full_screen_prims(n: int, pixel, size) -> np.ndarray:
+    """Triangle index of each of n full_screen_layers quads at `pixel` (row, col) of a `size`
+    (w, h) frame: quad i is triangles 2i (lower right on screen) and 2i + 1 (upper left), split
+    by the diagonal x/w + y/h = 1 through pixel centers (x, y) = (col, row) + 1/2. A center on the
+    diagonal is the lower right's: the top-left rule, that triangle's upper-left edge (checked
+    against the GPU by stochastic's noise, which hashes the triangle index)."""
+    (row, col), (w, h) = pixel, size
+    lower_right = (2 * col + 1) * h + (2 * row + 1) * w >= 2 * w * h
+    return 2 * np.arange(n) + (0 if lower_right else 1)
+
+
+def expected_image(name: str, width: int, height: int, z, rgb, alpha, bg=BG, **kw) -> np.ndarray:
+    """(h, w, 4) expected image of one stack drawn on every pixel (full_screen_layers)."""
+    out = [expected(name, z, rgb, alpha, bg, pixel=(r, c), size=(width, height),
+                    prims=full_screen_prims(len(z), (r, c), (width, height)), **kw)
+           for r in range(height) for c in range(width)]
+    return np.array(out).reshape(height, width, 4)
 
 
 # Methods whose output sums sum(alpha c) unnormalized: values (and float32 rounding) grow
@@ -104,12 +126,19 @@ def expected_image(name: str, width: int, height: int, z, rgb, alpha, bg=BG, **k
 UNNORMALIZED_SUMS = {"wsum", "additive"}
 
 
-def tolerance(name: str, n: int, mass: float = 1.0) -> float:
+def tolerance(name: str, n: int, mass: float = 1.0, **params) -> float:
     """Largest allowed |GPU - expected(...)| on a pixel of n fragments whose alphas sum to
-    `mass`. The base is the A-buffer's bound in docs/methods.md: one float32 rounding per
-    layer (n 2^-24, plus one for the float32 background); a float32 sum of n + 1 terms is off
-    by at most (n + 1) 2^-24 times their magnitude, which unnormalized sums (background
-    included) bound by 1 + mass. Method terms:"""
+    `mass` (`params`: the method's, where a term depends on them). The base is the A-buffer's
+    bound in docs/methods.md: one float32 rounding per layer (n 2^-24, plus one for the float32
+    background); a float32 sum of n + 1 terms is off by at most (n + 1) 2^-24 times their
+    magnitude, which unnormalized sums (background included) bound by 1 + mass. Method terms:"""
+    if name == "stochastic":
+        # The model draws the same samples (bit for bit) and keeps the targets' float32 sums
+        # and revealage, with the same operations in the same (submission) order as blending,
+        # whatever n: only the float32 resolve differs, by its quotient (WGSL allows 2.5 ulp:
+        # 5 2^-24 of a value <= 1), 1 - R, the products by it and by R, and their sum (one
+        # rounding each). Measured on llvmpipe: at most 1.6 2^-24.
+        return 9 * U
     tol = (n + 1) * U * ((1.0 + mass) if name in UNNORMALIZED_SUMS else 1.0)
     if name in ("hybrid", "hybrid64"):
         # Tail sums in fixed point at 2^-24 per unit (<= 2^-25 per term), and the tail's
@@ -123,6 +152,15 @@ def tolerance(name: str, n: int, mass: float = 1.0) -> float:
         # Weights 3e3 pow(1 - z, 3) with relative error 3 2^-21 each; a weighted average of
         # colors in [0, 1] moves by at most twice that.
         tol += 6 * POW_LOG2
+    elif name == "auto":
+        # The model is the exact composite (oit.models.auto): auto's rendered bound is at most
+        # its `tolerance` where it keeps hybrid, (n + 2) ROUNDING_TERM where it falls back to
+        # the A-buffer (crates/oit-core/src/method/auto.rs). That bound is for RGB; coverage
+        # is off by the quantization and T_core |T_est - T_tail| <= T_core, within the same
+        # tolerance where the tail term T_core (hi - lo) is, i.e. for tails whose colors span
+        # about [0, 1], as these suites' random colors do.
+        t = params.get("tolerance", params_for(name)["tolerance"])
+        tol += t + (n + 2) * float(oit.constants()["ROUNDING_TERM"])
     return tol
 
 
@@ -194,13 +232,12 @@ class Stacks:
     z: list[np.ndarray]
     rgb: list[np.ndarray]
     alpha: list[np.ndarray]
+    prims: list[np.ndarray]  # each fragment's triangle index (see stacks)
 
     def expect(self, name: str, bg=BG, **params) -> np.ndarray:
-        """(h, w, 4) float64 expected image, or None without a model."""
-        out = [expected(name, z, c, a, bg, pixel=divmod(p, self.width), **params)
-               for p, (z, c, a) in enumerate(zip(self.z, self.rgb, self.alpha))]
-        if any(o is None for o in out):
-            return None
+        """(h, w, 4) float64 expected image."""
+        out = [expected(name, z, c, a, bg, pixel=divmod(p, self.width), size=(self.width, self.height), prims=t, **params)
+               for p, (z, c, a, t) in enumerate(zip(self.z, self.rgb, self.alpha, self.prims))]
         return np.array(out).reshape(self.height, self.width, 4)
 
 
@@ -239,13 +276,17 @@ def stacks(width: int, height: int, layers: int, seed: int = 0, alpha: Callable 
     scene = oit.Scene()
     scene.add_mesh(pos.reshape(-1, 3), idx, colors)
     # Each pixel's fragments in submission order.
-    zs, cs, als = [], [], []
+    # The quad submitted j-th is triangles 2j and 2j + 1, split by the diagonal through the
+    # pixel's center (corners 0 and 2), which the top-left rule gives to 2j, as in
+    # full_screen_prims (checked against the GPU by stochastic's noise).
+    zs, cs, als, prims = [], [], [], []
     for p in range(pixels):
         mine = lay[pix == p]
         zs.append(z[p, mine].astype(np.float64))
         cs.append(rgb[p, mine].astype(np.float64))
         als.append(a[p, mine].astype(np.float64))
-    return Stacks(scene, width, height, zs, cs, als)
+        prims.append(2 * np.flatnonzero(pix == p))
+    return Stacks(scene, width, height, zs, cs, als, prims)
 
 
 def full_screen_layers(layers: Sequence, opaque: Sequence[int] = ()) -> oit.Scene:

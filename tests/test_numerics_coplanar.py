@@ -1,8 +1,8 @@
 """Coplanar and nearly coplanar fragments: equal depths, and depths apart by less than the
 24-bit key's resolution (2^-24).
 
-- The exact methods, hybrid, hybrid64 and ktab promise the same bits under any submission
-  order (docs/methods.md): 10 shuffles of mesh, triangle and vertex order, compared bit for
+- The exact methods, hybrid, hybrid64, ktab and auto promise the same bits under any
+  submission order (docs/methods.md): 10 shuffles of mesh, triangle and vertex order, compared bit for
   bit. The peeling methods are exact but break exact depth ties by submission (their
   documented rule): tested against that rule instead.
 - The commutative float sums (wsum, wavg, wboit, additive, filter) promise the same image

@@ -4,7 +4,10 @@ Each model takes the fragments of a pixel in submission order, `z` (n,) depths i
 `rgb` (n, 3) straight colors, `alpha` (n,), and the color behind them `bg` (3,) with its
 coverage `bg_a` (1 for an opaque surface, 0 for the background), and returns RGBA as the
 renderer does. They mirror the shaders' equations, keys and tie rules (docs/methods.md), so
-a GPU image can be checked against them to within float32 and fixed-point rounding.
+a GPU image can be checked against them to within float32 and fixed-point rounding. Models
+that depend on more than the stack take it by keyword: the frame pixel (screen_door,
+stochastic), the frame size and the fragments' triangle indices (stochastic). `auto` is the
+one envelope: the exact composite, which auto promises to be within its tolerance of.
 """
 
 from __future__ import annotations
@@ -293,8 +296,70 @@ def bucket_peeling(z, rgb, alpha, bg, bg_a=0.0, buckets=32):
     return _out(c, t, bg, bg_a)
 
 
+_M32 = 0xFFFFFFFF
+
+
+def lowbias32(x) -> np.ndarray:
+    """shaders/stochastic.wgsl `hash` (lowbias32, Wellons) on uint32 values."""
+    h = np.asarray(x, np.uint64) & _M32
+    h ^= h >> np.uint64(16)
+    h = (h * np.uint64(0x7FEB352D)) & _M32
+    h ^= h >> np.uint64(15)
+    h = (h * np.uint64(0x846CA68B)) & _M32
+    h ^= h >> np.uint64(16)
+    return h
+
+
+def stochastic_coverage(prims, alpha, frame_px: int, samples: int, seed: int) -> np.ndarray:
+    """(n, samples) bool: whether each fragment covers each sample, as `covers` in
+    shaders/stochastic.wgsl hashes it: hash(prim ^ hash(px ^ hash(s ^ hash(seed)))), kept where
+    its top 24 bits over 2^24 are below the float32 alpha (exact in float64)."""
+    s = np.arange(samples, dtype=np.uint64)
+    inner = lowbias32(np.uint64(frame_px) ^ lowbias32(s ^ lowbias32(np.uint64(seed & _M32))))
+    h = lowbias32(np.asarray(prims, np.uint64)[:, None] ^ inner[None, :])
+    a = np.asarray(alpha, np.float32).astype(np.float64)
+    return (h >> np.uint64(8)).astype(np.float64) * 2.0 ** -24 < a[:, None]
+
+
+def stochastic(z, rgb, alpha, bg, bg_a=0.0, samples=8, seed=0, prims=None, pixel=(0, 0), size=(1, 1)):
+    """Stochastic transparency (Enderton et al. 2010) with alpha correction, as
+    shaders/stochastic.wgsl on the frame pixel `pixel` (row, col) of a `size` (w, h) frame:
+    `prims` are the fragments' triangle indices in the drawn transparent geometry (the hash's
+    input). Each sample keeps the nearest covering depth (the largest ~bits of the float32
+    depth), a fragment's visibility is the share of samples whose nearest is not in front of
+    it, and the sums and revealage are float32 in submission order, as the blended targets."""
+    if prims is None:
+        raise ValueError("stochastic needs each fragment's triangle index (prims)")
+    z, rgb = np.asarray(z, np.float32), np.asarray(rgb, np.float32).reshape(-1, 3)
+    alpha, prims = np.asarray(alpha, np.float32), np.asarray(prims, np.uint64)
+    keep = alpha > 0  # both passes skip alpha-0 fragments
+    z, rgb, alpha, prims = z[keep], rgb[keep], alpha[keep], prims[keep]
+    key = ~z.view(np.uint32)  # larger = nearer; an empty sample is 0
+    cover = stochastic_coverage(prims, alpha, pixel[0] * size[0] + pixel[1], samples, seed)
+    nearest = np.where(cover, key[:, None], np.uint32(0)).max(0, initial=np.uint32(0))
+    seen = (key[:, None] >= nearest[None, :]).sum(1)
+    acc, acc_a, reveal = np.zeros(3, np.float32), np.float32(0), np.float32(1)
+    for c, a, v in zip(rgb, alpha, seen):
+        w = a * np.float32(v) / np.float32(samples)
+        acc, acc_a = acc + c * w, acc_a + w
+        reveal = reveal * (np.float32(1) - a)
+    bg, t = np.asarray(bg, np.float64), float(reveal)
+    color = np.zeros(3) if acc_a <= 0 else acc.astype(np.float64) / float(acc_a) * (1.0 - t)
+    return np.append(color + t * bg, 1.0 - t * (1.0 - bg_a))
+
+
+def auto(z, rgb, alpha, bg, bg_a=0.0, tolerance=1.0 / 255.0):
+    """auto as an envelope, not a replica: the exact composite, which auto's RGB stays within
+    `tolerance` of (hybrid's rendered bound is at most it) or within the A-buffer's rounding
+    where it falls back (the allowed error is numerics.tolerance's). A replica cannot be built
+    from one pixel's stack: auto's choice is the frame's (one pixel with no k predicted to meet
+    `tolerance` sends every pixel to the A-buffer, and so does a miss after widening), and its
+    widening reads the bound hybrid rendered (crates/oit-core/src/method/auto.rs)."""
+    return exact(z, rgb, alpha, bg, bg_a)
+
+
 MODELS = {"abuffer": exact, "hybrid": hybrid, "hybrid64": hybrid64, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit,
           "adaptive": adaptive, "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab,
-          "bucket_peeling": bucket_peeling}
+          "bucket_peeling": bucket_peeling, "stochastic": stochastic, "auto": auto}
 # The list versions run the same update in the same (submission) order.
 MODELS.update({"adaptive_lists": adaptive, "mlab_lists": mlab})
