@@ -54,6 +54,13 @@ impl Counter {
         self.readback.copy(enc, &self.buffer);
     }
 
+    /// Records the copy that the executor reads with the tile's pixels, after the passes that
+    /// count: the tile's overflow, and the extra stat `extra` where given.
+    pub fn tally(&self, enc: &mut wgpu::CommandEncoder, extra: Option<&'static str>) -> crate::method::Tally {
+        self.copy(enc);
+        crate::method::Tally { readback: self.readback.buffer.clone(), extra }
+    }
+
     /// The count copied by the last submitted `copy` (waits for it).
     pub fn read(&self, gpu: &GpuContext) -> Result<u64> {
         let raw = self.readback.read(gpu)?;

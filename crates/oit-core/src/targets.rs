@@ -151,28 +151,47 @@ pub fn storage_buffer(device: &wgpu::Device, label: &str, size: u64, extra: wgpu
 /// Maps `buffer` (MAP_READ), waits, and returns a copy of its first `size` bytes. The
 /// buffer is unmapped on every path, so a failed frame leaves it usable for the next.
 pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> crate::error::Result<Vec<u8>> {
+    Ok(read_buffers(gpu, &[(buffer, size)])?.pop().expect("one buffer read"))
+}
+
+/// The first bytes of each readback buffer (`(buffer, bytes)`), mapped together after one wait
+/// for the GPU: what a tile leaves to read is read at once.
+pub fn read_buffers(gpu: &GpuContext, buffers: &[(&wgpu::Buffer, u64)]) -> crate::error::Result<Vec<Vec<u8>>> {
     use crate::error::OitError;
-    let slice = buffer.slice(..size);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
+    let receivers: Vec<_> = buffers
+        .iter()
+        .map(|(buffer, size)| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            buffer.slice(..*size).map_async(wgpu::MapMode::Read, move |r| {
+                let _ = tx.send(r);
+            });
+            rx
+        })
+        .collect();
     let waited = gpu.wait();
-    // Another thread polling the same device may be the one running the callback: wait for it.
-    let mapped = match rx.recv_timeout(std::time::Duration::from_secs(30)) {
-        Ok(Ok(())) => true,
-        Ok(Err(e)) => return Err(waited.err().unwrap_or_else(|| OitError::Device(format!("mapping a readback buffer failed: {e}")))),
-        Err(_) => false,
-    };
-    let data = if mapped {
-        let view = slice.get_mapped_range().map(|v| v.to_vec());
-        buffer.unmap();
-        view.map_err(|e| OitError::Device(format!("reading a mapped buffer failed: {e:?}")))
-    } else {
-        Err(OitError::Device("a readback buffer was not mapped after the GPU finished".into()))
-    };
+    let mut out = Vec::with_capacity(buffers.len());
+    let mut failed = None;
+    for ((buffer, size), rx) in buffers.iter().zip(receivers) {
+        // Another thread polling the same device may be the one running the callback: wait for it.
+        match rx.recv_timeout(std::time::Duration::from_secs(30)) {
+            Ok(Ok(())) => {
+                let slice = buffer.slice(..*size);
+                let view = slice.get_mapped_range().map(|v| v.to_vec());
+                buffer.unmap();
+                match view {
+                    Ok(v) => out.push(v),
+                    Err(e) => failed = failed.or(Some(OitError::Device(format!("reading a mapped buffer failed: {e:?}")))),
+                }
+            }
+            Ok(Err(e)) => failed = failed.or(Some(OitError::Device(format!("mapping a readback buffer failed: {e}")))),
+            Err(_) => failed = failed.or(Some(OitError::Device("a readback buffer was not mapped after the GPU finished".into()))),
+        }
+    }
     waited?;
-    data
+    match failed {
+        Some(e) => Err(e),
+        None => Ok(out),
+    }
 }
 
 /// The pixels of `tile` of a texture, row-major within the tile, as f32.
@@ -183,29 +202,61 @@ pub fn read_region(
     bytes_per_pixel: u32,
     tile: Tile,
 ) -> crate::error::Result<Vec<f32>> {
-    let row = padded_row(tile.width, bytes_per_pixel);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d { x: tile.x, y: tile.y, z: 0 },
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: readback,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
-        },
-        wgpu::Extent3d { width: tile.width, height: tile.height, depth_or_array_layers: 1 },
-    );
+    let region = Region::copy(&mut enc, texture, readback, bytes_per_pixel, tile);
     gpu.queue.submit([enc.finish()]);
-    let raw = read_buffer(gpu, readback, row as u64 * tile.height as u64)?;
-    let line = (tile.width * bytes_per_pixel) as usize;
-    let mut out = Vec::with_capacity(line / 4 * tile.height as usize);
-    for r in 0..tile.height as usize {
-        out.extend(bytemuck::pod_collect_to_vec::<u8, f32>(&raw[r * row as usize..r * row as usize + line]));
+    let raw = read_buffer(gpu, readback, region.bytes())?;
+    Ok(region.unpack(&raw))
+}
+
+/// A tile of a texture copied into a readback buffer in rows padded for the copy.
+#[derive(Clone, Copy)]
+pub struct Region {
+    row: u32,
+    bytes_per_pixel: u32,
+    tile: Tile,
+}
+
+impl Region {
+    /// Records the copy of `tile` of `texture` into `readback`.
+    pub fn copy(
+        enc: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        readback: &wgpu::Buffer,
+        bytes_per_pixel: u32,
+        tile: Tile,
+    ) -> Self {
+        let row = padded_row(tile.width, bytes_per_pixel);
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: tile.x, y: tile.y, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: readback,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+            },
+            wgpu::Extent3d { width: tile.width, height: tile.height, depth_or_array_layers: 1 },
+        );
+        Self { row, bytes_per_pixel, tile }
     }
-    Ok(out)
+
+    /// Bytes of the readback the copy fills.
+    pub fn bytes(&self) -> u64 {
+        self.row as u64 * self.tile.height as u64
+    }
+
+    /// The tile's pixels, row-major, as f32, from the readback's bytes.
+    pub fn unpack(&self, raw: &[u8]) -> Vec<f32> {
+        let (row, line) = (self.row as usize, (self.tile.width * self.bytes_per_pixel) as usize);
+        let mut out = Vec::with_capacity(line / 4 * self.tile.height as usize);
+        for r in 0..self.tile.height as usize {
+            out.extend(bytemuck::pod_collect_to_vec::<u8, f32>(&raw[r * row..r * row + line]));
+        }
+        out
+    }
 }
 
 /// The targets of a coverage-mask frame at `samples` samples a pixel: per sample position the

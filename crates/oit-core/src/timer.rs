@@ -1,8 +1,6 @@
 //! GPU time per pass from timestamp queries (when the adapter offers them).
 
 use crate::context::GpuContext;
-use crate::error::Result;
-use crate::targets::read_buffer;
 
 const MAX_PASSES: u32 = 64;
 
@@ -93,24 +91,27 @@ impl PassTimer {
     }
 
     /// Reads every recorded pass's duration in milliseconds, in recording order.
-    pub fn read(&mut self, gpu: &GpuContext) -> Result<Option<Vec<(&'static str, f64)>>> {
-        let Some((set, resolve, readback)) = &self.queries else { return Ok(None) };
+    /// Records the copy of the recorded passes' timestamps into the readback: the buffer and
+    /// bytes to read once submitted, or None where nothing is timed.
+    pub fn record_read(&self, enc: &mut wgpu::CommandEncoder) -> Option<(wgpu::Buffer, u64)> {
+        let (set, resolve, readback) = self.queries.as_ref()?;
         let n = self.labels.len() as u32;
         if n == 0 {
-            return Ok(Some(Vec::new()));
+            return None;
         }
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.resolve_query_set(set, 0..2 * n, resolve, 0);
         enc.copy_buffer_to_buffer(resolve, 0, readback, 0, 16 * n as u64);
-        gpu.queue.submit([enc.finish()]);
-        let raw = read_buffer(gpu, readback, 16 * n as u64)?;
-        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&raw);
-        let out = self
-            .labels
+        Some((readback.clone(), 16 * n as u64))
+    }
+
+    /// Every recorded pass's duration in milliseconds, in recording order, from the bytes of a
+    /// `record_read`.
+    pub fn durations(&self, raw: &[u8]) -> Vec<(&'static str, f64)> {
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(raw);
+        self.labels
             .iter()
             .enumerate()
             .map(|(i, l)| (*l, ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * self.period_ns * 1e-6))
-            .collect();
-        Ok(Some(out))
+            .collect()
     }
 }

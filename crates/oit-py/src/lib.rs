@@ -478,8 +478,8 @@ fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         d.set_item("memory", memory)?;
         d.set_item("error_bound", m.error_bound.name())?;
         let tiling = PyDict::new(py);
-        tiling.set_item("kind", m.tiling.name())?;
-        if let oit_core::Tiling::Storage { per_pixel, per_fragment, per_triangle } = m.tiling {
+        tiling.set_item("kind", m.tiling().name())?;
+        if let oit_core::Tiling::Storage { per_pixel, per_fragment, per_triangle } = m.tiling() {
             tiling.set_item("per_pixel", per_pixel)?;
             tiling.set_item("per_fragment", per_fragment)?;
             tiling.set_item("per_triangle", per_triangle)?;

@@ -2,7 +2,7 @@
 //! sorting each list front to back in batches and compositing (shaders/abuffer.wgsl).
 
 use super::frame::{FrameCtx, Limits, Method, Outcome};
-use super::info::{never, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, Tiling};
+use super::info::{never, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, SceneBytes};
 use super::list_pipelines::{swept, FRAME, SAMPLES};
 use super::lists::{state_words, Aux, ListLayout, ListMethod, COUNTED_PIXEL_BYTES, STATE_WORDS};
 use crate::cache::PipelineSpec;
@@ -23,9 +23,11 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: &[AntialiasMode::Frames, AntialiasMode::Coverage],
-    memory: Memory::Scene { formula: "24 B/fragment + 80 B/pixel (the node pool grows with the scene)" },
+    memory: Memory::Scene {
+        storage: SceneBytes { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
+        note: "(the node pool grows with the scene)",
+    },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
     census: true,
     census_when: never,
     main: None,

@@ -44,11 +44,6 @@ pub(crate) fn accumulation_targets(aux: Companion) -> Vec<Option<wgpu::ColorTarg
 /// Bytes a pixel of the two targets.
 pub const TARGET_BYTES: u64 = 16 + 4;
 
-/// Bytes of the two targets at `pixels` pixels.
-pub fn memory_bytes(pixels: u64) -> u64 {
-    pixels * TARGET_BYTES
-}
-
 /// Float render targets of the frame's size that a geometry pass blends into and a resolve
 /// reads back as textures: the blended methods' two (`ACCUM_FORMAT`, `AUX_FORMAT`) and
 /// hybrid's blended tail's four (ktab.rs). Tiles of a frame share them, each drawing its part.

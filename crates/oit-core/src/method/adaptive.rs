@@ -4,7 +4,7 @@
 //! order and composites every fragment by it (shaders/adaptive_lists.wgsl).
 
 use super::frame::{FrameCtx, Method, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::list_pipelines::{single, FRAME};
 use super::lists::{check_replay_budget, Aux, ListLayout, ListMethod};
 use super::params::{ParamInfo, ParamKind};
@@ -29,9 +29,8 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Submission,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { formula: "32 B/fragment + 4 B/pixel (grows with the scene)" },
+    memory: Memory::Scene { storage: SceneBytes { per_pixel: 4, per_fragment: 32, per_triangle: 0 }, note: "(grows with the scene)" },
     error_bound: ErrorBound::None,
-    tiling: Tiling::Storage { per_pixel: 4, per_fragment: 32, per_triangle: 0 },
     census: true,
     census_when: never,
     main: Some("nodes"),

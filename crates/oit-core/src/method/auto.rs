@@ -9,7 +9,7 @@
 //! predicted to meet t, the A-buffer is rendered directly.
 
 use super::frame::{FrameCtx, Method, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::ktab::{self, KTab, Slots};
 use super::params::{ParamInfo, ParamKind, Params};
 use crate::cache::{spec, Layout, PipelineSpec};
@@ -44,9 +44,9 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Slots {
         formula: "2·Σk·4 + W·H·84 + 8 (hybrid with per-pixel slots and the estimate), or the A-buffer's",
         bytes: memory_bytes,
+        storage: SceneBytes { per_pixel: 84, per_fragment: 24, per_triangle: 0 },
     },
     error_bound: ErrorBound::PerPixel,
-    tiling: Tiling::Storage { per_pixel: 84, per_fragment: 24, per_triangle: 0 },
     census: true,
     census_when: never,
     main: None,

@@ -2,7 +2,7 @@
 //! submission order or per mesh back to front by centroid (docs/methods.md).
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
 use crate::bindings::COLOR_FORMAT;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -19,9 +19,8 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Submission,
     antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "0", bytes: |_, _| 0 },
+    memory: Memory::Frame(FrameBytes { per_pixel: Linear::bytes(0), fixed: 0 }),
     error_bound: ErrorBound::None,
-    tiling: Tiling::Formula,
     census: false,
     census_when: never,
     main: None,

@@ -3,7 +3,7 @@
 //! kept, the others dropped and counted (shaders/bucket_peeling.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -20,9 +20,8 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
     order: Order::BitwiseExceptTies,
     antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "W·H·(8 + 24·buckets) + 4", bytes: |px, p| memory_bytes(px, p.int("buckets") as u64) },
+    memory: Memory::Frame(BYTES),
     error_bound: ErrorBound::None,
-    tiling: Tiling::Formula,
     census: false,
     census_when: never,
     main: Some("buckets"),
@@ -30,10 +29,9 @@ pub const INFO: MethodInfo = MethodInfo {
     create: |_, _| Box::new(Buckets { buffers: None, dropped: None }),
 };
 
-/// Bytes bucket_peeling allocates: depth bounds, and a 64-bit key and a color per bucket.
-pub fn memory_bytes(pixels: u64, buckets: u64) -> u64 {
-    pixels * (8 + buckets * (8 + 16)) + 4
-}
+/// Bytes bucket_peeling allocates: depth bounds, a 64-bit key and a color per bucket, and the
+/// dropped counter.
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("buckets", 8 + 16, 8), fixed: 4 };
 
 const SHADER: &str = "bucket_peeling.wgsl";
 /// Group 2: bounds, keys, bucket colors, then the dropped counter.
@@ -67,13 +65,8 @@ impl Method for Buckets {
             cx.capture(&mut enc, label, &cx.capture_pipeline(spec(PIPELINES, fs), &consts), &b.group);
         }
         cx.resolve(&mut enc, "resolve", &cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, false), &b.group, false);
-        dropped.copy(&mut enc);
+        let tally = dropped.tally(&mut enc, None);
         cx.submit(enc);
-        let dropped = dropped.read(cx.gpu)?;
-        Ok(Outcome::Done(MethodReport {
-            memory_bytes: memory_bytes(pixels, buckets as u64),
-            overflow_fragments: dropped,
-            ..Default::default()
-        }))
+        Ok(Outcome::Done(MethodReport { memory_bytes: BYTES.at(pixels, cx.params), tallies: vec![tally], ..Default::default() }))
     }
 }

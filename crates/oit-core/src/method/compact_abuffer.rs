@@ -4,7 +4,7 @@
 //! shades each fragment from it, deferred (shaders/compact_abuffer.wgsl, docs/shading.md).
 
 use super::frame::{FrameCtx, Method, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::list_pipelines::{pool_layout, swept_after};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{COUNTED_PIXEL_BYTES, STATE_WORDS};
@@ -26,9 +26,8 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { formula: "12 B/fragment + 80 B/pixel + 176 B/triangle" },
+    memory: Memory::Scene { storage: SceneBytes { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: 12, per_triangle: 176 }, note: "" },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: 12, per_triangle: 176 },
     census: true,
     census_when: never,
     main: None,

@@ -386,6 +386,17 @@ pub struct MethodReport {
     /// Each pixel's transparent fragments (row-major), where the method counted them in its own
     /// capture in place of the census (`Method::counts_in_capture`).
     pub counts: Option<Vec<u32>>,
+    /// Counts the method's passes leave for the executor to read with the tile's pixels (one
+    /// wait for both): each adds to `overflow_fragments`, and to `extra` where named.
+    pub tallies: Vec<Tally>,
+}
+
+/// A u32 count in a readback buffer, copied there by the method's last submission.
+#[derive(Debug)]
+pub struct Tally {
+    pub readback: wgpu::Buffer,
+    /// The extra stat it is also reported as.
+    pub extra: Option<&'static str>,
 }
 
 /// What became of a tile a method was asked to render: the executor (renderer/execute.rs)

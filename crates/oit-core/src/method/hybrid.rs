@@ -2,7 +2,7 @@
 //! discarded: the k-TAB engine (ktab.rs) with the `k` parameter.
 
 use super::frame::{FrameCtx, Method, Outcome};
-use super::info::{ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
 use super::ktab::{compact_memory_bytes, memory_bytes, KTab, Slots, TailSums};
 use super::params::{ParamInfo, ParamKind, ParamValue};
 use crate::error::Result;
@@ -34,7 +34,6 @@ pub const HYBRID: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::PerPixel,
-    tiling: Tiling::Formula,
     census: false,
     census_when: |p| p.0.get("tail").is_some_and(|t| matches!(t, ParamValue::Str(s) if s == "compact")),
     main: Some("k"),
@@ -52,7 +51,7 @@ pub const KTAB: MethodInfo = MethodInfo {
     ..HYBRID
 };
 
-const MEMORY: Memory = Memory::Frame {
+const MEMORY: Memory = Memory::Computed {
     formula: "W·H·(2k + 15)·4 + 8 (tail = 'compact': W·H·(2k + 2)·4 + 8)",
     bytes: |px, p| {
         let k = p.int("k") as u64;

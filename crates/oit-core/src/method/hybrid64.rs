@@ -5,7 +5,7 @@
 //! One geometry pass and one full-screen resolve (shaders/hybrid64.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -26,9 +26,8 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "W·H·(8k + 24) + 4", bytes: |px, p| memory_bytes(px, p.int("k") as u64) },
+    memory: Memory::Frame(BYTES),
     error_bound: ErrorBound::PerPixel,
-    tiling: Tiling::Formula,
     census: false,
     census_when: never,
     main: Some("k"),
@@ -46,9 +45,7 @@ const PIPELINES: &[PipelineSpec] =
 pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_TAIL_WORDS as u64;
 
 /// Bytes hybrid64 allocates: k 64-bit words and the tail's words per pixel, a counter.
-pub fn memory_bytes(pixels: u64, k: u64) -> u64 {
-    pixels * (8 * k + 4 * ACCUM_WORDS) + 4
-}
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("k", 8, 4 * ACCUM_WORDS), fixed: 4 };
 
 struct Hybrid64 {
     buffers: Option<StorageGroup>,
@@ -71,13 +68,11 @@ impl Method for Hybrid64 {
         tail.clear(&mut enc);
         cx.capture(&mut enc, "insert", &insert, &b.group);
         cx.resolve(&mut enc, "resolve", &resolve, &b.group, true);
-        tail.copy(&mut enc);
+        let tally = tail.tally(&mut enc, Some("tail_fragments"));
         cx.submit(enc);
-        let tail = tail.read(cx.gpu)?;
         Ok(Outcome::Done(MethodReport {
-            memory_bytes: memory_bytes(pixels, k as u64),
-            overflow_fragments: tail,
-            extra: vec![("tail_fragments", tail as f64)],
+            memory_bytes: BYTES.at(pixels, cx.params),
+            tallies: vec![tally],
             error_bound: true,
             ..Default::default()
         }))

@@ -30,8 +30,6 @@ pub struct MethodInfo {
     pub memory: Memory,
     /// What bounds its error against the exact composite.
     pub error_bound: ErrorBound,
-    /// How a frame too large for its bindings or the memory budget is split into screen tiles.
-    pub tiling: Tiling,
     /// Whether the method reads the fragment census before it renders (its storage, tiles or
     /// pass count are planned from every pixel's fragment count). Methods that do not get no
     /// census pass unless the caller asks for the counts (`Renderer::set_census`).
@@ -104,34 +102,132 @@ impl AntialiasMode {
 /// Antialiasing by sample frames only (every method).
 pub const FRAMES: &[AntialiasMode] = &[AntialiasMode::Frames];
 
-/// The GPU memory a method allocates for one frame (`stats["memory_bytes"]`).
+/// Bytes linear in at most one integer parameter: `base + per · param`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Linear {
+    pub base: u64,
+    pub per: u64,
+    pub param: Option<&'static str>,
+}
+
+impl Linear {
+    /// `base` bytes whatever the parameters.
+    pub const fn bytes(base: u64) -> Self {
+        Self { base, per: 0, param: None }
+    }
+
+    /// `per` bytes for each unit of the integer parameter `param`, plus `base`.
+    pub const fn per(param: &'static str, per: u64, base: u64) -> Self {
+        Self { base, per, param: Some(param) }
+    }
+
+    pub fn at(&self, params: &Params) -> u64 {
+        self.base + self.param.map_or(0, |p| self.per * params.int(p).max(0) as u64)
+    }
+
+    /// The expression as the formula shows it: `20`, `8·k + 24`.
+    fn text(&self) -> String {
+        match self.param {
+            None => self.base.to_string(),
+            Some(p) if self.base == 0 => format!("{}·{p}", self.per),
+            Some(p) => format!("{}·{p} + {}", self.per, self.base),
+        }
+    }
+}
+
+/// Bytes a frame of `W·H` pixels allocates: `W·H·per_pixel + fixed`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameBytes {
+    pub per_pixel: Linear,
+    pub fixed: u64,
+}
+
+impl FrameBytes {
+    pub fn at(&self, pixels: u64, params: &Params) -> u64 {
+        pixels * self.per_pixel.at(params) + self.fixed
+    }
+
+    fn text(&self) -> String {
+        let per_pixel = match (self.per_pixel.param, self.per_pixel.base) {
+            (None, 0) if self.fixed > 0 => return self.fixed.to_string(),
+            (None, 0) => return "0".to_string(),
+            (None, _) => format!("W·H·{}", self.per_pixel.text()),
+            (Some(_), _) => format!("W·H·({})", self.per_pixel.text()),
+        };
+        if self.fixed > 0 {
+            format!("{per_pixel} + {}", self.fixed)
+        } else {
+            per_pixel
+        }
+    }
+}
+
+/// What a method stores that grows with the scene: bytes a pixel, a stored fragment (a node
+/// of its pool, spread over `lists::POOL_BINDINGS` bindings) and a transparent triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneBytes {
+    pub per_pixel: u64,
+    pub per_fragment: u64,
+    pub per_triangle: u64,
+}
+
+impl SceneBytes {
+    fn text(&self) -> String {
+        let mut t = format!("{} B/fragment + {} B/pixel", self.per_fragment, self.per_pixel);
+        if self.per_triangle > 0 {
+            t += &format!(" + {} B/triangle", self.per_triangle);
+        }
+        t
+    }
+}
+
+/// The GPU memory a method allocates for one frame (`stats["memory_bytes"]`), declared once:
+/// its formula's text, `oit.memory_bytes` and the tiling are derived from it.
 #[derive(Clone, Copy, Debug)]
 pub enum Memory {
-    /// Fixed by the frame size and the parameters: `bytes(pixels, params)`; `formula` is its text.
-    Frame { formula: &'static str, bytes: fn(u64, &Params) -> u64 },
-    /// Grows with the scene (its fragments or triangles); `formula` is its text.
-    Scene { formula: &'static str },
-    /// Chosen per frame as per-pixel slots (auto): `bytes(pixels, slots)` once the slots are known.
-    Slots { formula: &'static str, bytes: fn(u64, u64) -> u64 },
+    /// Fixed by the frame size and the parameters.
+    Frame(FrameBytes),
+    /// Fixed by the frame size and the parameters, where the parameters choose between sets of
+    /// buffers (hybrid's tails): `bytes(pixels, params)` in code, `formula` its text.
+    Computed { formula: &'static str, bytes: fn(u64, &Params) -> u64 },
+    /// Grows with the scene (its fragments or triangles); `note` says what more the text should.
+    Scene { storage: SceneBytes, note: &'static str },
+    /// Chosen per frame as per-pixel slots (auto): `bytes(pixels, slots)` once the slots are
+    /// known; its tiles are planned from `storage` (what its exact fallback keeps).
+    Slots { formula: &'static str, bytes: fn(u64, u64) -> u64, storage: SceneBytes },
 }
 
 impl Memory {
-    pub fn formula(&self) -> &'static str {
+    pub fn formula(&self) -> String {
         match self {
-            Memory::Frame { formula, .. } | Memory::Scene { formula } | Memory::Slots { formula, .. } => formula,
+            Memory::Frame(f) => f.text(),
+            Memory::Computed { formula, .. } | Memory::Slots { formula, .. } => formula.to_string(),
+            Memory::Scene { storage, note: "" } => storage.text(),
+            Memory::Scene { storage, note } => format!("{} {note}", storage.text()),
         }
     }
 
     pub fn kind(&self) -> &'static str {
         match self {
-            Memory::Frame { .. } => "frame",
+            Memory::Frame(_) | Memory::Computed { .. } => "frame",
             Memory::Scene { .. } => "scene",
             Memory::Slots { .. } => "slots",
         }
     }
+
+    /// How the renderer plans the method's screen tiles.
+    pub fn tiling(&self) -> Tiling {
+        match *self {
+            Memory::Frame(_) | Memory::Computed { .. } => Tiling::Formula,
+            Memory::Scene { storage, .. } | Memory::Slots { storage, .. } => {
+                Tiling::Storage { per_pixel: storage.per_pixel, per_fragment: storage.per_fragment, per_triangle: storage.per_triangle }
+            }
+        }
+    }
 }
 
-/// How the renderer plans a method's screen tiles (tiles.rs, docs/methods.md "Tiles").
+/// How the renderer plans a method's screen tiles (tiles.rs, docs/methods.md "Tiles"), from
+/// its `Memory`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tiling {
     /// By its memory formula (`Memory::Frame`): bytes grow with the tile's pixels (render
@@ -209,10 +305,16 @@ impl MethodInfo {
     /// the scene, or (auto) when it depends on the slots chosen per frame and `slots` is None.
     pub fn memory_bytes(&self, pixels: u64, params: &Params, slots: Option<u64>) -> Option<u64> {
         match self.memory {
-            Memory::Frame { bytes, .. } => Some(bytes(pixels, params)),
+            Memory::Frame(f) => Some(f.at(pixels, params)),
+            Memory::Computed { bytes, .. } => Some(bytes(pixels, params)),
             Memory::Scene { .. } => None,
             Memory::Slots { bytes, .. } => slots.map(|s| bytes(pixels, s)),
         }
+    }
+
+    /// How the renderer plans its screen tiles (from its `memory`).
+    pub fn tiling(&self) -> Tiling {
+        self.memory.tiling()
     }
 
     /// Whether a frame with `params` runs the census before the method (besides the caller's asking).

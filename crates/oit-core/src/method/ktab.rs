@@ -219,22 +219,15 @@ impl KTab {
                 cx.resolve_groups(&mut enc, "final", &fin, &[&b.group, &targets.group], true);
             }
         }
-        overflow.copy(&mut enc);
+        let tally = overflow.tally(&mut enc, Some("tail_fragments"));
         cx.submit(enc);
-        let overflow = overflow.read(cx.gpu)?;
         // What the frame allocated: the formulas above name each buffer, and the tests hold
         // these bytes to them.
         let mut memory = b.bytes() + COUNTER_BYTES;
         if sums == TailSums::Blend {
             memory += BLEND_BYTES_PER_PIXEL * cx.targets.width as u64 * cx.targets.height as u64;
         }
-        Ok(MethodReport {
-            memory_bytes: memory,
-            overflow_fragments: overflow,
-            extra: vec![("tail_fragments", overflow as f64)],
-            error_bound: true,
-            ..Default::default()
-        })
+        Ok(MethodReport { memory_bytes: memory, tallies: vec![tally], error_bound: true, ..Default::default() })
     }
 }
 
@@ -292,14 +285,12 @@ impl KTab {
         attachments.extend(sums.attachments(&[wgpu::Color::TRANSPARENT]));
         cx.capture_into(&mut enc, "shade", &shade, &group, &attachments);
         cx.resolve_groups(&mut enc, "final", &fin, &[&group, &sums.group], true);
-        overflow.copy(&mut enc);
+        let tally = overflow.tally(&mut enc, Some("tail_fragments"));
         cx.submit(enc);
-        let overflow = overflow.read(cx.gpu)?;
         let target_pixels = cx.targets.width as u64 * cx.targets.height as u64;
         Ok(MethodReport {
             memory_bytes: b.bytes() + target_pixels * COMPACT_TAIL_WORDS * 4 + COUNTER_BYTES,
-            overflow_fragments: overflow,
-            extra: vec![("tail_fragments", overflow as f64)],
+            tallies: vec![tally],
             error_bound: true,
             ..Default::default()
         })

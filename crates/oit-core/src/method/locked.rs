@@ -7,8 +7,8 @@
 
 use super::accum::{blended, FloatTargets, ACCUM_FORMAT, ADD};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
-use super::params::{ParamInfo, ParamKind, Params};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
+use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Readback, StorageGroup};
@@ -42,14 +42,10 @@ const NODE_BYTES: u64 = 8;
 const LAYER_BYTES: u64 = 20;
 
 /// adaptive: N nodes, the lock word and the shading pass's RGBA32F sums a pixel.
-pub fn adaptive_bytes(pixels: u64, nodes: u64) -> u64 {
-    pixels * (NODE_BYTES * nodes + LOCK_BYTES + 16) + LOCK_STATS_BYTES
-}
+const ADAPTIVE_BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("nodes", NODE_BYTES, LOCK_BYTES + 16), fixed: LOCK_STATS_BYTES };
 
 /// mlab: k layers and the lock word a pixel.
-pub fn mlab_bytes(pixels: u64, layers: u64) -> u64 {
-    pixels * (LAYER_BYTES * layers + LOCK_BYTES) + LOCK_STATS_BYTES
-}
+const MLAB_BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("layers", LAYER_BYTES, LOCK_BYTES), fixed: LOCK_STATS_BYTES };
 
 pub const ADAPTIVE: MethodInfo = MethodInfo {
     name: "adaptive",
@@ -69,9 +65,8 @@ pub const ADAPTIVE: MethodInfo = MethodInfo {
     features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Submission,
     antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "W·H·(8N + 4 + 16) + 8", bytes: |px, p: &Params| adaptive_bytes(px, p.int("nodes") as u64) },
+    memory: Memory::Frame(ADAPTIVE_BYTES),
     error_bound: ErrorBound::None,
-    tiling: Tiling::Formula,
     census: false,
     census_when: never,
     main: Some("nodes"),
@@ -85,7 +80,7 @@ pub const MLAB: MethodInfo = MethodInfo {
     passes: &["insert into the layers (geometry, per-pixel lock)", "composite (full screen)"],
     params: &[ParamInfo { name: "layers", kind: ParamKind::Int { min: 1, max: 32, default: 4 }, doc: "blended layers kept per pixel" }],
     features: wgpu::Features::empty(),
-    memory: Memory::Frame { formula: "W·H·(20k + 4) + 8", bytes: |px, p: &Params| mlab_bytes(px, p.int("layers") as u64) },
+    memory: Memory::Frame(MLAB_BYTES),
     main: Some("layers"),
     pipelines: &[MLAB_PIPELINES],
     create: |_, _| Box::new(Locked::new(Kind::Mlab)),
@@ -147,14 +142,14 @@ impl Method for Locked {
                 cx.capture_into(&mut enc, "shade", &shade, &b.group, &sums.attachments(&[wgpu::Color::TRANSPARENT]));
                 let resolve = cx.resolve_pipeline(spec(pipelines, "fs_resolve"), &read, false);
                 cx.resolve_groups(&mut enc, "composite", &resolve, &[&b.group, &sums.group], false);
-                adaptive_bytes(pixels, n as u64)
+                ADAPTIVE_BYTES.at(pixels, cx.params)
             }
             Kind::Mlab => {
                 let pipelines = MLAB_PIPELINES;
                 cx.capture(&mut enc, "insert", &cx.capture_pipeline(spec(pipelines, "fs_insert"), &consts), &b.group);
                 let resolve = cx.resolve_pipeline(spec(pipelines, "fs_resolve"), &consts, false);
                 cx.resolve(&mut enc, "composite", &resolve, &b.group, false);
-                mlab_bytes(pixels, n as u64)
+                MLAB_BYTES.at(pixels, cx.params)
             }
         };
         readback.copy(&mut enc, &b.buffers[2]);

@@ -26,8 +26,8 @@ mod stochastic;
 mod sweep_costs;
 mod weighted;
 
-pub use frame::MethodReport;
 pub(crate) use frame::{check_per_pixel, FrameCtx, Limits, Method, Outcome};
+pub use frame::{MethodReport, Tally};
 pub use info::*;
 pub use params::{ParamInfo, ParamKind, ParamValue, Params};
 

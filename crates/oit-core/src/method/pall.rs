@@ -4,7 +4,7 @@
 //! block without a global atomic. Resolved exactly like `abuffer` (shaders/pall.wgsl).
 
 use super::frame::{FrameCtx, Method, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::list_pipelines::{pool_layout, swept_after};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{PIXEL_BYTES, STATE_WORDS};
@@ -26,9 +26,11 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { formula: "24 B/node of the triangles' bounds + 68 B/pixel + 16 B/triangle" },
+    memory: Memory::Scene {
+        storage: SceneBytes { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 16 },
+        note: "(a fragment's node for each pixel of its triangle's bounds)",
+    },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 16 },
     census: true,
     census_when: never,
     main: None,

@@ -4,7 +4,7 @@
 //! (shaders/peel.wgsl, docs/methods.md).
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -29,7 +29,6 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Formula,
     census: true,
     census_when: never,
     main: Some("layers"),
@@ -61,11 +60,8 @@ pub const PEEL_WORDS: u64 = crate::consts::PEEL_WORDS as u64;
 
 /// Bytes either peeling method allocates: four 64-bit keys, two layer colors and the
 /// accumulators per pixel, and a counter.
-pub fn memory_bytes(pixels: u64) -> u64 {
-    pixels * (4 * 8 + 2 * 16 + PEEL_WORDS * 4) + 4
-}
-
-const MEMORY: Memory = Memory::Frame { formula: "W·H·100 + 4", bytes: |px, _| memory_bytes(px) };
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::bytes(4 * 8 + 2 * 16 + PEEL_WORDS * 4), fixed: 4 };
+const MEMORY: Memory = Memory::Frame(BYTES);
 
 struct Peel {
     dual: bool,
@@ -109,7 +105,7 @@ impl Method for Peel {
         cx.submit(enc);
         let peeled = peeled.read(cx.gpu)?;
         Ok(Outcome::Done(MethodReport {
-            memory_bytes: memory_bytes(pixels),
+            memory_bytes: BYTES.at(pixels, cx.params),
             overflow_fragments: cx.fragments.saturating_sub(peeled),
             extra: vec![("geometry_passes", passes as f64), ("peeled_fragments", peeled as f64)],
             ..Default::default()

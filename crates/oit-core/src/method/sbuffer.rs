@@ -4,7 +4,7 @@
 //! The pool holds exactly the counted fragments (shaders/sbuffer.wgsl).
 
 use super::frame::{FrameCtx, Method, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::list_pipelines::{pool_layout, swept_after};
 use super::lists::{Aux, ListLayout, ListMethod};
 use super::lists::{PIXEL_BYTES, STATE_WORDS};
@@ -26,9 +26,8 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { formula: "24 B/fragment + 72 B/pixel + scan sums" },
+    memory: Memory::Scene { storage: SceneBytes { per_pixel: PIXEL_BYTES + 8, per_fragment: 24, per_triangle: 0 }, note: "+ scan sums" },
     error_bound: ErrorBound::Exact,
-    tiling: Tiling::Storage { per_pixel: PIXEL_BYTES + 8, per_fragment: 24, per_triangle: 0 },
     census: true,
     census_when: never,
     main: None,

@@ -3,7 +3,7 @@
 //! opaque (shaders/screen_door.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
 use crate::bindings::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -21,9 +21,8 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::BitwiseExceptTies,
     antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "W·H·4", bytes: |px, _| memory_bytes(px) },
+    memory: Memory::Frame(BYTES),
     error_bound: ErrorBound::None,
-    tiling: Tiling::Formula,
     census: false,
     census_when: never,
     main: None,
@@ -32,9 +31,7 @@ pub const INFO: MethodInfo = MethodInfo {
 };
 
 /// Bytes screen_door allocates: its own depth buffer.
-pub fn memory_bytes(pixels: u64) -> u64 {
-    pixels * 4
-}
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::bytes(4), fixed: 0 };
 
 const PIPELINES: &[PipelineSpec] = &[PipelineSpec::geometry("screen_door.wgsl", "fs_door", &[Layout::Scene])];
 
@@ -71,6 +68,6 @@ impl Method for ScreenDoor {
             cx.scene.transparent.draw_all(&mut pass);
         }
         cx.gpu.queue.submit([enc.finish()]);
-        Ok(Outcome::Done(MethodReport { memory_bytes: memory_bytes(size.0 as u64 * size.1 as u64), ..Default::default() }))
+        Ok(Outcome::Done(MethodReport { memory_bytes: BYTES.at(size.0 as u64 * size.1 as u64, cx.params), ..Default::default() }))
     }
 }

@@ -4,7 +4,7 @@
 
 use super::accum::{accumulation_targets, Companion, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -34,9 +34,8 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Submission,
     antialias_modes: FRAMES,
-    memory: Memory::Frame { formula: "W·H·(4·samples + 20)", bytes: |px, p| memory_bytes(px, p.int("samples") as u64) },
+    memory: Memory::Frame(FrameBytes { per_pixel: Linear::per("samples", 4, super::accum::TARGET_BYTES), fixed: 0 }),
     error_bound: ErrorBound::None,
-    tiling: Tiling::Formula,
     census: false,
     census_when: never,
     main: Some("samples"),
@@ -55,11 +54,6 @@ const PIPELINES: &[PipelineSpec] = &[
     PipelineSpec::geometry(SHADER, "fs_accum", SAMPLES),
     PipelineSpec::fullscreen(SHADER, "fs_resolve", &[Layout::Scene, Layout::Targets, Layout::Textures(TEXTURES)]),
 ];
-
-/// Bytes stochastic allocates: `samples` depth words per pixel and two float targets.
-pub fn memory_bytes(pixels: u64, samples: u64) -> u64 {
-    pixels * (samples * 4 + super::accum::TARGET_BYTES)
-}
 
 struct Stochastic {
     samples: Option<StorageGroup>,

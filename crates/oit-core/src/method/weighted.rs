@@ -1,9 +1,9 @@
 //! `wsum`, `wavg` and `wboit`: one geometry pass with additive (and, for wboit's revealage,
 //! multiplicative) blending into two float targets, then a full-screen resolve.
 
-use super::accum::{accumulation_targets, memory_bytes, Companion, FloatTargets};
+use super::accum::{accumulation_targets, Companion, FloatTargets, TARGET_BYTES};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
 use super::params::{ParamInfo, ParamKind};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -41,7 +41,6 @@ pub const WSUM: MethodInfo = MethodInfo {
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::None,
-    tiling: Tiling::Formula,
     census: false,
     census_when: never,
     main: None,
@@ -72,7 +71,9 @@ pub const WBOIT: MethodInfo = MethodInfo {
     ..WSUM
 };
 
-const MEMORY: Memory = Memory::Frame { formula: "W·H·20", bytes: |px, _| memory_bytes(px) };
+/// The two targets: RGBA32F color and the R32F companion.
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::bytes(TARGET_BYTES), fixed: 0 };
+const MEMORY: Memory = Memory::Frame(BYTES);
 
 struct Weighted {
     kind: Weighting,
@@ -102,6 +103,6 @@ impl Method for Weighted {
         w.accumulate(cx, &mut enc, aux, &accumulate, &[]);
         cx.resolve(&mut enc, "resolve", &resolve, &w.group, false);
         cx.submit(enc);
-        Ok(Outcome::Done(MethodReport { memory_bytes: memory_bytes(cx.pixels()), ..Default::default() }))
+        Ok(Outcome::Done(MethodReport { memory_bytes: BYTES.at(cx.pixels(), cx.params), ..Default::default() }))
     }
 }

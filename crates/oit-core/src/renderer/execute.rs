@@ -12,7 +12,7 @@ use crate::error::{OitError, Result};
 use crate::method::{AntialiasMode, FrameCtx, Method, MethodInfo, MethodReport, Outcome, Params};
 use crate::scene::Camera;
 use crate::stats::{ExtraMerge, Stats};
-use crate::targets::{read_region, SampleTargets, Targets};
+use crate::targets::{read_buffers, Region, SampleTargets, Targets};
 use crate::tiles::Tile;
 
 /// One frame as the executor runs it: what is drawn with which method, and in which mode.
@@ -25,6 +25,9 @@ pub(super) struct Job<'a> {
     /// opaque pass per sample and hands the method the per-sample targets (`FrameCtx::coverage`).
     pub coverage: bool,
 }
+
+/// Each timed pass's label and GPU milliseconds, in recording order.
+type PassTimes = Vec<(&'static str, f64)>;
 
 /// Where a frame's fragment counts come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,7 +46,7 @@ enum Counting {
 struct Rendered {
     tiles: u32,
     report: MethodReport,
-    pass_times: Option<Vec<(&'static str, f64)>>,
+    pass_times: Option<PassTimes>,
     arrays: FrameArrays,
 }
 
@@ -210,7 +213,7 @@ impl Renderer {
             }
             let mut report = MethodReport::default();
             let mut extra = ExtraMerge::default();
-            let mut pass_times: Option<Vec<(&'static str, f64)>> = None;
+            let mut pass_times: Option<PassTimes> = None;
             let mut arrays = FrameArrays::new(w, h);
             let mut retile = None;
             for tile in &tiles {
@@ -233,14 +236,14 @@ impl Renderer {
                     }
                     Outcome::Grow => unreachable!("render_tile renders a grown tile again"),
                 };
-                if let Some(t) = self.timer.read(&self.gpu)? {
+                let (r, times) = self.read_tile(*tile, r, &mut arrays)?;
+                if let Some(t) = times {
                     pass_times.get_or_insert_with(Vec::new).extend(t);
                 }
                 report.memory_bytes = report.memory_bytes.max(r.memory_bytes);
                 report.counts = r.counts;
                 report.overflow_fragments += r.overflow_fragments;
                 extra.add(&r.extra, tile.pixels() as f64);
-                self.read_tile(*tile, r.error_bound, &mut arrays)?;
             }
             report.extra = extra.finish();
             if let Some(factor) = retile {
@@ -335,20 +338,45 @@ impl Renderer {
         Ok(made)
     }
 
-    /// Reads `tile`'s output (and its error bound, with `bound`) into the frame's arrays; a
-    /// frame into a caller's texture is copied there instead, once whole.
-    fn read_tile(&self, tile: Tile, bound: bool, arrays: &mut FrameArrays) -> Result<()> {
+    /// Reads what `tile` left to read, after one submission and one wait: its output (and
+    /// its error bound, where the method wrote one) into the frame's arrays (a frame into a
+    /// caller's texture is copied there instead, once whole), the pass times, and the counts
+    /// of `report`'s tallies, which it adds to the report.
+    fn read_tile(&self, tile: Tile, mut report: MethodReport, arrays: &mut FrameArrays) -> Result<(MethodReport, Option<PassTimes>)> {
         let t = self.targets.as_ref().expect("made by ensure_targets");
-        if self.into.is_some() {
-            return Ok(());
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        let times = self.timer.record_read(&mut enc);
+        let mut reads: Vec<(&wgpu::Buffer, u64)> = report.tallies.iter().map(|t| (&t.readback, 4)).collect();
+        reads.extend(times.as_ref().map(|(b, n)| (b, *n)));
+        let image = self.into.is_none().then(|| Region::copy(&mut enc, &t.out_texture, &t.image_readback, 16, tile.local()));
+        let bound = (self.into.is_none() && report.error_bound)
+            .then(|| Region::copy(&mut enc, &t.bound_texture, &t.bound_readback, 4, tile.local()));
+        reads.extend(image.map(|r| (&t.image_readback, r.bytes())));
+        reads.extend(bound.map(|r| (&t.bound_readback, r.bytes())));
+        self.gpu.queue.submit([enc.finish()]);
+        let mut raw = read_buffers(&self.gpu, &reads)?.into_iter();
+        let tallies = std::mem::take(&mut report.tallies);
+        let mut named = Vec::new();
+        for tally in &tallies {
+            let bytes = raw.next().expect("a tally's count");
+            let count = u32::from_le_bytes(bytes[..4].try_into().expect("4 bytes")) as u64;
+            report.overflow_fragments += count;
+            named.extend(tally.extra.map(|name| (name, count as f64)));
         }
+        // A tally's stat comes first, as the method's own extras follow its passes.
+        report.extra.splice(0..0, named);
+        let times = match times {
+            Some(_) => Some(self.timer.durations(&raw.next().expect("the pass times"))),
+            // Timed, with no pass recorded: no time.
+            None => self.timer.enabled().then(Vec::new),
+        };
         let size = (arrays.width, arrays.height);
-        let image = read_region(&self.gpu, &t.out_texture, &t.image_readback, 16, tile.local())?;
-        FrameArrays::place(&mut arrays.image, size, tile, image, 4);
-        if bound {
-            let values = read_region(&self.gpu, &t.bound_texture, &t.bound_readback, 4, tile.local())?;
-            FrameArrays::place(arrays.bound.get_or_insert_with(Vec::new), size, tile, values, 1);
+        if let Some(r) = image {
+            FrameArrays::place(&mut arrays.image, size, tile, r.unpack(&raw.next().expect("the image")), 4);
         }
-        Ok(())
+        if let Some(r) = bound {
+            FrameArrays::place(arrays.bound.get_or_insert_with(Vec::new), size, tile, r.unpack(&raw.next().expect("the bound")), 1);
+        }
+        Ok((report, times))
     }
 }

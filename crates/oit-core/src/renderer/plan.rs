@@ -88,7 +88,7 @@ impl Renderer {
         // first plan proved too loose.
         let variable = |rest: u64| if rest == u64::MAX { rest } else { (rest as f64 / squeeze) as u64 };
         let binding = self.limits.max_binding_bytes;
-        let mut fp = match info.tiling {
+        let mut fp = match info.tiling() {
             Tiling::Formula => {
                 let one = info.memory_bytes(1, params, None).unwrap_or(0);
                 let per_pixel = info.memory_bytes(2, params, None).unwrap_or(0) - one;
