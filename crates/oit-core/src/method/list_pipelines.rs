@@ -2,12 +2,9 @@
 //! pool, the sorted resolve's sweeps (common/sweep.wgsl) where the method keeps sweep state,
 //! the full-screen resolve, and the pass before capture that binding 7 may need.
 
-use super::lists::POOL_BINDINGS;
+use super::pool::POOL_LAYOUT;
 use crate::cache::{Layout, PipelineSpec};
 
-/// The pool's group: heads, allocator, the pool bindings, sweep state, binding 7 and the
-/// per-pixel counts a capture that counts its own fragments keeps (binding 8).
-pub(crate) const POOL_LAYOUT: Layout = Layout::Storage(5 + POOL_BINDINGS as u32);
 /// The groups of a list method's passes.
 pub(crate) const FRAME: &[Layout] = &[Layout::Scene, Layout::Targets, POOL_LAYOUT];
 /// The groups of its passes in a coverage-mask frame.

@@ -6,8 +6,9 @@
 use super::frame::{FrameCtx, Method, MethodReport};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, Tiling, FRAMES};
 use super::list_pipelines::{swept_after, FRAME};
-use super::lists::{Aux, ListLayout, ListMethod};
-use super::lists::{PIXEL_BYTES, STATE_WORDS};
+use super::lists::{ListLayout, ListMethod};
+use super::pool::PoolAux;
+use super::resolve_plan::{PIXEL_BYTES, STATE_WORDS};
 use crate::cache::PipelineSpec;
 use crate::error::Result;
 use crate::gpu_types::{PallBlock, PoolNode};
@@ -41,7 +42,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 state_words: STATE_WORDS,
                 samples: 1,
                 shades_at_resolve: false,
-                aux: Aux::PerTriangle(std::mem::size_of::<PallBlock>() as u64),
+                aux: PoolAux::PerTriangle(std::mem::size_of::<PallBlock>() as u64),
                 counts_in_capture: false,
             },
         )))
