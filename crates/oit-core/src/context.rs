@@ -29,17 +29,21 @@ pub struct LoopLimit {
 /// What one unit of the sorted resolve costs in a loop limiter's count (shaders/common/sweep.wgsl
 /// adds what turning a node into a fragment costs, FRAG_STEPS; method::resolve_plan::StepCosts
 /// plans dispatches from the same numbers): a node loaded into a run, a node relinked, a merge
-/// step, a fragment composited from the list (before its samples).
+/// step, a fragment composited from the list (before its samples), and what shading a fragment
+/// at composite costs besides its light loop and the shading-cost loop (`shade`: the other loops
+/// of shading.wgsl's `shade`, each counted once even when skipped; compact_abuffer).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SweepSteps {
     pub load: u32,
     pub link: u32,
     pub merge: u32,
     pub composite: u32,
+    pub shade: u32,
 }
 
 impl SweepSteps {
-    /// The shader's constants (SWEEP_*_STEPS in shaders/common/sweep.wgsl).
+    /// The shader's constants (SWEEP_*_STEPS in shaders/common/sweep.wgsl; `shade` reaches it in
+    /// SHADE_STEPS, method::lists).
     pub const fn consts(self) -> [Const; 4] {
         [
             Const::U32("SWEEP_LOAD_STEPS", self.load),
@@ -51,13 +55,13 @@ impl SweepSteps {
 }
 
 /// llvmpipe's count of the sorted resolve's units (`DeviceProfile::LLVMPIPE`).
-pub const LLVMPIPE_SWEEP: SweepSteps = SweepSteps { load: 2, link: 2, merge: 6, composite: 4 };
+pub const LLVMPIPE_SWEEP: SweepSteps = SweepSteps { load: 2, link: 2, merge: 6, composite: 4, shade: 4 };
 
 impl DeviceProfile {
     /// llvmpipe (lavapipe): 65,535 iterations an invocation, every `switch` counted as one (SPIR-V
     /// to NIR makes a switch a loop). A node loaded into a run costs its loop and the pool's
     /// switch; a node relinked its loop and append's switch; a merge step its switch, two
-    /// fragments, the link and the append; a composited fragment four.
+    /// fragments, the link and the append; a composited fragment four; shading it a margin of four.
     pub const LLVMPIPE: Self = Self { loop_limit: Some(LoopLimit { iterations: 65_535, sweep: LLVMPIPE_SWEEP }) };
     /// An adapter whose loops run to their end.
     pub const UNLIMITED: Self = Self { loop_limit: None };

@@ -84,13 +84,14 @@ impl ListMethod {
     /// fragments.
     fn step_costs(&self, cx: &FrameCtx<'_>, deepest: u32) -> StepCosts {
         // Shading at composite (compact_abuffer's frag_shaded): shading.wgsl's `shade` (its
-        // light loop, the shading-cost loop, and a margin for its other loops, each of which
-        // a loop limiter counts once even when skipped). Its nodes' fragments and tie keys
-        // read the triangle's record, which costs no loop: runs stay keyed.
-        let shade = if self.shades_at_resolve { 4 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64 } else { 0 };
+        // light loop, the shading-cost loop, and the profile's margin for its other loops). Its
+        // nodes' fragments and tie keys read the triangle's record, which costs no loop: runs
+        // stay keyed.
+        let steps = cx.gpu.profile.loop_limit.map(|l| l.sweep).unwrap_or_default();
+        let shading = steps.shade as u64 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64;
+        let shade = if self.shades_at_resolve { shading } else { 0 };
         let frag = 0;
         let run = (deepest as u64).min(RUN as u64);
-        let steps = cx.gpu.profile.loop_limit.map(|l| l.sweep).unwrap_or_default();
         StepCosts { steps, samples: self.sweeps.unwrap_or(1) as u64, frag, shade, run }
     }
 
