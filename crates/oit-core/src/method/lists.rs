@@ -25,8 +25,8 @@ pub(crate) struct ListMethod {
     pipelines: &'static [PipelineSpec],
     consts: Vec<Const>,
     pool: NodePool,
-    /// Whether the resolve runs `cs_sweep` dispatches before the full-screen pass, and the
-    /// samples a pixel it composites.
+    /// Whether the resolve sorts each pixel's list before the full-screen pass (the sorted
+    /// resolve, common/sweep.wgsl), and the samples a pixel it composites.
     sweeps: Option<u32>,
     aux: PoolAux,
     /// The prefix sum over binding 7, for `PoolAux::PixelOffsets`, and the pixels it is for.
@@ -95,6 +95,8 @@ impl ListMethod {
         StepCosts { steps, samples: self.sweeps.unwrap_or(1) as u64, frag, shade, run }
     }
 
+    /// A frame's shader constants: the pool's shape, the run length, the resolve's strategy and
+    /// step costs (from the adapter's profile), whether the capture counts, and the method's own.
     fn consts_for(&self, gpu: &GpuContext, run: u32, costs: StepCosts, strategy: ResolveStrategy, counting: bool) -> Vec<Const> {
         let mut consts = self.pool.consts().to_vec();
         consts.push(Const::U32("RUN", run));
