@@ -1,6 +1,6 @@
 // A node pool split across up to four storage bindings (2 to 5 of group 2), so that it can
 // pass the adapter's per-binding limit. NODES_PER_BINDING and POOL_SPLIT (the bindings in
-// use) are injected by the pipeline (oit_core::method::lists): a pool in one binding skips
+// use) are injected by the pipeline (oit_core::method::pool): a pool in one binding skips
 // the switch, which costs every lane all four loads on a SIMD software rasterizer. Unused
 // bindings hold a one-node placeholder buffer. The including shader defines `struct Node`
 // with a `next: u32` field.

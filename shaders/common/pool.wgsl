@@ -27,7 +27,7 @@ const NIL: u32 = 0u;
 
 // Where a capture counts its own fragments (COUNTING: a frame that runs no census, whose pool
 // was sized by an earlier frame), each pixel's count, for the frame's statistics and the
-// resolve's plan (oit_core::method::lists); a placeholder otherwise.
+// resolve's plan (oit_core::method::resolve_plan); a placeholder otherwise.
 @group(2) @binding(8) var<storage, read_write> pixel_counts: array<atomic<u32>>;
 
 // Appends `n` to pixel `px`'s list; past the capacity it is only counted (the host grows

@@ -42,17 +42,21 @@ pub const TAU_SCALE: f32 = 4096.0;
 pub const TAU2_SCALE: f32 = 1024.0;
 pub const QUANT_SCALE: f32 = 16_777_216.0;
 
-/// What one unit of the sorted resolve costs on llvmpipe's loop limiter, which ends an
-/// invocation's loops after 65,535 iterations and counts every `switch` as one
-/// (shaders/common/sweep.wgsl adds what turning a node into a fragment costs, FRAG_STEPS;
-/// oit_core::method::sweep_costs::StepCosts plans dispatches from the same numbers): a node loaded
-/// into a run (its loop, the pool's switch), a node relinked (the loop, append's switch), a
-/// merge step (its switch, two fragments, the link, the append), a fragment composited from
-/// the list (before its samples).
-pub const SWEEP_LOAD_STEPS: u32 = 2;
-pub const SWEEP_LINK_STEPS: u32 = 2;
-pub const SWEEP_MERGE_STEPS: u32 = 6;
-pub const SWEEP_COMPOSITE_STEPS: u32 = 4;
+/// Fragments the submission-order replays select per sweep (shaders/common/select.wgsl).
+pub const BATCH: u32 = 32;
+/// Fragments the exact resolve sorts in a local array at most (shaders/common/sweep_sort.wgsl,
+/// where the frame's own run length, RUN, is injected: `method::resolve_plan::run_length`): a
+/// longer list is sorted in runs, then merged by relinking its nodes. 128 keeps all but the
+/// deepest pixels of hair in one walk (the relinking merges cost far more a node than the local
+/// ones); the array holds twice RUN entries of 8 bytes (24 where the runs hold whole fragments).
+pub const RUN: u32 = 128;
+/// The shortest run, sorted by insertion before the local merges.
+pub const SWEEP_BLOCK: u32 = 8;
+/// Words of a pixel's sweep state besides its samples', and words a sample of it keeps (its
+/// accumulated color and transmittance): STATE_WORDS = SWEEP_PIXEL_WORDS + SWEEP_SAMPLE_WORDS ·
+/// samples (shaders/common/sweep.wgsl; `method::resolve_plan::state_words`).
+pub const SWEEP_PIXEL_WORDS: u32 = 12;
+pub const SWEEP_SAMPLE_WORDS: u32 = 4;
 
 /// Attempts a fragment makes at its pixel's lock before it gives up and is counted
 /// (`lock_failures`; shaders/common/pixel_lock.wgsl): far more than one pixel's fragments can
@@ -100,9 +104,9 @@ pub const SHARED: &[Const] = &[
     Const::U32("FIRST_SEGMENT", crate::primitive::FIRST_SEGMENT),
     Const::U32("LAST_SEGMENT", crate::primitive::LAST_SEGMENT),
     Const::U32("POINT_MASK", crate::primitive::POINT_MASK),
-    Const::U32("SWEEP_LOAD_STEPS", SWEEP_LOAD_STEPS),
-    Const::U32("SWEEP_LINK_STEPS", SWEEP_LINK_STEPS),
-    Const::U32("SWEEP_MERGE_STEPS", SWEEP_MERGE_STEPS),
-    Const::U32("SWEEP_COMPOSITE_STEPS", SWEEP_COMPOSITE_STEPS),
+    Const::U32("BATCH", BATCH),
+    Const::U32("SWEEP_BLOCK", SWEEP_BLOCK),
+    Const::U32("SWEEP_PIXEL_WORDS", SWEEP_PIXEL_WORDS),
+    Const::U32("SWEEP_SAMPLE_WORDS", SWEEP_SAMPLE_WORDS),
     Const::U32("LOCK_TRIES", LOCK_TRIES),
 ];

@@ -1,7 +1,108 @@
 //! Adapter and device selection. Prefers a hardware adapter, falls back to a software
 //! one (lavapipe), honours `OIT_ADAPTER`; also wraps a Device/Queue made elsewhere (viewer).
+//! The adapter's facts that generic code plans by (`DeviceProfile`) are read here, the one
+//! place that matches an adapter's name.
 
-use crate::error::{OitError, Result};
+use crate::consts::Const;
+use crate::error::{invalid, OitError, Result};
+
+/// What generic code needs to know of an adapter beyond its features and limits. Built from the
+/// adapter's info by `DeviceProfile::for_adapter`; `OIT_LOOP_LIMIT` overrides its loop limit
+/// (`none`, or a count of iterations counted as llvmpipe counts them), and tests may set
+/// `GpuContext::profile` (or `with_profile`) before a renderer takes the context.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DeviceProfile {
+    /// The loop limiter of the driver, if it has one: the sorted resolve then sweeps in budgeted
+    /// dispatches (method::resolve_plan::ResolveStrategy), and methods whose per-pixel work grows
+    /// with the depth complexity refuse frames past it.
+    pub loop_limit: Option<LoopLimit>,
+}
+
+/// A driver that silently ends one shader invocation's loops after `iterations` iterations, all
+/// loops together (llvmpipe: 65,535), and what it counts for the sorted resolve's units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoopLimit {
+    pub iterations: u64,
+    pub sweep: SweepSteps,
+}
+
+/// What one unit of the sorted resolve costs in a loop limiter's count (shaders/common/sweep.wgsl
+/// adds what turning a node into a fragment costs, FRAG_STEPS; method::resolve_plan::StepCosts
+/// plans dispatches from the same numbers): a node loaded into a run, a node relinked, a merge
+/// step, a fragment composited from the list (before its samples), and what shading a fragment
+/// at composite costs besides its light loop and the shading-cost loop (`shade`: the other loops
+/// of shading.wgsl's `shade`, each counted once even when skipped; compact_abuffer).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SweepSteps {
+    pub load: u32,
+    pub link: u32,
+    pub merge: u32,
+    pub composite: u32,
+    pub shade: u32,
+}
+
+impl SweepSteps {
+    /// The shader's constants (SWEEP_*_STEPS in shaders/common/sweep.wgsl; `shade` reaches it in
+    /// SHADE_STEPS, method::lists).
+    pub const fn consts(self) -> [Const; 4] {
+        [
+            Const::U32("SWEEP_LOAD_STEPS", self.load),
+            Const::U32("SWEEP_LINK_STEPS", self.link),
+            Const::U32("SWEEP_MERGE_STEPS", self.merge),
+            Const::U32("SWEEP_COMPOSITE_STEPS", self.composite),
+        ]
+    }
+}
+
+/// llvmpipe's count of the sorted resolve's units (`DeviceProfile::LLVMPIPE`).
+pub const LLVMPIPE_SWEEP: SweepSteps = SweepSteps { load: 2, link: 2, merge: 6, composite: 4, shade: 4 };
+
+impl DeviceProfile {
+    /// llvmpipe (lavapipe): 65,535 iterations an invocation, every `switch` counted as one (SPIR-V
+    /// to NIR makes a switch a loop). A node loaded into a run costs its loop and the pool's
+    /// switch; a node relinked its loop and append's switch; a merge step its switch, two
+    /// fragments, the link and the append; a composited fragment four; shading it a margin of four.
+    pub const LLVMPIPE: Self = Self { loop_limit: Some(LoopLimit { iterations: 65_535, sweep: LLVMPIPE_SWEEP }) };
+    /// An adapter whose loops run to their end.
+    pub const UNLIMITED: Self = Self { loop_limit: None };
+
+    /// The profile of the adapter `info` describes.
+    pub fn for_adapter(info: &wgpu::AdapterInfo) -> Self {
+        Self::for_name(&info.name)
+    }
+
+    fn for_name(name: &str) -> Self {
+        if name.contains("llvmpipe") {
+            Self::LLVMPIPE
+        } else {
+            Self::UNLIMITED
+        }
+    }
+
+    /// `self` with `OIT_LOOP_LIMIT` applied where it is set: `none` (no limit) or a count of
+    /// iterations, counted as llvmpipe counts them.
+    pub fn with_env(self) -> Result<Self> {
+        match std::env::var("OIT_LOOP_LIMIT").ok().filter(|s| !s.is_empty()) {
+            None => Ok(self),
+            Some(v) if v.eq_ignore_ascii_case("none") => Ok(Self::UNLIMITED),
+            Some(v) => match v.trim().parse::<u64>() {
+                Ok(iterations) => Ok(Self { loop_limit: Some(LoopLimit { iterations, sweep: LLVMPIPE_SWEEP }) }),
+                Err(_) => Err(invalid!("OIT_LOOP_LIMIT='{v}': set it to `none` or a number of loop iterations, or unset it")),
+            },
+        }
+    }
+
+    /// Iterations one invocation may loop, all loops together; None where they are not limited.
+    pub fn loop_iterations(&self) -> Option<u64> {
+        self.loop_limit.map(|l| l.iterations)
+    }
+
+    /// The sorted resolve's step costs as shader constants: the limiter's, or zeros where there
+    /// is none (the plain resolve counts no steps).
+    pub fn sweep_consts(&self) -> [Const; 4] {
+        self.loop_limit.map_or(SweepSteps::default(), |l| l.sweep).consts()
+    }
+}
 
 /// A device, its queue and what the adapter can do.
 pub struct GpuContext {
@@ -12,6 +113,8 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     pub features: wgpu::Features,
     pub limits: wgpu::Limits,
+    /// The adapter's facts that frames are planned by (its loop limit).
+    pub profile: DeviceProfile,
     /// Modules, layouts and pipelines of this device, built at their first use.
     pub cache: crate::cache::PipelineCache,
 }
@@ -80,11 +183,18 @@ impl GpuContext {
             ..Default::default()
         }))
         .map_err(|e| OitError::Device(format!("could not open a device on '{}': {e}", info.name)))?;
-        Ok(Self::from_device(device, queue, info))
+        let profile = DeviceProfile::for_adapter(&info).with_env()?;
+        Ok(Self { profile, ..Self::from_device(device, queue, info) })
+    }
+
+    /// The context with `profile` in place of its adapter's (tests: the plain resolve on llvmpipe).
+    pub fn with_profile(self, profile: DeviceProfile) -> Self {
+        Self { profile, ..self }
     }
 
     /// Wraps a device created elsewhere (the viewer's eframe device); features and limits
-    /// are read from the device itself.
+    /// are read from the device itself, the profile from `info` (an invalid `OIT_LOOP_LIMIT` is
+    /// ignored here; `new` refuses it).
     pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
         let features = device.features();
         let limits = device.limits();
@@ -94,7 +204,9 @@ impl GpuContext {
             let mut slot = sink.lock().unwrap_or_else(|p| p.into_inner());
             slot.get_or_insert_with(|| e.to_string());
         }));
-        Self { device, errors, queue, info, features, limits, cache: Default::default() }
+        let adapter = DeviceProfile::for_adapter(&info);
+        let profile = adapter.with_env().unwrap_or(adapter);
+        Self { device, errors, queue, info, features, limits, profile, cache: Default::default() }
     }
 
     pub fn has(&self, f: wgpu::Features) -> bool {
@@ -130,5 +242,19 @@ impl GpuContext {
     pub fn describe(&self) -> String {
         let i = &self.info;
         format!("{} ({:?}, {:?}, {} {})", i.name, i.backend, i.device_type, i.driver, i.driver_info)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn llvmpipe_alone_has_a_loop_limit() {
+        let lavapipe = DeviceProfile::for_name("llvmpipe (LLVM 15.0.6, 256 bits)");
+        assert_eq!(lavapipe.loop_iterations(), Some(65_535));
+        assert!(matches!(lavapipe.sweep_consts()[2], Const::U32("SWEEP_MERGE_STEPS", 6)));
+        assert_eq!(DeviceProfile::for_name("NVIDIA H200"), DeviceProfile::UNLIMITED);
+        assert!(matches!(DeviceProfile::UNLIMITED.sweep_consts()[0], Const::U32("SWEEP_LOAD_STEPS", 0)));
     }
 }

@@ -11,12 +11,19 @@ pub use crate::consts::Const;
 pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("NODES_PER_BINDING", 1 << 20),
     Const::U32("POOL_SPLIT", 4),
-    Const::U32("BATCH", 32),
-    Const::U32("RUN", 128),
+    Const::U32("RUN", crate::consts::RUN),
     Const::U32("STEP_BUDGET", 32_768),
+    // Whether the sorted resolve pauses after STEP_BUDGET steps (an adapter with a loop limit)
+    // or runs each pixel to its end in one dispatch (shaders/common/sweep_passes.wgsl).
+    Const::U32("BUDGETED", 1),
     Const::U32("FRAG_STEPS", 0),
     Const::U32("SHADE_STEPS", 0),
     Const::U32("KEYED", 1),
+    // What the sorted resolve's units cost in llvmpipe's loop limiter (context::DeviceProfile).
+    crate::context::LLVMPIPE_SWEEP.consts()[0],
+    crate::context::LLVMPIPE_SWEEP.consts()[1],
+    crate::context::LLVMPIPE_SWEEP.consts()[2],
+    crate::context::LLVMPIPE_SWEEP.consts()[3],
     // Whether a list capture counts its own fragments per pixel (shaders/common/pool.wgsl).
     Const::U32("COUNTING", 0),
     // Whether the device honours @early_depth_test(force) (set by `module`): validated with

@@ -4,7 +4,9 @@
 use super::frame::{FrameCtx, Limits, Method, Outcome};
 use super::info::{never, AntialiasMode, ErrorBound, Memory, MethodInfo, Order, SceneBytes};
 use super::list_pipelines::{swept, FRAME, SAMPLES};
-use super::lists::{state_words, Aux, ListLayout, ListMethod, COUNTED_PIXEL_BYTES, STATE_WORDS};
+use super::lists::{ListLayout, ListMethod};
+use super::pool::PoolAux;
+use super::resolve_plan::{state_words, COUNTED_PIXEL_BYTES, STATE_WORDS};
 use crate::cache::PipelineSpec;
 use crate::context::GpuContext;
 use crate::error::Result;
@@ -52,7 +54,7 @@ impl ABuffer {
                 state_words: STATE_WORDS,
                 samples: 1,
                 shades_at_resolve: false,
-                aux: Aux::None,
+                aux: PoolAux::None,
                 counts_in_capture: true,
             },
         );
@@ -74,7 +76,7 @@ impl Method for ABuffer {
                             state_words: state_words(c.samples),
                             samples: c.samples,
                             shades_at_resolve: false,
-                            aux: Aux::None,
+                            aux: PoolAux::None,
                             counts_in_capture: false,
                         },
                     )

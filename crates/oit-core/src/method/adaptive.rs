@@ -1,65 +1,84 @@
-//! `adaptive_lists`: adaptive transparency (Salvi et al. 2011) as the paper's proof of concept:
-//! every fragment captured in per-pixel lists (unbounded memory, as theirs), then a
-//! full-screen pass that builds a visibility function of at most `nodes` steps in submission
-//! order and composites every fragment by it (shaders/adaptive_lists.wgsl).
+//! `adaptive`: adaptive transparency (Salvi et al. 2011) as the seed designs it: a visibility
+//! function of at most `nodes` steps a pixel, built in a first geometry pass inside each pixel's
+//! critical section (pixel_lock.rs), then each fragment shaded by it in a second, blended, and
+//! composited (shaders/adaptive.wgsl). `adaptive_lists` is the list version it replaces.
 
+use super::accum::{blended, FloatTargets, ACCUM_FORMAT, ADD};
 use super::frame::{FrameCtx, Method, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
-use super::list_pipelines::{single, FRAME};
-use super::lists::{check_replay_budget, Aux, ListLayout, ListMethod};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::PipelineSpec;
+use super::pixel_lock::{locked_layout, PixelLocks, LOCK_BYTES, LOCK_STATS_BYTES};
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
-use crate::gpu_types::PrimNode;
 use crate::shader::Const;
 
-const PIPELINES: &[PipelineSpec] = &single("adaptive_lists.wgsl", FRAME);
+const OWN: Layout = locked_layout!("nodes");
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
+/// The resolve also reads the shading pass's sums at group 3.
+const SUMS: &[(&str, u32)] = &[("accum_tex", 0)];
+const RESOLVE: &[Layout] = &[Layout::Scene, Layout::Targets, OWN, Layout::Textures(SUMS)];
+
+const SHADER: &str = "adaptive.wgsl";
+const PIPELINES: &[PipelineSpec] = &[
+    PipelineSpec::geometry(SHADER, "fs_insert", GROUPS),
+    PipelineSpec::geometry(SHADER, "fs_shade", GROUPS),
+    PipelineSpec::fullscreen(SHADER, "fs_resolve", RESOLVE),
+];
+
+/// Bytes of a node (depth, transmittance).
+const NODE_BYTES: u64 = 8;
+
+/// N nodes, the lock word and the shading pass's RGBA32F sums a pixel.
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("nodes", NODE_BYTES, LOCK_BYTES + 16), fixed: LOCK_STATS_BYTES };
 
 pub const INFO: MethodInfo = MethodInfo {
-    name: "adaptive_lists",
-    summary: "adaptive transparency built from captured lists (unbounded memory; `adaptive` is the bounded one)",
+    name: "adaptive",
+    summary: "adaptive transparency: a visibility function of at most `nodes` steps per pixel, built under per-pixel locks",
     exact: false,
-    bounded_memory: false,
-    passes: &["capture (geometry)", "build visibility and composite (full screen)"],
+    bounded_memory: true,
+    passes: &[
+        "insert into the visibility function (geometry, per-pixel lock)",
+        "shade by it (geometry, blended)",
+        "composite (full screen)",
+    ],
     params: &[ParamInfo {
         name: "nodes",
         kind: ParamKind::Int { min: 1, max: 32, default: 8 },
         doc: "steps of the per-pixel visibility function",
     }],
-    features: wgpu::Features::empty(),
+    features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Submission,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { storage: SceneBytes { per_pixel: 4, per_fragment: 32, per_triangle: 0 }, note: "(grows with the scene)" },
+    memory: Memory::Frame(BYTES),
     error_bound: ErrorBound::None,
-    census: true,
+    census: false,
     census_when: never,
     main: Some("nodes"),
     pipelines: &[PIPELINES],
-    create: |gpu, limits| {
-        Box::new(Adaptive(ListMethod::new(
-            gpu,
-            limits,
-            ListLayout {
-                pipelines: PIPELINES,
-                node_bytes: std::mem::size_of::<PrimNode>() as u64,
-                state_words: 0,
-                samples: 1,
-                shades_at_resolve: false,
-                aux: Aux::None,
-                counts_in_capture: false,
-            },
-        )))
-    },
+    create: |_, _| Box::<Adaptive>::default(),
 };
 
-struct Adaptive(ListMethod);
+#[derive(Default)]
+struct Adaptive {
+    locks: PixelLocks,
+    sums: Option<FloatTargets>,
+}
 
 impl Method for Adaptive {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let nodes = cx.params.int("nodes") as u32;
-        // Per fragment: an insertion and a lookup of up to `nodes` steps each.
-        check_replay_budget(cx, "adaptive_lists", "nodes", nodes, 4 * nodes as u64)?;
-        self.0.set_consts(vec![Const::U32("NODES", nodes), Const::U32("NODES_PLUS_ONE", nodes + 1)]);
-        self.0.render(cx)
+        let n = cx.params.int("nodes") as u32;
+        let consts = [Const::U32("NODES", n), Const::U32("NODES_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)];
+        let (group, mut enc) = self.locks.begin(cx, OWN, &format!("adaptive with nodes = {n}"), (NODE_BYTES, n))?;
+        // The passes after the insert only read the nodes (READ_NODES: plain loads).
+        let read = [consts[0], consts[1], Const::U32("READ_NODES", 1)];
+        cx.capture(&mut enc, "insert", &cx.capture_pipeline(spec(PIPELINES, "fs_insert"), &consts), group);
+        let sums = FloatTargets::ensure(&mut self.sums, cx, &[ACCUM_FORMAT], SUMS);
+        let target = blended(ACCUM_FORMAT, ADD);
+        let shade = cx.draw_pipeline(spec(PIPELINES, "fs_shade"), &read, vec![target], crate::pipeline::depth_test_only());
+        cx.capture_into(&mut enc, "shade", &shade, group, &sums.attachments(&[wgpu::Color::TRANSPARENT]));
+        let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &read, false);
+        cx.resolve_groups(&mut enc, "composite", &resolve, &[group, &sums.group], false);
+        let memory = BYTES.at(cx.pixels(), cx.params);
+        self.locks.finish(cx, enc, memory).map(Outcome::Done)
     }
 }

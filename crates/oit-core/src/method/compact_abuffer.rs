@@ -5,9 +5,10 @@
 
 use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
-use super::list_pipelines::{pool_layout, swept_after};
-use super::lists::{Aux, ListLayout, ListMethod};
-use super::lists::{COUNTED_PIXEL_BYTES, STATE_WORDS};
+use super::list_pipelines::swept_after;
+use super::lists::{ListLayout, ListMethod};
+use super::pool::{pool_layout, PoolAux};
+use super::resolve_plan::{COUNTED_PIXEL_BYTES, STATE_WORDS};
 use crate::cache::{Layout, PipelineSpec};
 use crate::error::Result;
 use crate::gpu_types::{CompactNode, PrimShading};
@@ -42,7 +43,7 @@ pub const INFO: MethodInfo = MethodInfo {
                 state_words: STATE_WORDS,
                 samples: 1,
                 shades_at_resolve: true,
-                aux: Aux::PerTriangle(std::mem::size_of::<PrimShading>() as u64),
+                aux: PoolAux::PerTriangle(std::mem::size_of::<PrimShading>() as u64),
                 counts_in_capture: true,
             },
         )))

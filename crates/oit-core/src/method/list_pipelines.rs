@@ -2,22 +2,9 @@
 //! pool, the sorted resolve's sweeps (common/sweep.wgsl) where the method keeps sweep state,
 //! the full-screen resolve, and the pass before capture that binding 7 may need.
 
-use super::lists::POOL_BINDINGS;
+use super::pool::POOL_LAYOUT;
 use crate::cache::{Layout, PipelineSpec};
 
-/// The pool's group: heads, allocator, the `POOL_BINDINGS` pool bindings, sweep state, binding
-/// 7 by the name the method's shader gives it ("_" where no shader of the method reads it),
-/// and the per-pixel counts a capture that counts its own fragments keeps (binding 8).
-macro_rules! pool_layout {
-    ($aux:literal) => {
-        crate::cache::Layout::Storage(&["heads", "alloc", "pool0", "pool1", "pool2", "pool3", "state", $aux, "pixel_counts"])
-    };
-}
-pub(crate) use pool_layout;
-
-/// The pool's group of a method that keeps nothing at binding 7.
-pub(crate) const POOL_LAYOUT: Layout = pool_layout!("_");
-const _: () = assert!(matches!(POOL_LAYOUT, Layout::Storage(n) if n.len() as u64 == 5 + POOL_BINDINGS));
 /// The groups of a list method's passes.
 pub(crate) const FRAME: &[Layout] = &[Layout::Scene, Layout::Targets, POOL_LAYOUT];
 /// The groups of its passes in a coverage-mask frame.

@@ -1,279 +1,35 @@
 //! Per-pixel linked lists in a global node pool (Yang et al. 2010), shared by the methods
-//! that capture every fragment (abuffer, adaptive): one capture pass, one full-screen
-//! resolve. The pool follows the scene: it grows to the counted fragments and the frame is
-//! rendered again when the atomic counter says the pool overflowed (docs/methods.md).
+//! that capture every fragment (abuffer, adaptive_lists, ...): one capture pass, the sorted
+//! resolve's dispatches where the method has them, one full-screen resolve. The pool (pool.rs)
+//! follows the scene: it grows to the counted fragments and the frame is rendered again when
+//! the atomic counter says the pool overflowed (docs/methods.md).
 
 use super::frame::{Dispatch, FrameCtx, Limits, MethodReport, Outcome};
 use super::list_pipelines::SWEEPS;
-pub(crate) use super::sweep_costs::{pixel_bytes, state_words, COUNTED_PIXEL_BYTES, PIXEL_BYTES, STATE_WORDS};
-pub use super::sweep_costs::{resolve_dispatches, step_budget, StepCosts};
-use crate::cache::{spec, Layout, PipelineSpec};
+use super::pool::{NodePool, PoolAux, LIST_ARGS_BYTES};
+use super::resolve_plan::{run_length, ResolveStrategy, StepCosts};
+use crate::cache::{spec, PipelineSpec};
+use crate::consts::{BATCH, RUN};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::Alloc;
 use crate::scan::Scan;
 use crate::shader::Const;
-use crate::targets::{read_buffer, storage_buffer};
 
-/// Storage bindings the pool is split across (shaders/common/pool.wgsl).
-pub const POOL_BINDINGS: u64 = 4;
-/// Fragments the submission-order replays select per sweep (shaders/common/select.wgsl).
-pub const BATCH: u32 = 32;
-/// Fragments the exact resolve sorts in a local array at most (shaders/common/sweep.wgsl):
-/// a list no longer takes one walk; a longer one is sorted in runs of RUN, then merged by
-/// relinking its nodes. 128 keeps all but the deepest pixels of hair in one walk (the relinking
-/// merges cost far more a node than the local ones); the array holds twice RUN entries of 8
-/// bytes (24 where the runs hold whole fragments).
-pub const RUN: u32 = 128;
-/// The shortest run, sorted by insertion before the local merges (BLOCK in sweep.wgsl).
-pub const BLOCK: u64 = 8;
-
-/// The local array of a frame whose deepest pixel has n fragments: the smallest power of two
-/// from BLOCK to RUN that holds it (a smaller array is cheaper to keep: it is zeroed at every
-/// invocation).
-pub fn run_length(n: u64) -> u32 {
-    (n.next_power_of_two() as u32).clamp(BLOCK as u32, RUN)
-}
-
-const ALLOC_BYTES: u64 = std::mem::size_of::<Alloc>() as u64;
-/// The indirect dispatch arguments (x, y, z workgroups) of the sorted resolve's first pass,
-/// then of its deep phases.
-const LIST_ARGS_BYTES: u64 = 24;
-
-/// What a list method keeps at binding 7 besides its pool.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Aux {
-    None,
-    /// Bytes per transparent triangle, filled by a `cs_allocate` pass before capture.
-    PerTriangle(u64),
-    /// W * H + 1 words: per-pixel counts scanned into range starts (sbuffer).
-    PixelOffsets,
-}
-
-/// A linked-list node pool with its heads and allocator, shared by list-based methods.
-pub(crate) struct NodePool {
-    node_bytes: u64,
-    pub nodes_per_binding: u64,
-    pub capacity: u64,
-    pixels: u64,
-    pub heads: wgpu::Buffer,
-    pub alloc: wgpu::Buffer,
-    alloc_readback: wgpu::Buffer,
-    pub pools: Vec<wgpu::Buffer>,
-    /// Per-pixel state carried between resolve sweeps (binding 6).
-    state: wgpu::Buffer,
-    pub state_words: u64,
-    /// The sorted resolve's indirect dispatch arguments, copied from the allocator.
-    list_args: wgpu::Buffer,
-    /// Binding 7: per-triangle data of the allocation pass, or per-pixel offsets.
-    pub aux: wgpu::Buffer,
-    aux_kind: Aux,
-    aux_len: u64,
-    /// Binding 8: each pixel's fragments, where the capture counts them itself (`counting`),
-    /// with its readback; a placeholder otherwise.
-    counts: wgpu::Buffer,
-    counts_readback: Option<wgpu::Buffer>,
-    counting: bool,
-    /// The group's layout, by the names of the method's shader (its table's group 2).
-    pub layout: Layout,
-    pub group: Option<wgpu::BindGroup>,
-}
-
-impl NodePool {
-    pub fn new(
-        gpu: &GpuContext,
-        limits: &Limits,
-        node_bytes: u64,
-        state_words: u64,
-        aux_kind: Aux,
-        counting: bool,
-        layout: Layout,
-    ) -> Self {
-        let d = &gpu.device;
-        let alloc = storage_buffer(d, "alloc", ALLOC_BYTES, wgpu::BufferUsages::COPY_SRC);
-        let alloc_readback = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("alloc readback"),
-            size: ALLOC_BYTES,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        Self {
-            node_bytes,
-            nodes_per_binding: (limits.max_binding_bytes / node_bytes).max(1).min(u32::MAX as u64 / POOL_BINDINGS),
-            capacity: 0,
-            pixels: 0,
-            heads: storage_buffer(d, "heads", 4, wgpu::BufferUsages::empty()),
-            alloc,
-            alloc_readback,
-            pools: Vec::new(),
-            state: storage_buffer(d, "sweep state", 4, wgpu::BufferUsages::empty()),
-            state_words,
-            list_args: d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pixel list dispatch args"),
-                size: LIST_ARGS_BYTES,
-                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            aux: storage_buffer(d, "list aux", 4, wgpu::BufferUsages::empty()),
-            aux_kind,
-            aux_len: 0,
-            counts: storage_buffer(d, "capture counts", 4, wgpu::BufferUsages::empty()),
-            counts_readback: None,
-            counting,
-            layout,
-            group: None,
-        }
-    }
-
-    /// The pool's shape for its shaders: nodes a binding, and bindings in use (1 lets them
-    /// skip the switch over bindings).
-    pub fn consts(&self) -> [Const; 2] {
-        let split = if self.capacity <= self.nodes_per_binding { 1 } else { POOL_BINDINGS as u32 };
-        [Const::U32("NODES_PER_BINDING", self.nodes_per_binding as u32), Const::U32("POOL_SPLIT", split)]
-    }
-
-    pub fn max_nodes(&self) -> u64 {
-        self.nodes_per_binding * POOL_BINDINGS
-    }
-
-    /// Words of the state buffer a pixel: its sweep state and, with one, its entries of the
-    /// pixel lists (shaders/common/sweep.wgsl).
-    pub fn state_len(&self) -> u64 {
-        self.state_words + 2 * (self.state_words > 0) as u64
-    }
-
-    /// Bytes a pixel keeps: its head, sweep state and list entries, and its count where the
-    /// capture counts.
-    pub fn pixel_bytes(&self) -> u64 {
-        4 * (1 + self.state_len() + self.counting as u64)
-    }
-
-    pub fn bytes(&self) -> u64 {
-        self.capacity * self.node_bytes + self.pixels * self.pixel_bytes() + self.aux_len + ALLOC_BYTES + LIST_ARGS_BYTES
-    }
-
-    /// Makes room for `nodes` nodes, `pixels` heads and `triangles` per-triangle records,
-    /// reallocating only when needed.
-    /// With `exact`, the pool is made exactly `nodes` large (a tile of a budgeted frame);
-    /// otherwise it keeps a larger capacity unless less than a quarter would be used.
-    pub fn reserve(&mut self, gpu: &GpuContext, nodes: u64, pixels: u64, triangles: u64, exact: bool) -> Result<()> {
-        if nodes > self.max_nodes() {
-            return Err(OitError::OutOfMemory(format!(
-                "the frame has {nodes} transparent fragments but the node pool holds at most {} on this adapter \
-                 ({POOL_BINDINGS} bindings of {} bytes): render at a smaller size or with a bounded method (e.g. hybrid)",
-                self.max_nodes(),
-                self.nodes_per_binding * self.node_bytes
-            )));
-        }
-        let d = &gpu.device;
-        let mut changed = self.group.is_none();
-        if pixels != self.pixels {
-            self.heads = storage_buffer(d, "heads", pixels * 4, wgpu::BufferUsages::empty());
-            self.state = storage_buffer(d, "sweep state", pixels * 4 * self.state_len(), wgpu::BufferUsages::empty());
-            if self.counting {
-                self.counts = storage_buffer(d, "capture counts", pixels * 4, wgpu::BufferUsages::COPY_SRC);
-                self.counts_readback = Some(d.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("capture counts readback"),
-                    size: ALLOC_BYTES + pixels * 4,
-                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }));
-            }
-            self.pixels = pixels;
-            changed = true;
-        }
-        let aux_len = match self.aux_kind {
-            Aux::None => 0,
-            // At least one record: a binding must hold one element even without triangles.
-            Aux::PerTriangle(bytes) => triangles.max(1) * bytes,
-            Aux::PixelOffsets => (pixels + 1) * 4,
-        };
-        if aux_len != self.aux_len {
-            if aux_len > gpu.max_binding_bytes() {
-                return Err(OitError::OutOfMemory(format!(
-                    "this frame needs a {aux_len}-byte buffer of per-triangle or per-pixel data, past the adapter's \
-                     {}-byte storage binding limit: split the scene or render a smaller frame",
-                    gpu.max_binding_bytes()
-                )));
-            }
-            self.aux = storage_buffer(d, "list aux", aux_len, wgpu::BufferUsages::COPY_SRC);
-            self.aux_len = aux_len;
-            changed = true;
-        }
-        // Grow to what was counted; shrink when less than a quarter is used.
-        if nodes > self.capacity || nodes < self.capacity / 4 || (exact && nodes.max(1) != self.capacity) {
-            self.capacity = nodes.max(1);
-            self.pools = (0..POOL_BINDINGS)
-                .map(|b| {
-                    let n = self.capacity.saturating_sub(b * self.nodes_per_binding).min(self.nodes_per_binding).max(1);
-                    storage_buffer(d, "node pool", n * self.node_bytes, wgpu::BufferUsages::empty())
-                })
-                .collect();
-            changed = true;
-        }
-        if changed {
-            let Some(names) = self.layout.named() else { unreachable!("a storage layout") };
-            // Heads, allocator, pools, state, binding 7, counts: in the layout's order.
-            let buffers = [&self.heads, &self.alloc].into_iter().chain(&self.pools).chain([&self.state, &self.aux, &self.counts]);
-            let entries: Vec<(&str, wgpu::BindingResource<'_>)> =
-                names.iter().zip(buffers).map(|((name, _), b)| (*name, b.as_entire_binding())).collect();
-            self.group = Some(crate::cache::bind_named(&gpu.device, &gpu.cache, self.layout, "node pool", &entries));
-        }
-        Ok(())
-    }
-
-    /// Records the per-frame reset: empty lists and a zero counter with the capacity.
-    pub fn clear(&self, gpu: &GpuContext, enc: &mut wgpu::CommandEncoder) {
-        enc.clear_buffer(&self.heads, 0, None);
-        enc.clear_buffer(&self.state, 0, None);
-        let alloc = Alloc { capacity: self.capacity.min(u32::MAX as u64) as u32, ..Default::default() };
-        gpu.queue.write_buffer(&self.alloc, 0, bytemuck::bytes_of(&alloc));
-    }
-
-    pub fn copy_count(&self, enc: &mut wgpu::CommandEncoder) {
-        enc.copy_buffer_to_buffer(&self.alloc, 0, &self.alloc_readback, 0, ALLOC_BYTES);
-    }
-
-    /// Records the zeroing of the capture's per-pixel counts.
-    fn clear_counts(&self, enc: &mut wgpu::CommandEncoder) {
-        enc.clear_buffer(&self.counts, 0, None);
-    }
-
-    /// Records the copy of the allocator and the capture's per-pixel counts to one readback,
-    /// so that the host waits once for both.
-    fn copy_counts(&self, enc: &mut wgpu::CommandEncoder) {
-        let r = self.counts_readback.as_ref().expect("a counting pool has its readback once reserved");
-        enc.copy_buffer_to_buffer(&self.alloc, 0, r, 0, ALLOC_BYTES);
-        enc.copy_buffer_to_buffer(&self.counts, 0, r, ALLOC_BYTES, self.pixels * 4);
-    }
-
-    /// The allocator after the capture and the capture's per-pixel counts, row-major in the
-    /// tile (after `copy_counts` ran).
-    fn read_counts(&self, gpu: &GpuContext) -> Result<(Alloc, Vec<u32>)> {
-        let r = self.counts_readback.as_ref().expect("a counting pool has its readback once reserved");
-        let raw = read_buffer(gpu, r, ALLOC_BYTES + self.pixels * 4)?;
-        let (alloc, counts) = raw.split_at(ALLOC_BYTES as usize);
-        Ok((bytemuck::pod_read_unaligned::<Alloc>(alloc), bytemuck::pod_collect_to_vec(counts)))
-    }
-
-    /// The allocator after the last capture: nodes asked for (may exceed the capacity) and
-    /// fragments that escaped their allocation.
-    pub fn read_alloc(&self, gpu: &GpuContext) -> Result<Alloc> {
-        let raw = read_buffer(gpu, &self.alloc_readback, ALLOC_BYTES)?;
-        Ok(bytemuck::pod_read_unaligned::<Alloc>(&raw))
-    }
-}
+// What renderer/plan.rs reads by these paths.
+pub(crate) use super::pool::POOL_BINDINGS;
+pub(crate) use super::resolve_plan::pixel_bytes;
 
 /// A capture-then-resolve method over a node pool.
 pub(crate) struct ListMethod {
     pipelines: &'static [PipelineSpec],
     consts: Vec<Const>,
     pool: NodePool,
-    /// Whether the resolve runs `cs_sweep` dispatches before the full-screen pass, and the
-    /// samples a pixel it composites.
+    /// Whether the resolve sorts each pixel's list before the full-screen pass (the sorted
+    /// resolve, common/sweep.wgsl), and the samples a pixel it composites.
     sweeps: Option<u32>,
-    aux: Aux,
-    /// The prefix sum over binding 7, for `Aux::PixelOffsets`, and the pixels it is for.
+    aux: PoolAux,
+    /// The prefix sum over binding 7, for `PoolAux::PixelOffsets`, and the pixels it is for.
     scan: Option<(u64, Scan)>,
     shades_at_resolve: bool,
     /// The nodes the pool grew to after the last render of this tile proved it short
@@ -296,20 +52,10 @@ pub(crate) struct ListLayout {
     /// iterations then count in the resolve's step budget.
     pub shades_at_resolve: bool,
     /// What binding 7 holds, and so which passes run before capture.
-    pub aux: Aux,
+    pub aux: PoolAux,
     /// Whether the capture can count each pixel's fragments itself (its nodes are its
     /// fragments), so that a frame after the first needs no census (`ListMethod::counts_in_capture`).
     pub counts_in_capture: bool,
-}
-
-/// Loop iterations llvmpipe allows one shader invocation (all loops together); past them
-/// it silently ends the loops. Methods whose per-pixel work grows with the depth complexity
-/// check their estimate against it on that adapter.
-pub const LLVMPIPE_LOOP_LIMIT: u64 = 65_535;
-
-/// Whether `gpu` is llvmpipe (lavapipe), which has [`LLVMPIPE_LOOP_LIMIT`].
-pub fn loop_limited(gpu: &GpuContext) -> bool {
-    gpu.info.name.contains("llvmpipe")
 }
 
 impl ListMethod {
@@ -317,15 +63,7 @@ impl ListMethod {
         Self {
             pipelines: layout.pipelines,
             consts: Vec::new(),
-            pool: NodePool::new(
-                gpu,
-                limits,
-                layout.node_bytes,
-                layout.state_words,
-                layout.aux,
-                layout.counts_in_capture,
-                layout.pipelines[0].groups[2],
-            ),
+            pool: NodePool::new(gpu, limits, &layout),
             sweeps: (layout.state_words > 0).then_some(layout.samples),
             shades_at_resolve: layout.shades_at_resolve,
             aux: layout.aux,
@@ -352,20 +90,24 @@ impl ListMethod {
     /// fragments.
     fn step_costs(&self, cx: &FrameCtx<'_>, deepest: u32) -> StepCosts {
         // Shading at composite (compact_abuffer's frag_shaded): shading.wgsl's `shade` (its
-        // light loop, the shading-cost loop, and a margin for its other loops, each of which
-        // llvmpipe's limiter counts once even when skipped). Its nodes' fragments and tie keys
-        // read the triangle's record, which costs no loop: runs stay keyed.
-        let shade = if self.shades_at_resolve { 4 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64 } else { 0 };
+        // light loop, the shading-cost loop, and the profile's margin for its other loops). Its
+        // nodes' fragments and tie keys read the triangle's record, which costs no loop: runs
+        // stay keyed.
+        let steps = cx.gpu.profile.loop_limit.map(|l| l.sweep).unwrap_or_default();
+        let shading = steps.shade as u64 + crate::shading::MAX_LIGHTS as u64 + cx.variant.shading_cost as u64;
+        let shade = if self.shades_at_resolve { shading } else { 0 };
         let frag = 0;
         let run = (deepest as u64).min(RUN as u64);
-        StepCosts { samples: self.sweeps.unwrap_or(1) as u64, frag, shade, run }
+        StepCosts { steps, samples: self.sweeps.unwrap_or(1) as u64, frag, shade, run }
     }
 
-    fn consts_for(&self, run: u32, costs: StepCosts, budget: u64, counting: bool) -> Vec<Const> {
+    /// A frame's shader constants: the pool's shape, the run length, the resolve's strategy and
+    /// step costs (from the adapter's profile), whether the capture counts, and the method's own.
+    fn consts_for(&self, gpu: &GpuContext, run: u32, costs: StepCosts, strategy: ResolveStrategy, counting: bool) -> Vec<Const> {
         let mut consts = self.pool.consts().to_vec();
-        consts.push(Const::U32("BATCH", BATCH));
         consts.push(Const::U32("RUN", run));
-        consts.push(Const::U32("STEP_BUDGET", budget as u32));
+        consts.extend(strategy.consts());
+        consts.extend(gpu.profile.sweep_consts());
         consts.push(Const::U32("FRAG_STEPS", costs.frag as u32));
         consts.push(Const::U32("SHADE_STEPS", costs.shade as u32));
         consts.push(Const::U32("KEYED", costs.keyed() as u32));
@@ -378,8 +120,8 @@ impl ListMethod {
     fn capture_pipelines(&self, cx: &FrameCtx<'_>, consts: &[Const]) -> CapturePipelines {
         let at = |entry| spec(self.pipelines, entry);
         CapturePipelines {
-            allocate: matches!(self.aux, Aux::PerTriangle(_)).then(|| cx.compute_pipeline(at("cs_allocate"), consts)),
-            count: (self.aux == Aux::PixelOffsets).then(|| cx.capture_pipeline(at("fs_count"), consts)),
+            allocate: matches!(self.aux, PoolAux::PerTriangle(_)).then(|| cx.compute_pipeline(at("cs_allocate"), consts)),
+            count: (self.aux == PoolAux::PixelOffsets).then(|| cx.capture_pipeline(at("fs_count"), consts)),
             capture: cx.capture_pipeline(at("fs_capture"), consts),
         }
     }
@@ -489,12 +231,12 @@ impl ListMethod {
     }
 
     /// The resolve's plan for a deepest pixel of `deepest` fragments: its constants, and the
-    /// dispatches of each deep phase.
+    /// dispatches of each deep phase, by the strategy the adapter's profile calls for.
     fn resolve_plan(&self, cx: &FrameCtx<'_>, deepest: u32, counting: bool) -> Result<(Vec<Const>, [u32; 3])> {
         let costs = self.step_costs(cx, deepest);
-        let budget = if self.sweeps.is_some() { step_budget(cx.gpu, costs)? } else { 1 };
-        let sweeps = if self.sweeps.is_some() { resolve_dispatches(deepest as u64, costs, budget) } else { [0; 3] };
-        Ok((self.consts_for(run_length(deepest as u64), costs, budget, counting), sweeps))
+        let strategy = if self.sweeps.is_some() { ResolveStrategy::choose(&cx.gpu.profile, costs)? } else { ResolveStrategy::UNUSED };
+        let sweeps = if self.sweeps.is_some() { strategy.dispatches(deepest as u64, costs) } else { [0; 3] };
+        Ok((self.consts_for(cx.gpu, run_length(deepest as u64), costs, strategy, counting), sweeps))
     }
 
     /// The report of a frame whose capture asked for `count` nodes.
@@ -554,7 +296,7 @@ impl ListMethod {
         let initial = self.grown.take().unwrap_or(planned).clamp(1, self.pool.max_nodes());
         let triangles = cx.scene.transparent.triangles as u64;
         self.pool.reserve(cx.gpu, initial, pixels, triangles, tiled)?;
-        if self.aux == Aux::PixelOffsets && self.scan.as_ref().is_none_or(|(p, _)| *p != pixels) {
+        if self.aux == PoolAux::PixelOffsets && self.scan.as_ref().is_none_or(|(p, _)| *p != pixels) {
             self.scan = Some((pixels, Scan::new(cx.gpu, &self.pool.aux, pixels + 1)));
         }
         let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
@@ -562,7 +304,8 @@ impl ListMethod {
             // The capture alone, with the largest run in its constants (they do not change
             // its code, and so its pipeline stays the same from frame to frame); then the
             // counts plan the resolve.
-            let capture = self.capture_pipelines(cx, &self.consts_for(RUN, StepCosts::default(), 1, true));
+            let consts = self.consts_for(cx.gpu, RUN, StepCosts::default(), ResolveStrategy::UNUSED, true);
+            let capture = self.capture_pipelines(cx, &consts);
             self.record_capture(cx, &mut enc, &capture, pixels, true);
             cx.gpu.queue.submit([enc.finish()]);
             let (alloc, counts) = self.pool.read_counts(cx.gpu)?;
@@ -630,17 +373,18 @@ struct ResolvePipelines {
 }
 
 /// Refuses a frame whose deepest pixel the one-invocation replay of a submission-order
-/// method (adaptive, mlab) could not finish on llvmpipe: (n / BATCH + 1) heap sweeps of the
-/// list, then `per_fragment` loop iterations for each fragment.
+/// method (adaptive_lists, mlab_lists) could not finish under the adapter's loop limit:
+/// (n / BATCH + 1) heap sweeps of the list, then `per_fragment` loop iterations for each fragment.
 pub(crate) fn check_replay_budget(cx: &FrameCtx<'_>, method: &str, param: &str, value: u32, per_fragment: u64) -> Result<()> {
     let n = cx.frame_max_depth_complexity as u64;
     let iterations = (n / BATCH as u64 + 1) * n * 6 + n * per_fragment;
-    if loop_limited(cx.gpu) && iterations > LLVMPIPE_LOOP_LIMIT {
-        return Err(OitError::Unsupported(format!(
+    match cx.gpu.profile.loop_iterations() {
+        Some(limit) if iterations > limit => Err(OitError::Unsupported(format!(
             "{method} with {param} = {value} on a pixel with {n} fragments needs about {iterations} loop iterations in one \
-             shader invocation, and llvmpipe ends a shader's loops after {LLVMPIPE_LOOP_LIMIT}: use a hardware adapter, \
-             a smaller {param} or fewer layers"
-        )));
+             shader invocation, and {} ends a shader's loops after {limit}: use a hardware adapter, \
+             a smaller {param} or fewer layers",
+            cx.gpu.info.name
+        ))),
+        _ => Ok(()),
     }
-    Ok(())
 }

@@ -1,61 +1,56 @@
-//! `mlab_lists`: multi-layer alpha blending (Salvi & Vaidyanathan 2014), replayed in submission
-//! order over captured lists: the proof of concept beside the bounded `mlab` (locked.rs); memory is that of
-//! the lists, unbounded (shaders/mlab_lists.wgsl).
+//! `mlab`: multi-layer alpha blending (Salvi & Vaidyanathan 2014) as the seed designs it:
+//! `layers` depth-sorted blended layers a pixel, updated by each fragment inside its pixel's
+//! critical section (pixel_lock.rs) in one geometry pass, the farthest two merged on overflow,
+//! then composited (shaders/mlab.wgsl). `mlab_lists` is the list version it replaces.
 
+use super::adaptive;
 use super::frame::{FrameCtx, Method, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
-use super::list_pipelines::{single, FRAME};
-use super::lists::check_replay_budget;
-use super::lists::{Aux, ListLayout, ListMethod};
+use super::info::{FrameBytes, Linear, Memory, MethodInfo};
 use super::params::{ParamInfo, ParamKind};
-use crate::cache::PipelineSpec;
+use super::pixel_lock::{locked_layout, PixelLocks, LOCK_BYTES, LOCK_STATS_BYTES};
+use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
-use crate::gpu_types::PrimNode;
 use crate::shader::Const;
 
-const PIPELINES: &[PipelineSpec] = &single("mlab_lists.wgsl", FRAME);
+const OWN: Layout = locked_layout!("layers");
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
+const SHADER: &str = "mlab.wgsl";
+const PIPELINES: &[PipelineSpec] =
+    &[PipelineSpec::geometry(SHADER, "fs_insert", GROUPS), PipelineSpec::fullscreen(SHADER, "fs_resolve", GROUPS)];
+
+/// Bytes of a layer (color, transmittance, depth).
+const LAYER_BYTES: u64 = 20;
+
+/// k layers and the lock word a pixel.
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("layers", LAYER_BYTES, LOCK_BYTES), fixed: LOCK_STATS_BYTES };
 
 pub const INFO: MethodInfo = MethodInfo {
-    name: "mlab_lists",
-    summary: "multi-layer alpha blending replayed from captured lists (unbounded memory; `mlab` is the bounded one)",
-    exact: false,
-    bounded_memory: false,
-    passes: &["capture (geometry)", "replay in submission order and composite (full screen)"],
+    name: "mlab",
+    summary: "multi-layer alpha blending: `layers` depth-sorted blended layers per pixel under per-pixel locks, the farthest two merged on overflow",
+    passes: &["insert into the layers (geometry, per-pixel lock)", "composite (full screen)"],
     params: &[ParamInfo { name: "layers", kind: ParamKind::Int { min: 1, max: 32, default: 4 }, doc: "blended layers kept per pixel" }],
     features: wgpu::Features::empty(),
-    order: Order::Submission,
-    antialias_modes: FRAMES,
-    memory: Memory::Scene { storage: SceneBytes { per_pixel: 4, per_fragment: 32, per_triangle: 0 }, note: "(grows with the scene)" },
-    error_bound: ErrorBound::None,
-    census: true,
-    census_when: never,
+    memory: Memory::Frame(BYTES),
     main: Some("layers"),
     pipelines: &[PIPELINES],
-    create: |gpu, limits| {
-        Box::new(Mlab(ListMethod::new(
-            gpu,
-            limits,
-            ListLayout {
-                pipelines: PIPELINES,
-                node_bytes: std::mem::size_of::<PrimNode>() as u64,
-                state_words: 0,
-                samples: 1,
-                shades_at_resolve: false,
-                aux: Aux::None,
-                counts_in_capture: false,
-            },
-        )))
-    },
+    create: |_, _| Box::<Mlab>::default(),
+    ..adaptive::INFO
 };
 
-struct Mlab(ListMethod);
+#[derive(Default)]
+struct Mlab {
+    locks: PixelLocks,
+}
 
 impl Method for Mlab {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let layers = cx.params.int("layers") as u32;
-        // Per fragment: an insertion shifting up to `layers` entries.
-        check_replay_budget(cx, "mlab_lists", "layers", layers, layers as u64 + 2)?;
-        self.0.set_consts(vec![Const::U32("LAYERS", layers), Const::U32("LAYERS_PLUS_ONE", layers + 1)]);
-        self.0.render(cx)
+        let n = cx.params.int("layers") as u32;
+        let consts = [Const::U32("LAYERS", n), Const::U32("LAYERS_PLUS_ONE", n + 1)];
+        let (group, mut enc) = self.locks.begin(cx, OWN, &format!("mlab with layers = {n}"), (LAYER_BYTES, n))?;
+        cx.capture(&mut enc, "insert", &cx.capture_pipeline(spec(PIPELINES, "fs_insert"), &consts), group);
+        let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, false);
+        cx.resolve(&mut enc, "composite", &resolve, group, false);
+        let memory = BYTES.at(cx.pixels(), cx.params);
+        self.locks.finish(cx, enc, memory).map(Outcome::Done)
     }
 }

@@ -4,6 +4,7 @@
 mod abuffer;
 mod accum;
 mod adaptive;
+mod adaptive_lists;
 mod auto;
 mod blend;
 mod bucket_peeling;
@@ -15,15 +16,17 @@ mod info;
 mod ktab;
 mod list_pipelines;
 pub(crate) mod lists;
-mod locked;
 mod mlab;
+mod mlab_lists;
 mod pall;
 mod params;
 mod peel;
+mod pixel_lock;
+mod pool;
+mod resolve_plan;
 mod sbuffer;
 mod screen_door;
 mod stochastic;
-mod sweep_costs;
 mod weighted;
 
 pub(crate) use frame::{check_per_pixel, FrameCtx, Limits, Method, Outcome};
@@ -47,8 +50,8 @@ const REGISTRY: &[MethodInfo] = &[
     weighted::WAVG,
     weighted::WSUM,
     weighted::WBOIT,
-    locked::ADAPTIVE,
     adaptive::INFO,
+    adaptive_lists::INFO,
     pall::INFO,
     compact_abuffer::INFO,
     sbuffer::INFO,
@@ -56,8 +59,8 @@ const REGISTRY: &[MethodInfo] = &[
     peel::DUAL_DEPTH_PEELING,
     screen_door::INFO,
     stochastic::INFO,
-    locked::MLAB,
     mlab::INFO,
+    mlab_lists::INFO,
     bucket_peeling::INFO,
     auto::INFO,
 ];
