@@ -19,11 +19,12 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     Const::U32("FRAG_STEPS", 0),
     Const::U32("SHADE_STEPS", 0),
     Const::U32("KEYED", 1),
-    // What the sorted resolve's units cost in llvmpipe's loop limiter (context::DeviceProfile).
-    crate::context::LLVMPIPE_SWEEP.consts()[0],
-    crate::context::LLVMPIPE_SWEEP.consts()[1],
-    crate::context::LLVMPIPE_SWEEP.consts()[2],
-    crate::context::LLVMPIPE_SWEEP.consts()[3],
+    // What the sorted resolve's units cost in a loop limiter: the adapter's profile sets them
+    // (context::DeviceProfile); any count validates.
+    Const::U32("SWEEP_LOAD_STEPS", 1),
+    Const::U32("SWEEP_LINK_STEPS", 1),
+    Const::U32("SWEEP_MERGE_STEPS", 1),
+    Const::U32("SWEEP_COMPOSITE_STEPS", 1),
     // Whether a list capture counts its own fragments per pixel (shaders/common/pool.wgsl).
     Const::U32("COUNTING", 0),
     // Whether the device honours @early_depth_test(force) (set by `module`): validated with

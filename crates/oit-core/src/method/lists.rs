@@ -6,6 +6,7 @@
 
 use super::frame::{Dispatch, FrameCtx, Limits, MethodReport, Outcome};
 use super::list_pipelines::SWEEPS;
+pub(crate) use super::pool::ListLayout;
 use super::pool::{NodePool, PoolAux, LIST_ARGS_BYTES};
 use super::resolve_plan::{run_length, ResolveStrategy, StepCosts};
 use crate::cache::{spec, PipelineSpec};
@@ -36,26 +37,6 @@ pub(crate) struct ListMethod {
     /// (`Outcome::Grow`), and how many times it grew for this tile.
     grown: Option<u64>,
     regrown: u32,
-}
-
-/// The storage layout of a list method.
-pub(crate) struct ListLayout {
-    /// The pipelines of its shader (list_pipelines.rs).
-    pub pipelines: &'static [PipelineSpec],
-    /// Bytes of one node.
-    pub node_bytes: u64,
-    /// Per-pixel words carried between resolve sweeps; 0 for a single-pass resolve.
-    pub state_words: u64,
-    /// Samples a pixel of the sorted resolve (common/sweep.wgsl); unused without sweeps.
-    pub samples: u32,
-    /// Whether turning a node into a fragment shades it (compact_abuffer): its loop
-    /// iterations then count in the resolve's step budget.
-    pub shades_at_resolve: bool,
-    /// What binding 7 holds, and so which passes run before capture.
-    pub aux: PoolAux,
-    /// Whether the capture can count each pixel's fragments itself (its nodes are its
-    /// fragments), so that a frame after the first needs no census (`ListMethod::counts_in_capture`).
-    pub counts_in_capture: bool,
 }
 
 impl ListMethod {

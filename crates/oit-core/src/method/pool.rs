@@ -4,7 +4,7 @@
 //! (shaders/common/pool.wgsl mirrors its bindings).
 
 use super::frame::Limits;
-use crate::cache::Layout;
+use crate::cache::{Layout, PipelineSpec};
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::Alloc;
@@ -43,6 +43,26 @@ pub(crate) enum PoolAux {
     PixelOffsets,
 }
 
+/// The storage layout of a list method.
+pub(crate) struct ListLayout {
+    /// The pipelines of its shader (list_pipelines.rs).
+    pub pipelines: &'static [PipelineSpec],
+    /// Bytes of one node.
+    pub node_bytes: u64,
+    /// Per-pixel words carried between resolve sweeps; 0 for a single-pass resolve.
+    pub state_words: u64,
+    /// Samples a pixel of the sorted resolve (common/sweep.wgsl); unused without sweeps.
+    pub samples: u32,
+    /// Whether turning a node into a fragment shades it (compact_abuffer): its loop
+    /// iterations then count in the resolve's step budget.
+    pub shades_at_resolve: bool,
+    /// What binding 7 holds, and so which passes run before capture.
+    pub aux: PoolAux,
+    /// Whether the capture can count each pixel's fragments itself (its nodes are its
+    /// fragments), so that a frame after the first needs no census (`ListMethod::counts_in_capture`).
+    pub counts_in_capture: bool,
+}
+
 /// A linked-list node pool with its heads and allocator, shared by list-based methods.
 pub(crate) struct NodePool {
     node_bytes: u64,
@@ -73,7 +93,7 @@ pub(crate) struct NodePool {
 }
 
 impl NodePool {
-    pub fn new(gpu: &GpuContext, limits: &Limits, layout: &super::lists::ListLayout) -> Self {
+    pub fn new(gpu: &GpuContext, limits: &Limits, layout: &ListLayout) -> Self {
         let (node_bytes, state_words, aux_kind, counting) = (layout.node_bytes, layout.state_words, layout.aux, layout.counts_in_capture);
         // The method's own names for the group (its table's group 2).
         let layout = layout.pipelines[0].groups[2];
