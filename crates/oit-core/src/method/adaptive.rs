@@ -6,7 +6,7 @@
 use super::accum::{blended, FloatTargets, ACCUM_FORMAT, ADD};
 use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
-use super::params::{ParamInfo, ParamKind};
+use super::params::IntParam;
 use super::pixel_lock::{locked_layout, PixelLocks, LOCK_BYTES, LOCK_STATS_BYTES};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -29,7 +29,9 @@ const PIPELINES: &[PipelineSpec] = &[
 const NODE_BYTES: u64 = 8;
 
 /// N nodes, the lock word and the shading pass's RGBA32F sums a pixel.
-const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("nodes", NODE_BYTES, LOCK_BYTES + 16), fixed: LOCK_STATS_BYTES };
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(NODES, NODE_BYTES, LOCK_BYTES + 16), fixed: LOCK_STATS_BYTES };
+
+const NODES: IntParam = IntParam::new("nodes", (1, 32, 8), "steps of the per-pixel visibility function");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "adaptive",
@@ -41,11 +43,7 @@ pub const INFO: MethodInfo = MethodInfo {
         "shade by it (geometry, blended)",
         "composite (full screen)",
     ],
-    params: &[ParamInfo {
-        name: "nodes",
-        kind: ParamKind::Int { min: 1, max: 32, default: 8 },
-        doc: "steps of the per-pixel visibility function",
-    }],
+    params: &[NODES.0],
     features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Submission,
     antialias_modes: FRAMES,
@@ -66,7 +64,7 @@ struct Adaptive {
 
 impl Method for Adaptive {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let n = cx.params.int("nodes") as u32;
+        let n = NODES.of(cx.params);
         let consts = [Const::U32("NODES", n), Const::U32("NODES_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)];
         let (group, mut enc) = self.locks.begin(cx, OWN, &format!("adaptive with nodes = {n}"), (NODE_BYTES, n))?;
         // The passes after the insert only read the nodes (READ_NODES: plain loads).

@@ -7,7 +7,7 @@ use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::list_pipelines::{single, FRAME};
 use super::lists::{check_replay_budget, ListLayout, ListMethod};
-use super::params::{ParamInfo, ParamKind};
+use super::params::IntParam;
 use super::pool::PoolAux;
 use crate::cache::PipelineSpec;
 use crate::error::Result;
@@ -16,17 +16,15 @@ use crate::shader::Const;
 
 const PIPELINES: &[PipelineSpec] = &single("adaptive_lists.wgsl", FRAME);
 
+const NODES: IntParam = IntParam::new("nodes", (1, 32, 8), "steps of the per-pixel visibility function");
+
 pub const INFO: MethodInfo = MethodInfo {
     name: "adaptive_lists",
     summary: "adaptive transparency built from captured lists (unbounded memory; `adaptive` is the bounded one)",
     exact: false,
     bounded_memory: false,
     passes: &["capture (geometry)", "build visibility and composite (full screen)"],
-    params: &[ParamInfo {
-        name: "nodes",
-        kind: ParamKind::Int { min: 1, max: 32, default: 8 },
-        doc: "steps of the per-pixel visibility function",
-    }],
+    params: &[NODES.0],
     features: wgpu::Features::empty(),
     order: Order::Submission,
     antialias_modes: FRAMES,
@@ -57,7 +55,7 @@ struct AdaptiveLists(ListMethod);
 
 impl Method for AdaptiveLists {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let nodes = cx.params.int("nodes") as u32;
+        let nodes = NODES.of(cx.params);
         // Per fragment: an insertion and a lookup of up to `nodes` steps each.
         check_replay_budget(cx, "adaptive_lists", "nodes", nodes, 4 * nodes as u64)?;
         self.0.set_consts(vec![Const::U32("NODES", nodes), Const::U32("NODES_PLUS_ONE", nodes + 1)]);

@@ -11,7 +11,7 @@
 use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::ktab::{self, KTab, Slots};
-use super::params::{ParamInfo, ParamKind, Params};
+use super::params::{FloatParam, Params};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::consts::{self, ALPHA_8BIT_ERROR, ROUNDING_TERM as ROUNDING};
 use crate::context::GpuContext;
@@ -23,6 +23,9 @@ use crate::targets::read_region;
 const OWN: Layout = Layout::Storage(&["sums"]);
 const PIPELINES: &[PipelineSpec] = &[PipelineSpec::geometry("auto_estimate.wgsl", "fs_estimate", &[Layout::Scene, Layout::Targets, OWN])];
 
+const TOLERANCE: FloatParam =
+    FloatParam::new("tolerance", (0.0, 1.0, 1.0 / 255.0), "largest error allowed at any pixel and channel, against the exact composite");
+
 pub const INFO: MethodInfo = MethodInfo {
     name: "auto",
     summary: "accuracy on demand: the cheapest hybrid (or the exact A-buffer) whose error bound is at most `tolerance`",
@@ -33,11 +36,7 @@ pub const INFO: MethodInfo = MethodInfo {
         "estimate",
         "hybrid with each pixel's smallest k predicted to meet the tolerance (twice that where it misses), else abuffer",
     ],
-    params: &[ParamInfo {
-        name: "tolerance",
-        kind: ParamKind::Float { min: 0.0, max: 1.0, default: 1.0 / 255.0 },
-        doc: "largest error allowed at any pixel and channel, against the exact composite",
-    }],
+    params: &[TOLERANCE.0],
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
@@ -186,7 +185,7 @@ fn widen(slots: &[u32], counts: &[u32], bound: &[f32], tolerance: f64) -> Option
 
 impl Method for Auto {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let tolerance = cx.params.float("tolerance");
+        let tolerance = TOLERANCE.of(cx.params);
         let (t, tile) = (cx.targets, cx.tile);
         let pixels = cx.pixels();
         let counts = cx.depth_complexity;

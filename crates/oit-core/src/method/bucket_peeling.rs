@@ -4,11 +4,13 @@
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
-use super::params::{ParamInfo, ParamKind};
+use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
+
+const BUCKETS: IntParam = IntParam::new("buckets", (1, 32, 32), "buckets (layers) per pixel");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "bucket_peeling",
@@ -16,7 +18,7 @@ pub const INFO: MethodInfo = MethodInfo {
     exact: false,
     bounded_memory: true,
     passes: &["depth bounds (geometry)", "bucket keys (geometry)", "bucket colors (geometry)", "resolve (full screen)"],
-    params: &[ParamInfo { name: "buckets", kind: ParamKind::Int { min: 1, max: 32, default: 32 }, doc: "buckets (layers) per pixel" }],
+    params: &[BUCKETS.0],
     features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
     order: Order::BitwiseExceptTies,
     antialias_modes: FRAMES,
@@ -31,7 +33,7 @@ pub const INFO: MethodInfo = MethodInfo {
 
 /// Bytes bucket_peeling allocates: depth bounds, a 64-bit key and a color per bucket, and the
 /// dropped counter.
-const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("buckets", 8 + 16, 8), fixed: 4 };
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(BUCKETS, 8 + 16, 8), fixed: 4 };
 
 const SHADER: &str = "bucket_peeling.wgsl";
 /// Group 2: bounds, keys, bucket colors, then the dropped counter.
@@ -51,7 +53,7 @@ struct Buckets {
 
 impl Method for Buckets {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let buckets = cx.params.int("buckets") as u32;
+        let buckets = BUCKETS.of(cx.params);
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("bucket_peeling with {buckets} buckets"), 16 * buckets as u64)?;
         let dropped = self.dropped.get_or_insert_with(|| Counter::new(cx.gpu, "bucket dropped"));

@@ -4,23 +4,21 @@
 use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{ErrorBound, Memory, MethodInfo, Order, FRAMES};
 use super::ktab::{compact_memory_bytes, memory_bytes, KTab, Slots, TailSums};
-use super::params::{ParamInfo, ParamKind, ParamValue};
+use super::params::{ChoiceParam, IntParam};
 use crate::error::Result;
 
-const K_PARAM: ParamInfo = ParamInfo {
-    name: "k",
-    kind: ParamKind::Int { min: 1, max: 32, default: 8 },
-    doc: "core size: fragments per pixel kept exactly, sorted (k-TAB slots)",
-};
+const K: IntParam = IntParam::new("k", (1, 32, 8), "core size: fragments per pixel kept exactly, sorted (k-TAB slots)");
 
-const TAIL_PARAM: ParamInfo = ParamInfo {
-    name: "tail",
-    kind: ParamKind::Choice { choices: &["exact", "blend", "compact"], default: "exact" },
-    doc: "how the second pass sums core and tail: 'exact' by fixed-point atomics (bit-identical under any order), \
+const TAIL: ChoiceParam<TailSums> = ChoiceParam::new(
+    "tail",
+    &["exact", "blend", "compact"],
+    &[TailSums::Exact, TailSums::Blend, TailSums::Compact],
+    0,
+    "how the second pass sums core and tail: 'exact' by fixed-point atomics (bit-identical under any order), \
           'blend' by float blending as in the paper (faster; order changes the rounding), 'compact' by blending into \
           the output and one RGBA16F target at Eq. 12's 2k + 2 words a pixel, the tail count from the census \
           (docs/methods.md)",
-};
+);
 
 pub const HYBRID: MethodInfo = MethodInfo {
     name: "hybrid",
@@ -28,14 +26,14 @@ pub const HYBRID: MethodInfo = MethodInfo {
     exact: false,
     bounded_memory: true,
     passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core and tail (geometry)", "final composite (full screen)"],
-    params: &[K_PARAM, TAIL_PARAM],
+    params: &[K.0, TAIL.info],
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
     memory: MEMORY,
     error_bound: ErrorBound::PerPixel,
     census: false,
-    census_when: |p| p.0.get("tail").is_some_and(|t| matches!(t, ParamValue::Str(s) if s == "compact")),
+    census_when: |p| TAIL.is(p, TailSums::Compact),
     main: Some("k"),
     pipelines: &[super::ktab::PIPELINES],
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
@@ -45,7 +43,7 @@ pub const KTAB: MethodInfo = MethodInfo {
     name: "ktab",
     summary: "k-TAB: the k nearest fragments composited exactly, the others discarded (hybrid's core alone)",
     passes: &["store k-TAB (geometry)", "visibility (compute)", "shade core (geometry)", "final composite (full screen)"],
-    params: &[K_PARAM],
+    params: &[K.0],
     census_when: super::info::never,
     create: |_, _| Box::new(Hybrid(KTab::new(false))),
     ..HYBRID
@@ -54,8 +52,8 @@ pub const KTAB: MethodInfo = MethodInfo {
 const MEMORY: Memory = Memory::Computed {
     formula: "W·H·(2k + 15)·4 + 8 (tail = 'compact': W·H·(2k + 2)·4 + 8)",
     bytes: |px, p| {
-        let k = p.int("k") as u64;
-        if p.0.get("tail").is_some_and(|t| matches!(t, ParamValue::Str(s) if s == "compact")) {
+        let k = K.of(p) as u64;
+        if TAIL.is(p, TailSums::Compact) {
             compact_memory_bytes(px, k)
         } else {
             memory_bytes(px, k)
@@ -68,9 +66,9 @@ struct Hybrid(KTab);
 
 impl Method for Hybrid {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let k = cx.params.int("k") as u32;
+        let k = K.of(cx.params);
         // ktab has no tail, and sums its core as hybrid's default does.
-        let sums = if cx.params.0.contains_key("tail") { TailSums::from_param(cx.params.choice("tail")) } else { TailSums::Exact };
+        let sums = TAIL.or(cx.params, TailSums::Exact);
         self.0.render_slots(cx, Slots::Uniform(k), sums).map(Outcome::Done)
     }
 }

@@ -6,11 +6,13 @@
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
-use super::params::{ParamInfo, ParamKind};
+use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
+
+const K: IntParam = IntParam::new("k", (1, 32, 8), "core size: fragments per pixel kept, sorted, with their colors");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "hybrid64",
@@ -18,11 +20,7 @@ pub const INFO: MethodInfo = MethodInfo {
     exact: false,
     bounded_memory: true,
     passes: &["insert and accumulate the tail (geometry)", "resolve (full screen)"],
-    params: &[ParamInfo {
-        name: "k",
-        kind: ParamKind::Int { min: 1, max: 32, default: 8 },
-        doc: "core size: fragments per pixel kept, sorted, with their colors",
-    }],
+    params: &[K.0],
     features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
@@ -45,7 +43,7 @@ const PIPELINES: &[PipelineSpec] =
 pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_TAIL_WORDS as u64;
 
 /// Bytes hybrid64 allocates: k 64-bit words and the tail's words per pixel, a counter.
-const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("k", 8, 4 * ACCUM_WORDS), fixed: 4 };
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(K, 8, 4 * ACCUM_WORDS), fixed: 4 };
 
 struct Hybrid64 {
     buffers: Option<StorageGroup>,
@@ -54,7 +52,7 @@ struct Hybrid64 {
 
 impl Method for Hybrid64 {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let k = cx.params.int("k") as u32;
+        let k = K.of(cx.params);
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("hybrid64 with k = {k}"), (8 * k as u64).max(4 * ACCUM_WORDS))?;
         let tail = self.tail.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid64 tail count"));

@@ -117,8 +117,8 @@ impl Linear {
     }
 
     /// `per` bytes for each unit of the integer parameter `param`, plus `base`.
-    pub const fn per(param: &'static str, per: u64, base: u64) -> Self {
-        Self { base, per, param: Some(param) }
+    pub const fn per(param: super::params::IntParam, per: u64, base: u64) -> Self {
+        Self { base, per, param: Some(param.0.name) }
     }
 
     pub fn at(&self, params: &Params) -> u64 {

@@ -91,16 +91,6 @@ pub(crate) enum TailSums {
     Compact,
 }
 
-impl TailSums {
-    pub(crate) fn from_param(name: &str) -> Self {
-        match name {
-            "blend" => TailSums::Blend,
-            "compact" => TailSums::Compact,
-            _ => TailSums::Exact,
-        }
-    }
-}
-
 /// The blended sums' targets, as shaders/hybrid.wgsl's `Shade`: core color and tail count;
 /// tail C * alpha and alpha; the quantization sums and the tail's largest channel (max); one
 /// minus its smallest (max).

@@ -6,7 +6,7 @@
 use super::adaptive;
 use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{FrameBytes, Linear, Memory, MethodInfo};
-use super::params::{ParamInfo, ParamKind};
+use super::params::IntParam;
 use super::pixel_lock::{locked_layout, PixelLocks, LOCK_BYTES, LOCK_STATS_BYTES};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -22,13 +22,15 @@ const PIPELINES: &[PipelineSpec] =
 const LAYER_BYTES: u64 = 20;
 
 /// k layers and the lock word a pixel.
-const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per("layers", LAYER_BYTES, LOCK_BYTES), fixed: LOCK_STATS_BYTES };
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(LAYERS, LAYER_BYTES, LOCK_BYTES), fixed: LOCK_STATS_BYTES };
+
+const LAYERS: IntParam = IntParam::new("layers", (1, 32, 4), "blended layers kept per pixel");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "mlab",
     summary: "multi-layer alpha blending: `layers` depth-sorted blended layers per pixel under per-pixel locks, the farthest two merged on overflow",
     passes: &["insert into the layers (geometry, per-pixel lock)", "composite (full screen)"],
-    params: &[ParamInfo { name: "layers", kind: ParamKind::Int { min: 1, max: 32, default: 4 }, doc: "blended layers kept per pixel" }],
+    params: &[LAYERS.0],
     features: wgpu::Features::empty(),
     memory: Memory::Frame(BYTES),
     main: Some("layers"),
@@ -44,7 +46,7 @@ struct Mlab {
 
 impl Method for Mlab {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let n = cx.params.int("layers") as u32;
+        let n = LAYERS.of(cx.params);
         let consts = [Const::U32("LAYERS", n), Const::U32("LAYERS_PLUS_ONE", n + 1)];
         let (group, mut enc) = self.locks.begin(cx, OWN, &format!("mlab with layers = {n}"), (LAYER_BYTES, n))?;
         cx.capture(&mut enc, "insert", &cx.capture_pipeline(spec(PIPELINES, "fs_insert"), &consts), group);

@@ -6,7 +6,7 @@ use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::list_pipelines::{single, FRAME};
 use super::lists::{check_replay_budget, ListLayout, ListMethod};
-use super::params::{ParamInfo, ParamKind};
+use super::params::IntParam;
 use super::pool::PoolAux;
 use crate::cache::PipelineSpec;
 use crate::error::Result;
@@ -15,13 +15,15 @@ use crate::shader::Const;
 
 const PIPELINES: &[PipelineSpec] = &single("mlab_lists.wgsl", FRAME);
 
+const LAYERS: IntParam = IntParam::new("layers", (1, 32, 4), "blended layers kept per pixel");
+
 pub const INFO: MethodInfo = MethodInfo {
     name: "mlab_lists",
     summary: "multi-layer alpha blending replayed from captured lists (unbounded memory; `mlab` is the bounded one)",
     exact: false,
     bounded_memory: false,
     passes: &["capture (geometry)", "replay in submission order and composite (full screen)"],
-    params: &[ParamInfo { name: "layers", kind: ParamKind::Int { min: 1, max: 32, default: 4 }, doc: "blended layers kept per pixel" }],
+    params: &[LAYERS.0],
     features: wgpu::Features::empty(),
     order: Order::Submission,
     antialias_modes: FRAMES,
@@ -52,7 +54,7 @@ struct MlabLists(ListMethod);
 
 impl Method for MlabLists {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let layers = cx.params.int("layers") as u32;
+        let layers = LAYERS.of(cx.params);
         // Per fragment: an insertion shifting up to `layers` entries.
         check_replay_budget(cx, "mlab_lists", "layers", layers, layers as u64 + 2)?;
         self.0.set_consts(vec![Const::U32("LAYERS", layers), Const::U32("LAYERS_PLUS_ONE", layers + 1)]);

@@ -20,6 +20,80 @@ pub struct ParamInfo {
     pub doc: &'static str,
 }
 
+/// An integer parameter declared once: its `ParamInfo` (what `MethodInfo::params` lists) and
+/// the typed read of its checked value, so that a method names it in one place.
+#[derive(Clone, Copy, Debug)]
+pub struct IntParam(pub ParamInfo);
+
+impl IntParam {
+    pub const fn new(name: &'static str, (min, max, default): (i64, i64, i64), doc: &'static str) -> Self {
+        assert!(0 <= min && min <= default && default <= max && max <= u32::MAX as i64, "an integer parameter is a u32 in range");
+        Self(ParamInfo { name, kind: ParamKind::Int { min, max, default }, doc })
+    }
+
+    /// Its value in `params` (checked against its range when they were resolved).
+    pub fn of(&self, params: &Params) -> u32 {
+        params.int(self.0.name) as u32
+    }
+}
+
+/// A number parameter declared once (see `IntParam`).
+#[derive(Clone, Copy, Debug)]
+pub struct FloatParam(pub ParamInfo);
+
+impl FloatParam {
+    pub const fn new(name: &'static str, (min, max, default): (f64, f64, f64), doc: &'static str) -> Self {
+        Self(ParamInfo { name, kind: ParamKind::Float { min, max, default }, doc })
+    }
+
+    pub fn of(&self, params: &Params) -> f64 {
+        params.float(self.0.name)
+    }
+}
+
+/// A parameter that is one of named choices, declared once with the value each choice stands
+/// for: the method reads the value, never the name.
+#[derive(Clone, Copy, Debug)]
+pub struct ChoiceParam<T: 'static> {
+    pub info: ParamInfo,
+    values: &'static [T],
+}
+
+impl<T: Copy + PartialEq> ChoiceParam<T> {
+    /// `choices[i]` stands for `values[i]`; `choices[default]` is the default.
+    pub const fn new(
+        name: &'static str,
+        choices: &'static [&'static str],
+        values: &'static [T],
+        default: usize,
+        doc: &'static str,
+    ) -> Self {
+        assert!(choices.len() == values.len() && default < choices.len(), "a value for each choice");
+        Self { info: ParamInfo { name, kind: ParamKind::Choice { choices, default: choices[default] }, doc }, values }
+    }
+
+    /// The value of its checked choice in `params`.
+    pub fn of(&self, params: &Params) -> T {
+        let ParamKind::Choice { choices, .. } = self.info.kind else { unreachable!("made by ChoiceParam::new") };
+        let at = choices.iter().position(|c| *c == params.choice(self.info.name));
+        self.values[at.expect("resolve_params checked the choice")]
+    }
+
+    /// Its value in `params`, or `absent` for a method without it (ktab has no `tail`).
+    pub fn or(&self, params: &Params, absent: T) -> T {
+        if params.0.contains_key(self.info.name) {
+            self.of(params)
+        } else {
+            absent
+        }
+    }
+
+    /// Whether `params` choose `value` (false where the method has no such parameter).
+    pub fn is(&self, params: &Params, value: T) -> bool {
+        params.0.contains_key(self.info.name) && self.of(params) == value
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum ParamValue {
     Int(i64),

@@ -5,17 +5,14 @@
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
-use super::params::{ParamInfo, ParamKind};
+use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
 use crate::shader::Const;
 
-const LAYERS: ParamInfo = ParamInfo {
-    name: "layers",
-    kind: ParamKind::Int { min: 0, max: 1 << 20, default: 0 },
-    doc: "most layers to peel; 0 peels until no fragment is left (the census depth complexity)",
-};
+const LAYERS: IntParam =
+    IntParam::new("layers", (0, 1 << 20, 0), "most layers to peel; 0 peels until no fragment is left (the census depth complexity)");
 
 pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     name: "depth_peeling",
@@ -23,7 +20,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     exact: true,
     bounded_memory: true,
     passes: &["per layer: peel (geometry) and composite (compute)", "resolve (full screen)"],
-    params: &[LAYERS],
+    params: &[LAYERS.0],
     features: wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
     order: Order::BitwiseExceptTies,
     antialias_modes: FRAMES,
@@ -77,7 +74,7 @@ impl Method for Peel {
         let peeled = self.peeled.get_or_insert_with(|| Counter::new(cx.gpu, "peeled count"));
         let sizes = [("keys", pixels * 32), ("layers", pixels * 32), ("acc", pixels * PEEL_WORDS * 4)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("peeled", peeled)]);
-        let limit = cx.params.int("layers") as u64;
+        let limit = LAYERS.of(cx.params) as u64;
         let n = cx.max_depth_complexity as u64;
         let layers = if limit == 0 { n } else { limit.min(n) };
         // The first pass only finds; each later pass shades one layer (two when dual).

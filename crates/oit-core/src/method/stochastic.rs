@@ -5,7 +5,7 @@
 use super::accum::{accumulation_targets, Companion, FloatTargets};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
-use super::params::{ParamInfo, ParamKind};
+use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::gpu_types::FrameUniform;
@@ -13,28 +13,21 @@ use crate::pipeline;
 use crate::resources::StorageGroup;
 use crate::shader::Const;
 
+const SAMPLES: IntParam =
+    IntParam::new("samples", (1, 64, 8), "coverage samples per pixel (the estimate's noise falls as 1/sqrt(samples))");
+const SEED: IntParam = IntParam::new("seed", (0, u32::MAX as i64, 0), "random seed of the coverage masks");
+
 pub const INFO: MethodInfo = MethodInfo {
     name: "stochastic",
     summary: "stochastic transparency: random per-sample coverage by alpha, stochastic depth, alpha-corrected average",
     exact: false,
     bounded_memory: true,
     passes: &["stochastic depth (geometry)", "accumulate (geometry, blended)", "resolve (full screen)"],
-    params: &[
-        ParamInfo {
-            name: "samples",
-            kind: ParamKind::Int { min: 1, max: 64, default: 8 },
-            doc: "coverage samples per pixel (the estimate's noise falls as 1/sqrt(samples))",
-        },
-        ParamInfo {
-            name: "seed",
-            kind: ParamKind::Int { min: 0, max: u32::MAX as i64, default: 0 },
-            doc: "random seed of the coverage masks",
-        },
-    ],
+    params: &[SAMPLES.0, SEED.0],
     features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Submission,
     antialias_modes: FRAMES,
-    memory: Memory::Frame(FrameBytes { per_pixel: Linear::per("samples", 4, super::accum::TARGET_BYTES), fixed: 0 }),
+    memory: Memory::Frame(FrameBytes { per_pixel: Linear::per(SAMPLES, 4, super::accum::TARGET_BYTES), fixed: 0 }),
     error_bound: ErrorBound::None,
     census: false,
     census_when: never,
@@ -46,12 +39,12 @@ pub const INFO: MethodInfo = MethodInfo {
 const SHADER: &str = "stochastic.wgsl";
 /// Group 2 of the geometry passes: the per-pixel depth samples.
 const OWN: Layout = Layout::Storage(&["samples"]);
-const SAMPLES: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
+const GROUPS: &[Layout] = &[Layout::Scene, Layout::Targets, OWN];
 /// The bindings the resolve reads the accumulation targets at (group 2).
 const TEXTURES: &[(&str, u32)] = &[("accum_tex", 1), ("aux_tex", 2)];
 const PIPELINES: &[PipelineSpec] = &[
-    PipelineSpec::geometry(SHADER, "fs_depth", SAMPLES),
-    PipelineSpec::geometry(SHADER, "fs_accum", SAMPLES),
+    PipelineSpec::geometry(SHADER, "fs_depth", GROUPS),
+    PipelineSpec::geometry(SHADER, "fs_accum", GROUPS),
     PipelineSpec::fullscreen(SHADER, "fs_resolve", &[Layout::Scene, Layout::Targets, Layout::Textures(TEXTURES)]),
 ];
 
@@ -62,8 +55,8 @@ struct Stochastic {
 
 impl Method for Stochastic {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let samples = cx.params.int("samples") as u32;
-        let seed = cx.params.int("seed") as u32;
+        let samples = SAMPLES.of(cx.params);
+        let seed = SEED.of(cx.params);
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("stochastic with {samples} samples"), 4 * samples as u64)?;
         let b = StorageGroup::ensure(&mut self.samples, cx.gpu, OWN, &[("samples", pixels * samples as u64 * 4)], &[]);

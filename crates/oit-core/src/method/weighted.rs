@@ -4,7 +4,7 @@
 use super::accum::{accumulation_targets, Companion, FloatTargets, TARGET_BYTES};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
-use super::params::{ParamInfo, ParamKind};
+use super::params::ChoiceParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::pipeline;
@@ -56,17 +56,19 @@ pub const WAVG: MethodInfo = MethodInfo {
     ..WSUM
 };
 
-/// Weight functions of McGuire & Bavoil 2013 by equation number.
-pub const WBOIT_WEIGHTS: &[&str] = &["eq10", "eq7", "eq8", "eq9"];
+/// Weight functions of McGuire & Bavoil 2013, by equation number (the shader's WEIGHT).
+const WEIGHT: ChoiceParam<u32> = ChoiceParam::new(
+    "weight",
+    &["eq10", "eq7", "eq8", "eq9"],
+    &[10, 7, 8, 9],
+    0,
+    "weight function (paper's eq. 7-10); eq7-9 use the view distance, eq10 the window depth",
+);
 
 pub const WBOIT: MethodInfo = MethodInfo {
     name: "wboit",
     summary: "weighted blended OIT (McGuire & Bavoil 2013): depth-weighted average, exact total coverage",
-    params: &[ParamInfo {
-        name: "weight",
-        kind: ParamKind::Choice { choices: WBOIT_WEIGHTS, default: "eq10" },
-        doc: "weight function (paper's eq. 7-10); eq7-9 use the view distance, eq10 the window depth",
-    }],
+    params: &[WEIGHT.info],
     create: |_, _| Box::new(Weighted::new(Weighting::Blended)),
     ..WSUM
 };
@@ -88,8 +90,8 @@ impl Weighted {
 
 impl Method for Weighted {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let weight = if self.kind == Weighting::Blended { cx.params.choice("weight") } else { "eq10" };
-        let eq = weight.trim_start_matches("eq").parse::<u32>().expect("choices are eqN");
+        // wsum and wavg weigh nothing; their shaders compile with wboit's default.
+        let eq = WEIGHT.or(cx.params, 10);
         let consts = [Const::U32("WEIGHT", eq)];
         let (fs, resolve_fs, aux) = match self.kind {
             Weighting::Sum => ("fs_sum", "fs_resolve_wsum", Companion::Sum),
