@@ -7,8 +7,9 @@ include!(concat!(env!("OUT_DIR"), "/shader_sources.rs"));
 
 pub use crate::consts::Const;
 
-/// Constants a shader needs when it is validated without a pipeline (tests, tools).
-pub const DEFAULT_CONSTS: &[Const] = &[
+/// The engine's constants a shader needs when it is validated without a pipeline (tests,
+/// tools); the methods' own come from the registry (`method::default_consts`).
+pub const ENGINE_CONSTS: &[Const] = &[
     Const::U32("NODES_PER_BINDING", 1 << 20),
     Const::U32("POOL_SPLIT", 4),
     Const::U32("RUN", crate::consts::RUN),
@@ -38,19 +39,6 @@ pub const DEFAULT_CONSTS: &[Const] = &[
     // Whether the device has 64-bit integers (set by `module` where the pipeline's constants do
     // not say): the sorted resolve's keys are then one 64-bit word each (shaders/common/sweep.wgsl).
     Const::U32("INT64", 0),
-    Const::U32("K", 8),
-    Const::U32("PER_PIXEL", 0),
-    Const::U32("TAIL", 1),
-    Const::U32("COMPACT", 0),
-    Const::U32("WEIGHT", 10),
-    Const::U32("NODES", 8),
-    Const::U32("NODES_PLUS_ONE", 9),
-    Const::U32("READ_NODES", 0),
-    Const::U32("DUAL", 1),
-    Const::U32("SAMPLES", 8),
-    Const::U32("LAYERS", 4),
-    Const::U32("LAYERS_PLUS_ONE", 5),
-    Const::U32("BUCKETS", 32),
     // The scene variant (`SceneVariant`): validated shaded, lit and textured, the longest text.
     Const::U32("SHADED", 1),
     Const::U32("LIGHTS", 2),
@@ -147,13 +135,13 @@ const UNLIT: SceneVariant = SceneVariant {
     alpha_test: false,
 };
 
-/// `DEFAULT_CONSTS` with `variant`'s constants in place of the defaults of the same names.
-pub fn variant_consts(variant: SceneVariant) -> Vec<Const> {
+/// `base` with `variant`'s constants in place of those of the same names.
+pub fn with_variant(base: &[Const], variant: SceneVariant) -> Vec<Const> {
     let own = variant.consts();
     let name = |c: &Const| match *c {
         Const::U32(n, _) | Const::F32(n, _) => n,
     };
-    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !own.iter().any(|o| name(o) == name(c))).collect();
+    let mut consts: Vec<Const> = base.iter().copied().filter(|c| !own.iter().any(|o| name(o) == name(c))).collect();
     consts.extend(own);
     consts
 }

@@ -11,7 +11,8 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use oit_core::cache::{Layout, PipelineSpec, ENGINE_PIPELINES};
-use oit_core::shader::{compose, variant_consts, Const, DEFAULT_CONSTS, VALIDATION_VARIANTS};
+use oit_core::method::{default_consts, variant_consts};
+use oit_core::shader::{compose, Const, VALIDATION_VARIANTS};
 
 /// Every declared pipeline, with who declares it.
 fn declared() -> Vec<(&'static str, &'static PipelineSpec)> {
@@ -146,7 +147,7 @@ fn every_declared_pipeline_binds_what_its_shader_uses() {
     let all = declared();
     assert!(all.len() > 40, "the pipeline tables look truncated: {} pipelines", all.len());
     let variants: Vec<Vec<Const>> =
-        std::iter::once(DEFAULT_CONSTS.to_vec()).chain(VALIDATION_VARIANTS.iter().map(|v| variant_consts(*v))).collect();
+        std::iter::once(default_consts()).chain(VALIDATION_VARIANTS.iter().map(|v| variant_consts(*v))).collect();
     let mut wrong = BTreeSet::new();
     for consts in &variants {
         let mut modules = BTreeMap::new();
@@ -175,7 +176,7 @@ fn every_binding_of_a_method_group_is_declared_by_a_shader() {
             // A binding named "_" is bound for the group's shape, and no shader of it reads it.
             let named = layout.named().expect("a method's own group is bound by name");
             wanted.insert(key.clone(), named.iter().filter(|(n, _)| *n != "_").map(|(_, b)| *b).collect());
-            let (module, _) = modules.entry(spec.shader).or_insert_with(|| reflect(spec.shader, DEFAULT_CONSTS));
+            let (module, _) = modules.entry(spec.shader).or_insert_with(|| reflect(spec.shader, &default_consts()));
             let bound = module.global_variables.iter().filter_map(|(_, v)| v.binding.as_ref()).filter(|b| b.group as usize == g);
             declared_at.entry(key).or_default().extend(bound.map(|b| b.binding));
         }
@@ -216,7 +217,7 @@ fn no_binding_or_struct_is_written_twice() {
 fn swapping_two_bindings_of_one_type_is_caught_by_name() {
     let owner = oit_core::methods().iter().find(|m| m.name == "hybrid").expect("hybrid is registered");
     let spec = owner.pipelines.iter().flat_map(|t| t.iter()).find(|p| p.entry == "fs_store").expect("hybrid's store pass");
-    let src = compose(spec.shader, DEFAULT_CONSTS);
+    let src = compose(spec.shader, &default_consts());
     let (ktab, vis) = ("@group(2) @binding(0) var<storage, read_write> ktab", "@group(2) @binding(1) var<storage, read_write> vis");
     assert!(src.contains(ktab) && src.contains(vis), "hybrid.wgsl's declarations moved: update this test");
     let (module, info) = reflect_source(spec.shader, &src);

@@ -5,7 +5,8 @@
 //! scenes is also hashed into that file, so that two builds can be compared bit for bit.
 
 use oit_core::context::DeviceProfile;
-use oit_core::shader::{compose, Const, DEFAULT_CONSTS};
+use oit_core::method::default_consts;
+use oit_core::shader::{compose, Const};
 use oit_core::{shared_context, AntialiasMode, Camera, GpuContext, Mesh, Renderer, Scene};
 use std::sync::Arc;
 
@@ -78,7 +79,7 @@ fn resolve_sweeps(f: &oit_core::Frame) -> f64 {
 
 #[test]
 fn the_plain_resolve_validates() {
-    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !matches!(c, Const::U32("BUDGETED", _))).collect();
+    let mut consts: Vec<Const> = default_consts().iter().copied().filter(|c| !matches!(c, Const::U32("BUDGETED", _))).collect();
     consts.push(Const::U32("BUDGETED", 0));
     for path in ["abuffer.wgsl", "abuffer_coverage.wgsl", "pall.wgsl", "sbuffer.wgsl", "compact_abuffer.wgsl"] {
         let src = compose(path, &consts);

@@ -4,10 +4,11 @@
 use oit_core::gpu_types::{
     Alloc, CompactNode, CoverageNode, FrameUniform, GpuInstance, GpuLight, GpuSegment, PallBlock, PoolNode, PrimNode, PrimShading,
 };
-use oit_core::shader::{compose, entry_files, variant_consts, Const, SceneVariant, DEFAULT_CONSTS, VALIDATION_VARIANTS};
+use oit_core::method::{default_consts, variant_consts};
+use oit_core::shader::{compose, entry_files, Const, SceneVariant, VALIDATION_VARIANTS};
 
 fn validate(path: &str) -> naga::Module {
-    validate_with(path, DEFAULT_CONSTS)
+    validate_with(path, &default_consts())
 }
 
 fn validate_with(path: &str, consts: &[Const]) -> naga::Module {
@@ -43,7 +44,7 @@ fn every_shader_validates_in_every_scene_variant() {
 /// set per device) validate as well as the 32-bit pairs of the defaults.
 #[test]
 fn the_64_bit_atomic_variants_validate() {
-    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !matches!(c, Const::U32("ATOMIC64", _))).collect();
+    let mut consts: Vec<Const> = default_consts().iter().copied().filter(|c| !matches!(c, Const::U32("ATOMIC64", _))).collect();
     consts.push(Const::U32("ATOMIC64", 1));
     for f in ["hybrid.wgsl", "hybrid64.wgsl", "adaptive.wgsl"] {
         let text = compose(f, &consts);
@@ -56,7 +57,7 @@ fn the_64_bit_atomic_variants_validate() {
 /// pairs of 32-bit words of the defaults.
 #[test]
 fn the_64_bit_sort_keys_validate() {
-    let mut consts: Vec<Const> = DEFAULT_CONSTS.iter().copied().filter(|c| !matches!(c, Const::U32("INT64", _))).collect();
+    let mut consts: Vec<Const> = default_consts().iter().copied().filter(|c| !matches!(c, Const::U32("INT64", _))).collect();
     consts.push(Const::U32("INT64", 1));
     for f in ["abuffer.wgsl", "sbuffer.wgsl", "pall.wgsl", "abuffer_coverage.wgsl"] {
         let text = compose(f, &consts);
@@ -68,7 +69,7 @@ fn the_64_bit_sort_keys_validate() {
 #[test]
 fn an_unlit_variant_has_no_shading_varyings() {
     let unlit = compose("blend.wgsl", &variant_consts(SceneVariant::default()));
-    let lit = compose("blend.wgsl", DEFAULT_CONSTS);
+    let lit = compose("blend.wgsl", &default_consts());
     let code = ["fn sample_map", "uv_plane_u: vec3<f32>", "fn surface_emission", "(flags & ALPHA_TEST) != 0u"];
     for varying in ["normal: vec3<f32>", "uv: vec2<f32>", "material: u32"].into_iter().chain(code) {
         assert!(!unlit.contains(varying), "the unlit blend shader still has `{varying}`");

@@ -34,6 +34,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES, COVERAGE],
+    constants: &[],
     create: |gpu, limits| Box::new(ABuffer::new(gpu, limits)),
 };
 

@@ -31,7 +31,7 @@ const NODE_BYTES: u64 = 8;
 /// N nodes, the lock word and the shading pass's RGBA32F sums a pixel.
 const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(NODES, NODE_BYTES, LOCK_BYTES + 16), fixed: LOCK_STATS_BYTES };
 
-const NODES: IntParam = IntParam::new("nodes", (1, 32, 8), "steps of the per-pixel visibility function");
+const NODES: IntParam = IntParam::new("nodes", (1, 32, 8), "steps of the per-pixel visibility function").compiled_as("NODES");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "adaptive",
@@ -53,6 +53,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: Some("nodes"),
     pipelines: &[PIPELINES],
+    constants: &[Const::U32("NODES_PLUS_ONE", 9), Const::U32("READ_NODES", 0)],
     create: |_, _| Box::<Adaptive>::default(),
 };
 
@@ -65,7 +66,7 @@ struct Adaptive {
 impl Method for Adaptive {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let n = NODES.of(cx.params);
-        let consts = [Const::U32("NODES", n), Const::U32("NODES_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)];
+        let consts = [NODES.constant(cx.params), Const::U32("NODES_PLUS_ONE", n + 1), Const::U32("READ_NODES", 0)];
         let (group, mut enc) = self.locks.begin(cx, OWN, &format!("adaptive with nodes = {n}"), (NODE_BYTES, n))?;
         // The passes after the insert only read the nodes (READ_NODES: plain loads).
         let read = [consts[0], consts[1], Const::U32("READ_NODES", 1)];

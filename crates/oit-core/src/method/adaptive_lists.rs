@@ -16,7 +16,7 @@ use crate::shader::Const;
 
 const PIPELINES: &[PipelineSpec] = &single("adaptive_lists.wgsl", FRAME);
 
-const NODES: IntParam = IntParam::new("nodes", (1, 32, 8), "steps of the per-pixel visibility function");
+const NODES: IntParam = IntParam::new("nodes", (1, 32, 8), "steps of the per-pixel visibility function").compiled_as("NODES");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "adaptive_lists",
@@ -34,6 +34,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: Some("nodes"),
     pipelines: &[PIPELINES],
+    constants: &[Const::U32("NODES_PLUS_ONE", 9)],
     create: |gpu, limits| {
         Box::new(AdaptiveLists(ListMethod::new(
             gpu,
@@ -58,7 +59,7 @@ impl Method for AdaptiveLists {
         let nodes = NODES.of(cx.params);
         // Per fragment: an insertion and a lookup of up to `nodes` steps each.
         check_replay_budget(cx, "adaptive_lists", "nodes", nodes, 4 * nodes as u64)?;
-        self.0.set_consts(vec![Const::U32("NODES", nodes), Const::U32("NODES_PLUS_ONE", nodes + 1)]);
+        self.0.set_consts(vec![NODES.constant(cx.params), Const::U32("NODES_PLUS_ONE", nodes + 1)]);
         self.0.render(cx)
     }
 }

@@ -50,6 +50,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES, ktab::PIPELINES],
+    constants: &[],
     create: |gpu, limits| Box::new(Auto::new(gpu, limits)),
 };
 

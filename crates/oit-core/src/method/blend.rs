@@ -25,6 +25,7 @@ pub const UNSORTED: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES],
+    constants: &[],
     create: |_, _| Box::new(Blend { kind: Blending::Unsorted }),
 };
 

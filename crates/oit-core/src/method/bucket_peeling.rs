@@ -8,9 +8,8 @@ use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
-use crate::shader::Const;
 
-const BUCKETS: IntParam = IntParam::new("buckets", (1, 32, 32), "buckets (layers) per pixel");
+const BUCKETS: IntParam = IntParam::new("buckets", (1, 32, 32), "buckets (layers) per pixel").compiled_as("BUCKETS");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "bucket_peeling",
@@ -28,6 +27,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: Some("buckets"),
     pipelines: &[PIPELINES],
+    constants: &[],
     create: |_, _| Box::new(Buckets { buffers: None, dropped: None }),
 };
 
@@ -59,7 +59,7 @@ impl Method for Buckets {
         let dropped = self.dropped.get_or_insert_with(|| Counter::new(cx.gpu, "bucket dropped"));
         let sizes = [("bounds", pixels * 8), ("keys", pixels * buckets as u64 * 8), ("bucket_colors", pixels * buckets as u64 * 16)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("dropped", dropped)]);
-        let consts = [Const::U32("BUCKETS", buckets)];
+        let consts = [BUCKETS.constant(cx.params)];
         let mut enc = cx.encoder();
         b.clear(&mut enc);
         dropped.clear(&mut enc);

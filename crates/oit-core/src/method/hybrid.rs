@@ -7,7 +7,7 @@ use super::ktab::{compact_memory_bytes, memory_bytes, KTab, Slots, TailSums};
 use super::params::{ChoiceParam, IntParam};
 use crate::error::Result;
 
-const K: IntParam = IntParam::new("k", (1, 32, 8), "core size: fragments per pixel kept exactly, sorted (k-TAB slots)");
+const K: IntParam = IntParam::new("k", (1, 32, 8), "core size: fragments per pixel kept exactly, sorted (k-TAB slots)").compiled_as("K");
 
 const TAIL: ChoiceParam<TailSums> = ChoiceParam::new(
     "tail",
@@ -36,6 +36,7 @@ pub const HYBRID: MethodInfo = MethodInfo {
     census_when: |p| TAIL.is(p, TailSums::Compact),
     main: Some("k"),
     pipelines: &[super::ktab::PIPELINES],
+    constants: super::ktab::CONSTANTS,
     create: |_, _| Box::new(Hybrid(KTab::new(true))),
 };
 

@@ -10,9 +10,8 @@ use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::resources::{Counter, StorageGroup};
-use crate::shader::Const;
 
-const K: IntParam = IntParam::new("k", (1, 32, 8), "core size: fragments per pixel kept, sorted, with their colors");
+const K: IntParam = IntParam::new("k", (1, 32, 8), "core size: fragments per pixel kept, sorted, with their colors").compiled_as("K");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "hybrid64",
@@ -30,6 +29,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: Some("k"),
     pipelines: &[PIPELINES],
+    constants: &[],
     create: |_, _| Box::new(Hybrid64 { buffers: None, tail: None }),
 };
 
@@ -58,7 +58,7 @@ impl Method for Hybrid64 {
         let tail = self.tail.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid64 tail count"));
         let sizes = [("ktab", pixels * k as u64 * 8), ("tail_words", pixels * ACCUM_WORDS * 4)];
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("overflow", tail)]);
-        let consts = [Const::U32("K", k)];
+        let consts = [K.constant(cx.params)];
         let insert = cx.capture_pipeline(spec(PIPELINES, "fs_insert"), &consts);
         let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, true);
         let mut enc = cx.encoder();

@@ -8,6 +8,7 @@ use super::params::{check, did_you_mean, ParamInfo, ParamKind, ParamValue, Param
 use crate::cache::PipelineSpec;
 use crate::context::GpuContext;
 use crate::error::{invalid, Result};
+use crate::shader::Const;
 
 /// Everything known about a method before it renders: what `oit.methods()` reports, what the
 /// renderer checks before creating it, and what `oit.memory_bytes` answers. One declaration
@@ -43,6 +44,9 @@ pub struct MethodInfo {
     /// The pipelines it builds, a table per shader file: what it creates them from, and what
     /// tests/bindings.rs checks against each shader's bindings.
     pub pipelines: &'static [&'static [PipelineSpec]],
+    /// The shader constants its pipelines take besides its parameters' (`ParamInfo::compiled`)
+    /// and the scene's, at the values its shaders are validated with (`method::default_consts`).
+    pub constants: &'static [Const],
     pub(crate) create: fn(&GpuContext, &Limits) -> Box<dyn Method>,
 }
 

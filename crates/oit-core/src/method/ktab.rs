@@ -78,6 +78,10 @@ pub(crate) const PIPELINES: &[PipelineSpec] = &[
     PipelineSpec::fullscreen(SHADER, "fs_final_compact", &[Layout::Scene, Layout::Targets, OWN, Layout::Textures(COMPACT_BINDINGS)]),
 ];
 
+/// The k-TAB engine's constants besides `k` (its per-pixel slots, its tail, the compact tail),
+/// validated with the tail and uniform slots.
+pub(crate) const CONSTANTS: &[Const] = &[Const::U32("PER_PIXEL", 0), Const::U32("TAIL", 1), Const::U32("COMPACT", 0)];
+
 /// How the second geometry pass sums the core and the tail.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum TailSums {

@@ -24,7 +24,7 @@ const LAYER_BYTES: u64 = 20;
 /// k layers and the lock word a pixel.
 const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(LAYERS, LAYER_BYTES, LOCK_BYTES), fixed: LOCK_STATS_BYTES };
 
-const LAYERS: IntParam = IntParam::new("layers", (1, 32, 4), "blended layers kept per pixel");
+const LAYERS: IntParam = IntParam::new("layers", (1, 32, 4), "blended layers kept per pixel").compiled_as("LAYERS");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "mlab",
@@ -35,6 +35,7 @@ pub const INFO: MethodInfo = MethodInfo {
     memory: Memory::Frame(BYTES),
     main: Some("layers"),
     pipelines: &[PIPELINES],
+    constants: &[Const::U32("LAYERS_PLUS_ONE", 5)],
     create: |_, _| Box::<Mlab>::default(),
     ..adaptive::INFO
 };
@@ -47,7 +48,7 @@ struct Mlab {
 impl Method for Mlab {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let n = LAYERS.of(cx.params);
-        let consts = [Const::U32("LAYERS", n), Const::U32("LAYERS_PLUS_ONE", n + 1)];
+        let consts = [LAYERS.constant(cx.params), Const::U32("LAYERS_PLUS_ONE", n + 1)];
         let (group, mut enc) = self.locks.begin(cx, OWN, &format!("mlab with layers = {n}"), (LAYER_BYTES, n))?;
         cx.capture(&mut enc, "insert", &cx.capture_pipeline(spec(PIPELINES, "fs_insert"), &consts), group);
         let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, false);

@@ -15,7 +15,7 @@ use crate::shader::Const;
 
 const PIPELINES: &[PipelineSpec] = &single("mlab_lists.wgsl", FRAME);
 
-const LAYERS: IntParam = IntParam::new("layers", (1, 32, 4), "blended layers kept per pixel");
+const LAYERS: IntParam = IntParam::new("layers", (1, 32, 4), "blended layers kept per pixel").compiled_as("LAYERS");
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "mlab_lists",
@@ -33,6 +33,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: Some("layers"),
     pipelines: &[PIPELINES],
+    constants: &[Const::U32("LAYERS_PLUS_ONE", 5)],
     create: |gpu, limits| {
         Box::new(MlabLists(ListMethod::new(
             gpu,
@@ -57,7 +58,7 @@ impl Method for MlabLists {
         let layers = LAYERS.of(cx.params);
         // Per fragment: an insertion shifting up to `layers` entries.
         check_replay_budget(cx, "mlab_lists", "layers", layers, layers as u64 + 2)?;
-        self.0.set_consts(vec![Const::U32("LAYERS", layers), Const::U32("LAYERS_PLUS_ONE", layers + 1)]);
+        self.0.set_consts(vec![LAYERS.constant(cx.params), Const::U32("LAYERS_PLUS_ONE", layers + 1)]);
         self.0.render(cx)
     }
 }

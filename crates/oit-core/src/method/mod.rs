@@ -36,6 +36,7 @@ pub use params::{ParamInfo, ParamKind, ParamValue, Params};
 
 use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
+use crate::shader::{self, Const, SceneVariant};
 use params::did_you_mean;
 
 const REGISTRY: &[MethodInfo] = &[
@@ -67,6 +68,30 @@ const REGISTRY: &[MethodInfo] = &[
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY
+}
+
+/// Every constant the shaders take, at the values they are validated with (tests, tools): the
+/// engine's (`shader::ENGINE_CONSTS`), then each registered method's compiled parameters at
+/// their defaults and its other constants (`MethodInfo::constants`), the first of a name kept.
+pub fn default_consts() -> Vec<Const> {
+    let mut out: Vec<Const> = shader::ENGINE_CONSTS.to_vec();
+    let name = |c: &Const| match *c {
+        Const::U32(n, _) | Const::F32(n, _) => n,
+    };
+    for m in REGISTRY {
+        let compiled = m.params.iter().filter_map(|p| p.compiled).map(|(n, v)| Const::U32(n, v));
+        for c in compiled.chain(m.constants.iter().copied()) {
+            if !out.iter().any(|o| name(o) == name(&c)) {
+                out.push(c);
+            }
+        }
+    }
+    out
+}
+
+/// `default_consts` compiled for the scene variant `variant`.
+pub fn variant_consts(variant: SceneVariant) -> Vec<Const> {
+    shader::with_variant(&default_consts(), variant)
 }
 
 pub fn lookup(name: &str) -> Result<&'static MethodInfo> {

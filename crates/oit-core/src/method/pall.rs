@@ -36,6 +36,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES],
+    constants: &[],
     create: |gpu, limits| {
         Box::new(Pall(ListMethod::new(
             gpu,

@@ -4,6 +4,7 @@
 use std::collections::BTreeMap;
 
 use crate::error::{invalid, Result};
+use crate::shader::Const;
 
 /// A parameter's type, range and default.
 #[derive(Clone, Copy, Debug)]
@@ -18,6 +19,9 @@ pub struct ParamInfo {
     pub name: &'static str,
     pub kind: ParamKind,
     pub doc: &'static str,
+    /// The shader constant its value compiles into, with the value of its default (what the
+    /// shaders are validated with: `method::default_consts`).
+    pub compiled: Option<(&'static str, u32)>,
 }
 
 /// An integer parameter declared once: its `ParamInfo` (what `MethodInfo::params` lists) and
@@ -28,12 +32,24 @@ pub struct IntParam(pub ParamInfo);
 impl IntParam {
     pub const fn new(name: &'static str, (min, max, default): (i64, i64, i64), doc: &'static str) -> Self {
         assert!(0 <= min && min <= default && default <= max && max <= u32::MAX as i64, "an integer parameter is a u32 in range");
-        Self(ParamInfo { name, kind: ParamKind::Int { min, max, default }, doc })
+        Self(ParamInfo { name, kind: ParamKind::Int { min, max, default }, doc, compiled: None })
+    }
+
+    /// The same parameter compiled into the shader constant `constant`.
+    pub const fn compiled_as(self, constant: &'static str) -> Self {
+        let ParamKind::Int { default, .. } = self.0.kind else { unreachable!() };
+        Self(ParamInfo { compiled: Some((constant, default as u32)), ..self.0 })
     }
 
     /// Its value in `params` (checked against its range when they were resolved).
     pub fn of(&self, params: &Params) -> u32 {
         params.int(self.0.name) as u32
+    }
+
+    /// Its shader constant with its value in `params`.
+    pub fn constant(&self, params: &Params) -> Const {
+        let (name, _) = self.0.compiled.expect("a compiled parameter (IntParam::compiled_as)");
+        Const::U32(name, self.of(params))
     }
 }
 
@@ -43,7 +59,7 @@ pub struct FloatParam(pub ParamInfo);
 
 impl FloatParam {
     pub const fn new(name: &'static str, (min, max, default): (f64, f64, f64), doc: &'static str) -> Self {
-        Self(ParamInfo { name, kind: ParamKind::Float { min, max, default }, doc })
+        Self(ParamInfo { name, kind: ParamKind::Float { min, max, default }, doc, compiled: None })
     }
 
     pub fn of(&self, params: &Params) -> f64 {
@@ -57,6 +73,7 @@ impl FloatParam {
 pub struct ChoiceParam<T: 'static> {
     pub info: ParamInfo,
     values: &'static [T],
+    default: usize,
 }
 
 impl<T: Copy + PartialEq> ChoiceParam<T> {
@@ -69,7 +86,11 @@ impl<T: Copy + PartialEq> ChoiceParam<T> {
         doc: &'static str,
     ) -> Self {
         assert!(choices.len() == values.len() && default < choices.len(), "a value for each choice");
-        Self { info: ParamInfo { name, kind: ParamKind::Choice { choices, default: choices[default] }, doc }, values }
+        Self {
+            info: ParamInfo { name, kind: ParamKind::Choice { choices, default: choices[default] }, doc, compiled: None },
+            values,
+            default,
+        }
     }
 
     /// The value of its checked choice in `params`.
@@ -192,5 +213,18 @@ pub(crate) fn check(method: &str, info: &ParamInfo, value: &ParamValue) -> Resul
             };
             Err(invalid!("{method}: {name} must be {want}, got {got}"))
         }
+    }
+}
+
+impl ChoiceParam<u32> {
+    /// The same parameter compiled into the shader constant `constant` (its value's number).
+    pub const fn compiled_as(self, constant: &'static str) -> Self {
+        Self { info: ParamInfo { compiled: Some((constant, self.values[self.default])), ..self.info }, ..self }
+    }
+
+    /// Its shader constant with its value in `params` (`absent` for a method without it).
+    pub fn constant_or(&self, params: &Params, absent: u32) -> Const {
+        let (name, _) = self.info.compiled.expect("a compiled parameter (ChoiceParam::compiled_as)");
+        Const::U32(name, self.or(params, absent))
     }
 }

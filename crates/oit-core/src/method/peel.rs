@@ -30,6 +30,7 @@ pub const DEPTH_PEELING: MethodInfo = MethodInfo {
     census_when: never,
     main: Some("layers"),
     pipelines: &[PIPELINES],
+    constants: &[Const::U32("DUAL", 1)],
     create: |_, _| Box::new(Peel { dual: false, buffers: None, peeled: None }),
 };
 

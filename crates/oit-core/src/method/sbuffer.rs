@@ -33,6 +33,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES],
+    constants: &[],
     create: |gpu, limits| {
         Box::new(SBuffer(ListMethod::new(
             gpu,

@@ -27,6 +27,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES],
+    constants: &[],
     create: |_, _| Box::new(ScreenDoor { depth: None }),
 };
 

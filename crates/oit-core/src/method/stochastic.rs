@@ -11,10 +11,10 @@ use crate::error::Result;
 use crate::gpu_types::FrameUniform;
 use crate::pipeline;
 use crate::resources::StorageGroup;
-use crate::shader::Const;
 
 const SAMPLES: IntParam =
-    IntParam::new("samples", (1, 64, 8), "coverage samples per pixel (the estimate's noise falls as 1/sqrt(samples))");
+    IntParam::new("samples", (1, 64, 8), "coverage samples per pixel (the estimate's noise falls as 1/sqrt(samples))")
+        .compiled_as("SAMPLES");
 const SEED: IntParam = IntParam::new("seed", (0, u32::MAX as i64, 0), "random seed of the coverage masks");
 
 pub const INFO: MethodInfo = MethodInfo {
@@ -33,6 +33,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census_when: never,
     main: Some("samples"),
     pipelines: &[PIPELINES],
+    constants: &[],
     create: |_, _| Box::new(Stochastic { samples: None, targets: None }),
 };
 
@@ -62,7 +63,7 @@ impl Method for Stochastic {
         let b = StorageGroup::ensure(&mut self.samples, cx.gpu, OWN, &[("samples", pixels * samples as u64 * 4)], &[]);
         // The accumulation targets are read only by the resolve.
         let w = FloatTargets::accumulation(&mut self.targets, cx, TEXTURES);
-        let consts = [Const::U32("SAMPLES", samples)];
+        let consts = [SAMPLES.constant(cx.params)];
         let depth = cx.capture_pipeline(spec(PIPELINES, "fs_depth"), &consts);
         let accumulate =
             cx.draw_pipeline(spec(PIPELINES, "fs_accum"), &consts, accumulation_targets(Companion::Reveal), pipeline::depth_test_only());

@@ -8,7 +8,6 @@ use super::params::ChoiceParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
 use crate::pipeline;
-use crate::shader::Const;
 
 const SHADER: &str = "weighted.wgsl";
 /// The bindings the resolves read the two targets at (group 2).
@@ -45,6 +44,7 @@ pub const WSUM: MethodInfo = MethodInfo {
     census_when: never,
     main: None,
     pipelines: &[PIPELINES],
+    constants: &[],
     create: |_, _| Box::new(Weighted::new(Weighting::Sum)),
 };
 
@@ -63,7 +63,8 @@ const WEIGHT: ChoiceParam<u32> = ChoiceParam::new(
     &[10, 7, 8, 9],
     0,
     "weight function (paper's eq. 7-10); eq7-9 use the view distance, eq10 the window depth",
-);
+)
+.compiled_as("WEIGHT");
 
 pub const WBOIT: MethodInfo = MethodInfo {
     name: "wboit",
@@ -91,8 +92,7 @@ impl Weighted {
 impl Method for Weighted {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         // wsum and wavg weigh nothing; their shaders compile with wboit's default.
-        let eq = WEIGHT.or(cx.params, 10);
-        let consts = [Const::U32("WEIGHT", eq)];
+        let consts = [WEIGHT.constant_or(cx.params, 10)];
         let (fs, resolve_fs, aux) = match self.kind {
             Weighting::Sum => ("fs_sum", "fs_resolve_wsum", Companion::Sum),
             Weighting::Average => ("fs_sum", "fs_resolve_wavg", Companion::Sum),
