@@ -1,33 +1,47 @@
 //! The method trait, the registry of names, and parameter validation.
-//! Adding a method: one file here, its WGSL, one line in `REGISTRY`, and its tests.
+//! Adding a method: its file here (its declaration and passes), its WGSL, its line in
+//! `registry!` below, and its numpy model (python/oit/models.py): docs/methods.md, "Adding a
+//! method".
 
-mod abuffer;
 mod accum;
-mod adaptive;
-mod adaptive_lists;
-mod auto;
-mod blend;
-mod bucket_peeling;
-mod compact_abuffer;
 mod frame;
-mod hybrid;
-mod hybrid64;
 mod info;
 mod ktab;
 mod list_pipelines;
 pub(crate) mod lists;
-mod mlab;
-mod mlab_lists;
-mod pall;
 mod params;
-mod peel;
 mod pixel_lock;
 mod pool;
 mod resolve_plan;
-mod sbuffer;
-mod screen_door;
-mod stochastic;
-mod weighted;
+
+/// The registry: each method's module, declared here once with the methods it registers, in
+/// the order `oit.methods()` lists them.
+macro_rules! registry {
+    ($($module:ident: [$($info:ident),+]),+ $(,)?) => {
+        $(mod $module;)+
+        const REGISTRY: &[MethodInfo] = &[$($($module::$info),+),+];
+    };
+}
+
+registry! {
+    abuffer: [INFO],
+    blend: [UNSORTED, SORTED, ADDITIVE, FILTER],
+    hybrid: [HYBRID, KTAB],
+    hybrid64: [INFO],
+    weighted: [WAVG, WSUM, WBOIT],
+    adaptive: [INFO],
+    adaptive_lists: [INFO],
+    pall: [INFO],
+    compact_abuffer: [INFO],
+    sbuffer: [INFO],
+    peel: [DEPTH_PEELING, DUAL_DEPTH_PEELING],
+    screen_door: [INFO],
+    stochastic: [INFO],
+    mlab: [INFO],
+    mlab_lists: [INFO],
+    bucket_peeling: [INFO],
+    auto: [INFO],
+}
 
 pub(crate) use frame::{check_per_pixel, FrameCtx, Limits, Method, Outcome};
 pub use frame::{MethodReport, Tally};
@@ -38,33 +52,6 @@ use crate::context::GpuContext;
 use crate::error::{invalid, OitError, Result};
 use crate::shader::{self, Const, SceneVariant};
 use params::did_you_mean;
-
-const REGISTRY: &[MethodInfo] = &[
-    abuffer::INFO,
-    blend::UNSORTED,
-    blend::SORTED,
-    blend::ADDITIVE,
-    blend::FILTER,
-    hybrid::HYBRID,
-    hybrid::KTAB,
-    hybrid64::INFO,
-    weighted::WAVG,
-    weighted::WSUM,
-    weighted::WBOIT,
-    adaptive::INFO,
-    adaptive_lists::INFO,
-    pall::INFO,
-    compact_abuffer::INFO,
-    sbuffer::INFO,
-    peel::DEPTH_PEELING,
-    peel::DUAL_DEPTH_PEELING,
-    screen_door::INFO,
-    stochastic::INFO,
-    mlab::INFO,
-    mlab_lists::INFO,
-    bucket_peeling::INFO,
-    auto::INFO,
-];
 
 pub fn methods() -> &'static [MethodInfo] {
     REGISTRY
