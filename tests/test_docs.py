@@ -164,6 +164,8 @@ def problems_in(rel_doc: str, src: str) -> list[str]:
             pointer, first, last = m.group(1), m.group(2), m.group(3)
             if pointer.startswith(("out/", "../", ".gpu/")) or "<" in pointer or "*" in pointer:
                 continue
+            if fenced and re.match(r"[ab]/", pointer):
+                pointer = pointer[2:]  # a diff's a/ and b/ sides
             files = find(pointer)
             if not files:
                 problems.append(f"{where}: no file {pointer}")

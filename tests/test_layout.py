@@ -147,3 +147,23 @@ def test_no_two_types_of_one_name():
     assert not twice, "types of one name in several places (name each after what it holds):\n" + "\n".join(
         f"{crate} {name}: {', '.join(where)}" for (crate, name), where in sorted(twice.items())
     )
+
+
+def test_a_simple_method_lives_in_four_places():
+    """docs/methods.md, "Adding a method": screen_door is its file, its shader, its registry line
+    and its CPU model, and no other code of the engine or its package names it (the bench's
+    claims and the tests compare methods by name)."""
+    places = set()
+    for path in sources(".rs", ".py", ".wgsl"):
+        rel = path.relative_to(ROOT).as_posix()
+        if rel.startswith(("tests/", "scripts/", "python/oit/bench/")) or "/tests/" in rel:
+            continue
+        lines = code_lines(path) if path.suffix in (".rs", ".wgsl") else path.read_text().splitlines()
+        if path.stem == "screen_door" or any("screen_door" in line for line in lines):
+            places.add(rel)
+    assert places == {
+        "crates/oit-core/src/method/screen_door.rs",
+        "crates/oit-core/src/method/mod.rs",
+        "shaders/screen_door.wgsl",
+        "python/oit/models.py",
+    }, sorted(places)
