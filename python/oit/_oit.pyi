@@ -7,6 +7,10 @@ from typing import Any, Literal, TypedDict, final
 import numpy as np
 import numpy.typing as npt
 
+# A frame's stats: the TypedDict is written once, in the public API, and tests/test_contract.py
+# holds it to the core's table (crates/oit-core/src/stats.rs).
+from oit._api import Stats as _Stats
+
 _ParamValue = int | float | str
 
 class _AdapterInfo(TypedDict):
@@ -40,33 +44,6 @@ class _TilingInfo(TypedDict, total=False):
     per_pixel: int  # census only: bytes a pixel, a stored fragment, a transparent triangle
     per_fragment: int
     per_triangle: int
-
-class _Stats(TypedDict, total=False):
-    # crates/oit-core/src/stats.rs, SCHEMA; tests/test_contract.py checks these against it.
-    method: str
-    params: dict[str, Any]
-    census: bool
-    fragments: int | None
-    max_depth_complexity: int | None
-    memory_bytes: int
-    target_bytes: int
-    scene_bytes: int
-    expanded_bytes: int
-    texture_bytes: int
-    scene_bytes_by_primitive: dict[str, float]
-    gpu_time_ms: float | None
-    pass_times_ms: dict[str, float]
-    overflow_fragments: int
-    wall_time_ms: float
-    antialias: int
-    antialias_mode: str
-    tiles: int
-    geometry_chunks: int
-    instances: int
-    peak_memory_bytes: int
-    adapter: str
-    extra: dict[str, float]
-    error_bound_max: float
 
 class _MethodInfo(TypedDict):
     name: str

@@ -1,110 +1,53 @@
-//! What a frame reports, defined once: [`Stats`], and [`SCHEMA`], the keys a frame's stats have
-//! outside Rust, with their Python types and meanings. [`Stats::entries`] gives the values in the
-//! schema's order; oit-py converts them without naming a key, `oit._oit.stats_schema()` exports
-//! the schema, and tests/test_contract.py holds the Python `Stats` TypedDict and the `.pyi`
-//! against it.
+//! What a frame reports, declared once in the table of [`stats_table!`]: each key's field, its
+//! Python type, its merge over the samples of an antialiased frame, how it shows outside Rust,
+//! and its meaning. The table makes the [`Stats`] struct, [`SCHEMA`], [`Stats::entries`] (the
+//! dict Python gets: oit-py converts it without naming a key) and the samples' merge
+//! ([`SampleMerge`]). `oit._oit.stats_schema()` exports the schema, and tests/test_contract.py
+//! holds the Python `oit.Stats` TypedDict against it. Method-specific numbers (`extra`) merge by
+//! the rules of [`EXTRAS`]; one not declared there is a bug, and panics where it is met.
 
 use crate::method::{AntialiasMode, Params};
 
-/// Numbers about one frame (see the contract in README and docs/methods.md).
-#[derive(Clone, Debug, Default)]
-pub struct Stats {
-    pub method: String,
-    pub params: Params,
-    /// Whether the fragment census ran: without it `fragments` and `max_depth_complexity` are 0
-    /// and the frame's `depth_complexity` is empty (methods that need no census run none unless
-    /// `Renderer::set_census` asks for it).
-    pub census: bool,
-    /// Transparent fragments that passed the opaque depth test.
-    pub fragments: u64,
-    pub max_depth_complexity: u32,
-    /// GPU memory the method allocated for this frame (its largest tile's; excludes the frame's
-    /// own targets).
-    pub memory_bytes: u64,
-    /// The frame's own targets and readbacks, at the tile size: base color, depth, output,
-    /// error bound, census counts, and a coverage-mask frame's per-sample targets.
-    pub target_bytes: u64,
-    /// The scene's buffers (vertices, indices, materials, textures, the instance table), apart
-    /// from the frame's.
-    pub scene_bytes: u64,
-    /// `scene_bytes` by what uploaded them: meshes (with materials, textures and instance
-    /// tables), strand sets, particle sets.
-    pub scene_bytes_by_primitive: [u64; 3],
-    /// The part of `scene_bytes` that strand and particle corners take: built on the GPU each
-    /// frame, not uploaded.
-    pub expanded_bytes: u64,
-    /// The part of `scene_bytes` that the materials' textures take (the atlas of every image
-    /// with its mips, each image once).
-    pub texture_bytes: u64,
-    pub gpu_time_ms: Option<f64>,
-    pub pass_times_ms: Vec<(&'static str, f64)>,
-    pub overflow_fragments: u64,
-    pub wall_time_ms: f64,
-    pub extra: Vec<(&'static str, f64)>,
-    /// Samples a pixel (1: no antialiasing).
-    pub antialias: u32,
-    pub antialias_mode: AntialiasMode,
-    /// Screen tiles the frame was rendered in (1: untiled); summed over antialiasing samples.
-    pub tiles: u32,
-    /// Chunks the transparent geometry was uploaded in (1 unless it passes a binding).
-    pub geometry_chunks: u32,
-    /// Instances drawn, over every mesh (a mesh added once counts one).
-    pub instances: u64,
-    /// The most GPU memory the frame allocated at once: the method's largest tile and the
-    /// frame's targets and readbacks (`memory_bytes + target_bytes`), within the memory budget
-    /// when one is set; the scene's own buffers are `scene_bytes`.
-    pub peak_memory_bytes: u64,
-    /// The adapter's name.
-    pub adapter: String,
-    /// The largest value of the frame's error bound, where the method derives one.
-    pub error_bound_max: Option<f64>,
+/// How a number combines over the parts of a frame: a key of [`Stats`] over the samples of an
+/// antialiased frame, an extra number over tiles and samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Merge {
+    /// Alike in every sample (the scene, the method): the first sample's.
+    First,
+    /// The whole frame's, set once its samples are merged (wall time, adapter, bound).
+    Frame,
+    /// Counts: they add up (named numbers: a name that repeats adds up).
+    Sum,
+    /// Peaks, choices and flags (auto's largest k, whether it fell back): the largest.
+    Max,
+    /// Per-pixel means: weighted by each part's pixels (tiles) or equally (samples).
+    Mean,
+    /// Each extra number by its own rule ([`EXTRAS`]).
+    ByName,
+}
+
+impl Merge {
+    pub fn name(self) -> &'static str {
+        match self {
+            Merge::First => "first",
+            Merge::Frame => "frame",
+            Merge::Sum => "sum",
+            Merge::Max => "max",
+            Merge::Mean => "mean",
+            Merge::ByName => "by_name",
+        }
+    }
 }
 
 /// One key of a frame's stats outside Rust: its name, its Python type (as the TypedDict writes
-/// it) and what it means.
+/// it), what it means, and how the samples of an antialiased frame merge it.
 #[derive(Clone, Copy, Debug)]
 pub struct StatKey {
     pub name: &'static str,
     pub ty: &'static str,
     pub doc: &'static str,
+    pub merge: Merge,
 }
-
-const fn key(name: &'static str, ty: &'static str, doc: &'static str) -> StatKey {
-    StatKey { name, ty, doc }
-}
-
-/// Every key, in the order [`Stats::entries`] gives them. `error_bound_max` is present only
-/// where the method derives a bound.
-pub const SCHEMA: &[StatKey] = &[
-    key("method", "str", "the method's name"),
-    key("params", "dict[str, Any]", "every parameter, defaults filled in"),
-    key("census", "bool", "whether the fragment census ran (render(census=True), or a method that plans from it)"),
-    key("fragments", "int | None", "transparent fragments in front of the opaque depth (summed over samples); None without a census"),
-    key("max_depth_complexity", "int | None", "the most transparent fragments of a pixel; None without a census"),
-    key("memory_bytes", "int", "what the method allocated (oit.memory_bytes gives its formula)"),
-    key("target_bytes", "int", "the frame's targets and readbacks as allocated (tile-sized under a small budget)"),
-    key("scene_bytes", "int", "the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's"),
-    key("expanded_bytes", "int", "the part of scene_bytes that strands and particles build on the GPU each frame, not uploaded"),
-    key("texture_bytes", "int", "the part of scene_bytes that textures take (each image once, with its mips, 4 bytes a texel)"),
-    key(
-        "scene_bytes_by_primitive",
-        "dict[str, float]",
-        "scene_bytes as 'triangles' (meshes, materials, instances), 'strands' and 'particles'",
-    ),
-    key("gpu_time_ms", "float | None", "the passes' GPU time; None where the adapter has no timestamp queries"),
-    key("pass_times_ms", "dict[str, float]", "GPU time per pass; a pass run more than once adds up"),
-    key("overflow_fragments", "int", "fragments a bounded structure could not hold"),
-    key("wall_time_ms", "float", "the render's wall time, readback included"),
-    key("antialias", "int", "samples a pixel (1: no antialiasing)"),
-    key("antialias_mode", "str", "'frames' or 'coverage'"),
-    key("tiles", "int", "screen tiles the frame was rendered in (1: untiled), summed over antialiasing samples"),
-    key("geometry_chunks", "int", "chunks the transparent geometry was uploaded in (1 unless it passes a binding)"),
-    key("instances", "int", "instances drawn, over every mesh (a mesh added once counts one)"),
-    key("peak_memory_bytes", "int", "memory_bytes + target_bytes: all the frame allocated at once, within memory_budget"),
-    key("adapter", "str", "the adapter's name"),
-    key("extra", "dict[str, float]", "method-specific figures, each declared with its merge rule (oit._oit.extra_merge_rules())"),
-    key("error_bound_max", "float", "the largest of frame.error_bound, where the method derives one"),
-];
 
 /// A value of a frame's stats, as [`Stats::entries`] gives it.
 #[derive(Clone, Debug, PartialEq)]
@@ -118,43 +61,246 @@ pub enum StatValue<'a> {
     Numbers(Vec<(&'static str, f64)>),
 }
 
-impl Stats {
-    /// Every key of [`SCHEMA`] with its value, in its order (`error_bound_max` only where there
-    /// is a bound). Without a census, `fragments` and `max_depth_complexity` are None.
-    pub fn entries(&self) -> Vec<(&'static str, StatValue<'_>)> {
-        use StatValue::*;
-        let counted = |v: u64| Int(self.census.then_some(v));
-        let mut entries = vec![
-            ("method", Str(&self.method)),
-            ("params", Params(&self.params)),
-            ("census", Bool(self.census)),
-            ("fragments", counted(self.fragments)),
-            ("max_depth_complexity", counted(self.max_depth_complexity as u64)),
-            ("memory_bytes", Int(Some(self.memory_bytes))),
-            ("target_bytes", Int(Some(self.target_bytes))),
-            ("scene_bytes", Int(Some(self.scene_bytes))),
-            ("expanded_bytes", Int(Some(self.expanded_bytes))),
-            ("texture_bytes", Int(Some(self.texture_bytes))),
-            ("scene_bytes_by_primitive", Numbers(primitive_bytes(self.scene_bytes_by_primitive))),
-            ("gpu_time_ms", Float(self.gpu_time_ms)),
-            ("pass_times_ms", Numbers(summed(&self.pass_times_ms))),
-            ("overflow_fragments", Int(Some(self.overflow_fragments))),
-            ("wall_time_ms", Float(Some(self.wall_time_ms))),
-            ("antialias", Int(Some(self.antialias as u64))),
-            ("antialias_mode", Str(self.antialias_mode.name())),
-            ("tiles", Int(Some(self.tiles as u64))),
-            ("geometry_chunks", Int(Some(self.geometry_chunks as u64))),
-            ("instances", Int(Some(self.instances))),
-            ("peak_memory_bytes", Int(Some(self.peak_memory_bytes))),
-            ("adapter", Str(&self.adapter)),
-            ("extra", Numbers(self.extra.clone())),
-        ];
-        if let Some(max) = self.error_bound_max {
-            entries.push(("error_bound_max", Float(Some(max))));
+/// `name: Type, "Python type", Merge, shape, "meaning";` a row, in the order Python's dict has
+/// them. The shape (a function of [`shape`]) says how the value shows outside Rust.
+macro_rules! stats_table {
+    ($(#[$attr:meta])* pub struct $name:ident {
+        $($(#[doc = $rdoc:literal])* $field:ident: $ty:ty, $py:literal, $merge:ident, $shape:ident, $doc:literal;)*
+    }) => {
+        $(#[$attr])*
+        pub struct $name {
+            $($(#[doc = $rdoc])* #[doc = concat!("\n\nOutside Rust: `", $py, "`, ", $doc, ".")] pub $field: $ty,)*
         }
-        entries
+
+        /// Every key, in the order [`Stats::entries`] gives them.
+        pub const SCHEMA: &[StatKey] =
+            &[$(StatKey { name: stringify!($field), ty: $py, doc: $doc, merge: Merge::$merge },)*];
+
+        impl $name {
+            /// Every key of [`SCHEMA`] that has a value, with it, in its order
+            /// (`error_bound_max` only where there is a bound).
+            pub fn entries(&self) -> Vec<(&'static str, StatValue<'_>)> {
+                let mut out = Vec::with_capacity(SCHEMA.len());
+                $(if let Some(v) = shape::$shape(self, &self.$field) {
+                    out.push((stringify!($field), v));
+                })*
+                out
+            }
+
+            /// Merges the stats of a later sample into this one's, key by key by its rule (the
+            /// extra numbers are [`SampleMerge`]'s).
+            fn merge_sample(&mut self, later: Stats) {
+                $(merge_key!($merge, self.$field, later.$field);)*
+            }
+        }
+    };
+}
+
+/// One key's merge: `First`, `Frame` and `ByName` keys keep what they have (`Mean` is for
+/// extras only).
+macro_rules! merge_key {
+    (Sum, $a:expr, $b:expr) => {
+        Add::add(&mut $a, $b)
+    };
+    (Max, $a:expr, $b:expr) => {
+        $a = $a.max($b)
+    };
+    (First, $a:expr, $b:expr) => {};
+    (Frame, $a:expr, $b:expr) => {};
+    (ByName, $a:expr, $b:expr) => {};
+}
+
+stats_table! {
+    /// Numbers about one frame (see the contract in README and docs/methods.md).
+    #[derive(Clone, Debug, Default)]
+    pub struct Stats {
+        method: String, "str", First, plain, "the method's name";
+        params: Params, "dict[str, Any]", First, plain, "every parameter, defaults filled in";
+        /// Whether the fragment census ran: without it `fragments` and `max_depth_complexity`
+        /// are unknown and the frame's `depth_complexity` is empty (methods that need no census
+        /// run none unless `Renderer::set_census` asks for it).
+        census: bool, "bool", First, plain,
+            "whether the fragment census ran (render(census=True), or a method that plans from it)";
+        /// Transparent fragments that passed the opaque depth test.
+        fragments: u64, "int | None", Sum, counted,
+            "transparent fragments in front of the opaque depth (summed over samples); None without a census";
+        max_depth_complexity: u32, "int | None", Max, counted,
+            "the most transparent fragments of a pixel; None without a census";
+        /// GPU memory the method allocated for this frame (its largest tile's; excludes the
+        /// frame's own targets).
+        memory_bytes: u64, "int", Max, plain, "what the method allocated (oit.memory_bytes gives its formula)";
+        /// The frame's own targets and readbacks, at the tile size: base color, depth, output,
+        /// error bound, census counts, and a coverage-mask frame's per-sample targets.
+        target_bytes: u64, "int", First, plain,
+            "the frame's targets and readbacks as allocated (tile-sized under a small budget)";
+        /// The scene's buffers (vertices, indices, materials, textures, the instance table).
+        scene_bytes: u64, "int", First, plain,
+            "the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's";
+        /// Strand and particle corners: built on the GPU each frame, not uploaded.
+        expanded_bytes: u64, "int", First, plain,
+            "the part of scene_bytes that strands and particles build on the GPU each frame, not uploaded";
+        /// The atlas of every image with its mips, each image once.
+        texture_bytes: u64, "int", First, plain,
+            "the part of scene_bytes that textures take (each image once, with its mips, 4 bytes a texel)";
+        /// By what uploaded them: meshes (with materials, textures and instance tables), strand
+        /// sets, particle sets.
+        scene_bytes_by_primitive: [u64; 3], "dict[str, float]", First, by_primitive,
+            "scene_bytes as 'triangles' (meshes, materials, instances), 'strands' and 'particles'";
+        gpu_time_ms: Option<f64>, "float | None", Sum, plain,
+            "the passes' GPU time; None where the adapter has no timestamp queries";
+        pass_times_ms: Vec<(&'static str, f64)>, "dict[str, float]", Sum, summed,
+            "GPU time per pass; a pass run more than once adds up";
+        overflow_fragments: u64, "int", Sum, plain, "fragments a bounded structure could not hold";
+        wall_time_ms: f64, "float", Frame, plain, "the render's wall time, readback included";
+        antialias: u32, "int", Frame, plain, "samples a pixel (1: no antialiasing)";
+        antialias_mode: AntialiasMode, "str", Frame, plain, "'frames' or 'coverage'";
+        tiles: u32, "int", Sum, plain,
+            "screen tiles the frame was rendered in (1: untiled), summed over antialiasing samples";
+        geometry_chunks: u32, "int", First, plain,
+            "chunks the transparent geometry was uploaded in (1 unless it passes a binding)";
+        instances: u64, "int", First, plain, "instances drawn, over every mesh (a mesh added once counts one)";
+        /// The most GPU memory the frame allocated at once: the method's largest tile and the
+        /// frame's targets and readbacks (`memory_bytes + target_bytes`); the scene's own
+        /// buffers are `scene_bytes`.
+        peak_memory_bytes: u64, "int", Max, plain,
+            "memory_bytes + target_bytes: all the frame allocated at once, within memory_budget";
+        adapter: String, "str", Frame, plain, "the adapter's name";
+        extra: Vec<(&'static str, f64)>, "dict[str, float]", ByName, declared,
+            "method-specific figures, each declared with its merge rule (oit._oit.extra_merge_rules())";
+        error_bound_max: Option<f64>, "float", Frame, if_some,
+            "the largest of frame.error_bound, where the method derives one";
+    }
+}
+
+/// How a field shows outside Rust: None leaves its key out.
+mod shape {
+    use super::{declared_rule, StatValue, Stats};
+
+    /// A value as it is.
+    pub(super) fn plain<'a, T: Plain>(_: &Stats, v: &'a T) -> Option<StatValue<'a>> {
+        Some(v.plain())
     }
 
+    /// A count the census makes: None without one.
+    pub(super) fn counted<'a, T: Plain>(s: &Stats, v: &'a T) -> Option<StatValue<'a>> {
+        Some(if s.census { v.plain() } else { StatValue::Int(None) })
+    }
+
+    /// Present only with a value.
+    pub(super) fn if_some(_: &Stats, v: &Option<f64>) -> Option<StatValue<'static>> {
+        v.map(|v| StatValue::Float(Some(v)))
+    }
+
+    /// Bytes by primitive kind as named numbers.
+    pub(super) fn by_primitive(_: &Stats, b: &[u64; 3]) -> Option<StatValue<'static>> {
+        Some(StatValue::Numbers(vec![("triangles", b[0] as f64), ("strands", b[1] as f64), ("particles", b[2] as f64)]))
+    }
+
+    /// Named numbers with repeats added up, in the order of first appearance (a pass that ran
+    /// more than once: antialiasing samples, auto's attempts).
+    pub(super) fn summed(_: &Stats, pairs: &[(&'static str, f64)]) -> Option<StatValue<'static>> {
+        let mut out: Vec<(&'static str, f64)> = Vec::new();
+        for &(k, v) in pairs {
+            match out.iter_mut().find(|(name, _)| *name == k) {
+                Some((_, total)) => *total += v,
+                None => out.push((k, v)),
+            }
+        }
+        Some(StatValue::Numbers(out))
+    }
+
+    /// Extra numbers, each declared in `EXTRAS` (an undeclared one panics: a method's bug).
+    pub(super) fn declared(_: &Stats, pairs: &[(&'static str, f64)]) -> Option<StatValue<'static>> {
+        pairs.iter().for_each(|(name, _)| _ = declared_rule(name));
+        Some(StatValue::Numbers(pairs.to_vec()))
+    }
+
+    /// A field's value as a plain [`StatValue`].
+    pub(super) trait Plain {
+        fn plain(&self) -> StatValue<'_>;
+    }
+
+    impl Plain for String {
+        fn plain(&self) -> StatValue<'_> {
+            StatValue::Str(self)
+        }
+    }
+
+    impl Plain for crate::method::Params {
+        fn plain(&self) -> StatValue<'_> {
+            StatValue::Params(self)
+        }
+    }
+
+    impl Plain for bool {
+        fn plain(&self) -> StatValue<'_> {
+            StatValue::Bool(*self)
+        }
+    }
+
+    impl Plain for u64 {
+        fn plain(&self) -> StatValue<'_> {
+            StatValue::Int(Some(*self))
+        }
+    }
+
+    impl Plain for u32 {
+        fn plain(&self) -> StatValue<'_> {
+            StatValue::Int(Some(*self as u64))
+        }
+    }
+
+    impl Plain for f64 {
+        fn plain(&self) -> StatValue<'_> {
+            StatValue::Float(Some(*self))
+        }
+    }
+
+    impl Plain for Option<f64> {
+        fn plain(&self) -> StatValue<'_> {
+            StatValue::Float(*self)
+        }
+    }
+
+    impl Plain for crate::method::AntialiasMode {
+        fn plain(&self) -> StatValue<'_> {
+            StatValue::Str(self.name())
+        }
+    }
+}
+
+/// The `Sum` merge of a field's type.
+trait Add {
+    fn add(&mut self, other: Self);
+}
+
+impl Add for u64 {
+    fn add(&mut self, other: Self) {
+        *self += other;
+    }
+}
+
+impl Add for u32 {
+    fn add(&mut self, other: Self) {
+        *self += other;
+    }
+}
+
+/// Unknown (None) where any part's is.
+impl Add for Option<f64> {
+    fn add(&mut self, other: Self) {
+        *self = self.zip(other).map(|(a, b)| a + b);
+    }
+}
+
+/// Named numbers: the later part's follow (`shape::summed` adds up the repeats).
+impl Add for Vec<(&'static str, f64)> {
+    fn add(&mut self, other: Self) {
+        self.extend(other);
+    }
+}
+
+impl Stats {
     /// What the renderer knows once the frame is whole: the adapter, and the bound's largest
     /// value.
     pub(crate) fn finish(&mut self, adapter: &str, error_bound: Option<&[f32]>) {
@@ -163,25 +309,32 @@ impl Stats {
     }
 }
 
-/// Bytes by primitive kind as named numbers ("triangles", "strands", "particles").
-fn primitive_bytes(b: [u64; 3]) -> Vec<(&'static str, f64)> {
-    vec![("triangles", b[0] as f64), ("strands", b[1] as f64), ("particles", b[2] as f64)]
+/// The stats of an antialiased frame's samples, merged by each key's rule ([`SCHEMA`]); the
+/// `Frame` keys are the caller's to set afterwards.
+#[derive(Default)]
+pub(crate) struct SampleMerge {
+    stats: Option<Stats>,
+    extra: ExtraMerge,
 }
 
-/// How a method's extra number combines over the tiles of a frame and over the samples of an
-/// antialiased frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Merge {
-    /// Counts: they add up.
-    Sum,
-    /// Choices and flags (auto's largest k, whether it fell back): the largest.
-    Max,
-    /// Per-pixel means: weighted by each part's pixels (tiles) or equally (samples).
-    Mean,
+impl SampleMerge {
+    pub fn add(&mut self, sample: Stats) {
+        self.extra.add(&sample.extra, 1.0);
+        match &mut self.stats {
+            Some(first) => first.merge_sample(sample),
+            None => self.stats = Some(sample),
+        }
+    }
+
+    pub fn finish(self) -> Stats {
+        let mut stats = self.stats.unwrap_or_default();
+        stats.extra = self.extra.finish();
+        stats
+    }
 }
 
-/// Every extra number a method reports, with its merge rule: declared once (tests/test_contract.py
-/// checks that every method's extras are here).
+/// Every extra number a method reports, with its merge rule (`Sum`, `Max` or `Mean`): declared
+/// once (tests/test_contract.py checks that every method's extras are here).
 pub const EXTRAS: &[(&str, Merge)] = &[
     ("tail_fragments", Merge::Sum),
     ("geometry_passes", Merge::Sum),
@@ -200,49 +353,42 @@ pub const EXTRAS: &[(&str, Merge)] = &[
     ("lock_waits", Merge::Sum),
 ];
 
-/// The merge rule of extra `name` (a count unless declared otherwise).
-pub fn merge_rule(name: &str) -> Merge {
-    EXTRAS.iter().find(|(n, _)| *n == name).map_or(Merge::Sum, |(_, m)| *m)
+/// The merge rule of extra `name`, None where [`EXTRAS`] does not declare it.
+pub fn merge_rule(name: &str) -> Option<Merge> {
+    EXTRAS.iter().find(|(n, _)| *n == name).map(|(_, m)| *m)
+}
+
+/// The merge rule of an extra a method reported: one not in [`EXTRAS`] is a bug in that method,
+/// and panics (the binding reports a panic as a bug).
+fn declared_rule(name: &str) -> Merge {
+    merge_rule(name).unwrap_or_else(|| panic!("extra number '{name}' has no merge rule: declare it in stats::EXTRAS"))
 }
 
 /// Extra numbers of several parts of a frame (tiles or samples), merged by their rules; each part
 /// has a weight (its pixels, or 1 a sample) for the means.
 #[derive(Default)]
 pub(crate) struct ExtraMerge {
-    values: Vec<(&'static str, f64, f64)>,
+    values: Vec<(&'static str, Merge, f64, f64)>,
 }
 
 impl ExtraMerge {
     pub fn add(&mut self, extra: &[(&'static str, f64)], weight: f64) {
         for &(name, v) in extra {
-            let rule = merge_rule(name);
+            let rule = declared_rule(name);
             let x = if rule == Merge::Mean { v * weight } else { v };
-            match self.values.iter_mut().find(|(n, _, _)| *n == name) {
-                Some((_, total, w)) => {
+            match self.values.iter_mut().find(|(n, ..)| *n == name) {
+                Some((_, _, total, w)) => {
                     *total = if rule == Merge::Max { total.max(x) } else { *total + x };
                     *w += weight;
                 }
-                None => self.values.push((name, x, weight)),
+                None => self.values.push((name, rule, x, weight)),
             }
         }
     }
 
     pub fn finish(self) -> Vec<(&'static str, f64)> {
-        self.values.into_iter().map(|(name, v, w)| (name, if merge_rule(name) == Merge::Mean && w > 0.0 { v / w } else { v })).collect()
+        self.values.into_iter().map(|(name, rule, v, w)| (name, if rule == Merge::Mean && w > 0.0 { v / w } else { v })).collect()
     }
-}
-
-/// Named numbers with repeats added up, in the order of first appearance (a pass that ran more
-/// than once: antialiasing samples, auto's attempts).
-fn summed(pairs: &[(&'static str, f64)]) -> Vec<(&'static str, f64)> {
-    let mut out: Vec<(&'static str, f64)> = Vec::new();
-    for &(k, v) in pairs {
-        match out.iter_mut().find(|(name, _)| *name == k) {
-            Some((_, total)) => *total += v,
-            None => out.push((k, v)),
-        }
-    }
-    out
 }
 
 #[cfg(test)]
@@ -275,6 +421,51 @@ mod tests {
         assert_eq!(m.finish(), vec![("tail_fragments", 8.0), ("auto_k", 4.0), ("auto_mean_k", 3.5)]);
         let names: Vec<_> = EXTRAS.iter().map(|(n, _)| *n).collect();
         assert!(names.iter().enumerate().all(|(i, n)| !names[..i].contains(n)), "an extra declared twice");
+        assert!(EXTRAS.iter().all(|(_, m)| matches!(m, Merge::Sum | Merge::Max | Merge::Mean)));
+    }
+
+    #[test]
+    #[should_panic(expected = "extra number 'made_up' has no merge rule: declare it in stats::EXTRAS")]
+    fn an_undeclared_extra_is_refused_when_merged() {
+        ExtraMerge::default().add(&[("tail_fragments", 1.0), ("made_up", 2.0)], 1.0);
+    }
+
+    #[test]
+    #[should_panic(expected = "extra number 'made_up' has no merge rule")]
+    fn an_undeclared_extra_is_refused_on_its_way_out() {
+        Stats { extra: vec![("made_up", 2.0)], ..Default::default() }.entries();
+    }
+
+    #[test]
+    fn samples_merge_by_each_keys_rule() {
+        let sample = |i: u32| Stats {
+            method: "hybrid".into(),
+            census: true,
+            fragments: 10 * i as u64,
+            max_depth_complexity: 4 - i,
+            memory_bytes: 100 * i as u64,
+            target_bytes: 7 + i as u64,
+            gpu_time_ms: Some(i as f64),
+            pass_times_ms: vec![("capture", 1.0), ("resolve", i as f64)],
+            overflow_fragments: i as u64,
+            tiles: 2,
+            instances: 3,
+            peak_memory_bytes: 50 * i as u64,
+            wall_time_ms: 9.0,
+            extra: vec![("tail_fragments", i as f64), ("auto_mean_k", 2.0 * i as f64)],
+            ..Default::default()
+        };
+        let mut m = SampleMerge::default();
+        (1..=3).for_each(|i| m.add(sample(i)));
+        let s = m.finish();
+        assert_eq!((s.method.as_str(), s.census, s.fragments, s.max_depth_complexity), ("hybrid", true, 60, 3));
+        assert_eq!((s.memory_bytes, s.target_bytes, s.overflow_fragments, s.tiles, s.instances), (300, 8, 6, 6, 3));
+        assert_eq!((s.gpu_time_ms, s.peak_memory_bytes, s.wall_time_ms), (Some(6.0), 150, 9.0));
+        assert_eq!(s.pass_times_ms.len(), 6);
+        assert_eq!(s.extra, vec![("tail_fragments", 6.0), ("auto_mean_k", 4.0)]);
+        let mut untimed = SampleMerge::default();
+        [sample(1), Stats { gpu_time_ms: None, ..sample(2) }].into_iter().for_each(|s| untimed.add(s));
+        assert_eq!(untimed.finish().gpu_time_ms, None, "unknown where a sample's is");
     }
 
     #[test]

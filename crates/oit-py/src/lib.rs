@@ -543,13 +543,7 @@ fn stats_schema() -> Vec<(&'static str, &'static str, &'static str)> {
 /// 'mean'; crates/oit-core/src/stats.rs, EXTRAS).
 #[pyfunction]
 fn extra_merge_rules() -> Vec<(&'static str, &'static str)> {
-    use oit_core::stats::Merge;
-    let name = |m: Merge| match m {
-        Merge::Sum => "sum",
-        Merge::Max => "max",
-        Merge::Mean => "mean",
-    };
-    oit_core::stats::EXTRAS.iter().map(|(n, m)| (*n, name(*m))).collect()
+    oit_core::stats::EXTRAS.iter().map(|(n, m)| (*n, m.name())).collect()
 }
 
 /// The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs).
