@@ -285,3 +285,16 @@ def test_every_extra_a_method_reports_has_a_declared_merge_rule(renderer, method
     scene = build_scene([layer(0.3, (1.0, 0.0, 0.0, 0.5)), layer(0.6, (0.0, 0.0, 1.0, 0.5))])
     frame = renderer(16, 16).render(scene, IDENTITY, method=method)
     assert set(frame.stats["extra"]) <= set(rules), set(frame.stats["extra"]) - set(rules)
+
+
+def test_the_surface_keywords_default_to_the_cores_material():
+    """Every surface keyword with a default takes the core's (`Material::default()`), held once."""
+    core = oit._oit.surface_defaults()
+    assert core == {"shading": "unlit", "specular": 0.0, "shininess": 32.0, "opacity": 1.0, "two_sided": True,
+                    "cull_back_faces": False}
+    for fn in (oit.Scene.add_mesh, oit.Scene.add_strands, oit.Scene.add_particles, oit.Scene.from_trimesh):
+        params = inspect.signature(fn).parameters
+        for name, default in core.items():
+            if name in params and name != "shading":
+                assert params[name].default == default, (fn.__name__, name)
+    assert inspect.signature(oit.Scene.add_strands).parameters["shading"].default == core["shading"]

@@ -8,7 +8,12 @@ from typing import Any
 
 import numpy as np
 
+from . import _oit
 from ._trimesh import srgb_to_linear
+
+# A surface's defaults, the core's (`Material::default()`): every keyword of the API that has one
+# takes it from here.
+SURFACE: dict[str, Any] = _oit.surface_defaults()
 
 
 def _float_array(value: Any, name: str) -> np.ndarray:
@@ -91,7 +96,7 @@ def _texture(texture: Any) -> np.ndarray:
 
 
 def _surface(n: int, normals: Any, uvs: Any, texture: Any, shading: str | None, specular: float, shininess: float,
-             opacity: float, two_sided: bool, cull_back_faces: bool = False) -> dict[str, Any]:
+             opacity: float, two_sided: bool, cull_back_faces: bool = SURFACE["cull_back_faces"]) -> dict[str, Any]:
     """The keyword arguments of the native add_mesh that describe the surface, checked."""
     out: dict[str, Any] = {}
     if normals is not None:

@@ -1,5 +1,5 @@
-# The native module (crates/oit-py/src/lib.rs). It is private: python/oit/_api.py wraps it. Keep
-# this file in step with the #[pyclass], #[pymethods] and #[pyfunction] items there;
+# The native module (crates/oit-py/src). It is private: python/oit/_scene.py and _render.py wrap
+# it. Keep this file in step with the #[pyclass], #[pymethods] and #[pyfunction] items there;
 # tests/test_stub.py checks that the names match.
 
 from typing import Any, Literal, TypedDict, final
@@ -45,6 +45,31 @@ class _TilingInfo(TypedDict, total=False):
     per_fragment: int
     per_triangle: int
 
+# The values passed as one argument (crates/oit-py/src/surface.rs), every key present.
+class _Surface(TypedDict):
+    normals: npt.NDArray[np.float32] | None
+    uvs: npt.NDArray[np.float32] | None
+    texture: npt.NDArray[np.float32] | None
+    shading: str
+    specular: float
+    shininess: float
+    opacity: float
+    two_sided: bool
+    cull_back_faces: bool
+
+class _Look(TypedDict):
+    shading: str
+    specular: float
+    shininess: float
+    opacity: float
+
+class _FrameOptions(TypedDict):
+    background: tuple[float, float, float]
+    antialias: int
+    antialias_mode: str
+    shading_cost: int
+    census: bool
+
 class _MethodInfo(TypedDict):
     name: str
     summary: str
@@ -73,21 +98,14 @@ class Scene:
         indices: npt.NDArray[np.uint32],
         colors: npt.NDArray[np.float32],
         opaque: bool,
-        normals: npt.NDArray[np.float32] | None = None,
-        uvs: npt.NDArray[np.float32] | None = None,
-        texture: npt.NDArray[np.float32] | None = None,
-        shading: str = "unlit",
-        specular: float = 0.0,
-        shininess: float = 32.0,
-        opacity: float = 1.0,
-        two_sided: bool = True,
-        cull_back_faces: bool = False,
+        surface: _Surface,
         transform: npt.NDArray[np.float64] | None = None,
     ) -> int:
         """positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
-        surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
-        shading "unlit", "flat", "smooth" or "hair". `transform` (4, 4) float64 places it (else it is
-        drawn where its vertices are)."""
+        surface a dict (surface.rs): normals (n, 3) and uvs (n, 2) float32 or None, texture (h, w,
+        4) float32 linear RGBA or None, shading "unlit", "flat", "smooth" or "hair", specular,
+        shininess, opacity, two_sided, cull_back_faces. `transform` (4, 4) float64 places it (else
+        it is drawn where its vertices are)."""
     def add_strands(
         self,
         points: npt.NDArray[np.float32],
@@ -95,13 +113,11 @@ class Scene:
         widths: npt.NDArray[np.float32],
         colors: npt.NDArray[np.float32],
         opaque: bool,
-        shading: str = "unlit",
-        specular: float = 0.0,
-        shininess: float = 32.0,
-        opacity: float = 1.0,
+        look: _Look,
     ) -> int:
         """A strand set: points (n, 3), counts (strands,) uint32, widths (n,) or (1,), colors (n, 4)
-        or (1, 4) float32; shading "unlit" or "hair"."""
+        or (1, 4) float32; the look a dict of shading ("unlit" or "hair"), specular, shininess and
+        opacity."""
     def add_particles(
         self,
         centers: npt.NDArray[np.float32],
@@ -184,15 +200,12 @@ class Renderer:
         scene: Scene,
         view_proj: npt.NDArray[np.float64],
         method: str,
-        background: tuple[float, float, float],
         params: dict[str, _ParamValue],
-        antialias: int = 1,
-        antialias_mode: str = "frames",
-        shading_cost: int = 0,
-        census: bool = False,
+        options: _FrameOptions,
     ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32] | None, _Stats, npt.NDArray[np.float32] | None]:
         """Returns (image (h, w, 4) float32, depth complexity (h, w) uint32 or None without a
-        census, stats dict, error bound (h, w) float32 or None)."""
+        census, stats dict, error bound (h, w) float32 or None); `options` a dict (surface.rs):
+        background, antialias, antialias_mode, shading_cost, census."""
 
 def methods() -> list[_MethodInfo]:
     """Every method: name, summary, exact, bounded memory, passes, parameters."""
@@ -206,6 +219,17 @@ def extra_merge_rules() -> list[tuple[str, str]]:
 
 def stats_schema() -> list[tuple[str, str, str]]:
     """The keys of a frame's stats: (name, Python type, meaning), in order (crates/oit-core/src/stats.rs)."""
+
+class _SurfaceDefaults(TypedDict):
+    shading: str
+    specular: float
+    shininess: float
+    opacity: float
+    two_sided: bool
+    cull_back_faces: bool
+
+def surface_defaults() -> _SurfaceDefaults:
+    """The surface a mesh has unless told otherwise (the core's `Material::default()`)."""
 
 def constants() -> dict[str, Any]:
     """The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs)."""

@@ -235,11 +235,10 @@ def _read_primitive(data: bytes, at: int, n: int) -> tuple[dict[str, Any], int]:
 
 
 def _surface_bytes(surface: dict[str, Any], n: int) -> bytes:
-    from ._checks import _surface
+    from ._checks import SURFACE, _surface
 
-    s = _surface(n, surface.get("normals"), surface.get("uvs"), surface.get("texture"), surface.get("shading"),
-                 surface.get("specular", 0.0), surface.get("shininess", 32.0), surface.get("opacity", 1.0),
-                 surface.get("two_sided", True), surface.get("cull_back_faces", False))
+    s = _surface(n, *(surface.get(k) for k in ("normals", "uvs", "texture", "shading")),
+                 *(surface.get(k, SURFACE[k]) for k in ("specular", "shininess", "opacity", "two_sided", "cull_back_faces")))
     # The sidedness word: bit 0 two-sided lighting, bit 1 back faces culled (docs/viewer.md).
     sides = int(s["two_sided"]) | int(s["cull_back_faces"]) << 1
     out = [struct.pack("<2I3f", SHADING_CODES[s["shading"]], sides, s["specular"], s["shininess"], s["opacity"])]
