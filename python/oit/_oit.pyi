@@ -262,6 +262,31 @@ def load_file(
     file's cameras, the note and the loader's warnings (one sentence a feature not drawn). A
     panic while reading is a RuntimeError naming the file."""
 
+# A scene file's records (crates/oit-py/src/scenefile.rs): a camera is (1, 16 row-major
+# view-projection values) or (2, eye, target, up, fov_y, near, far); a light (direction, color,
+# intensity).
+_CameraRecord = tuple[int, list[float]]
+_LightRecord = tuple[tuple[float, float, float], tuple[float, float, float], float]
+
+def encode_scene(
+    meshes: list[dict[str, Any]],
+    camera: _CameraRecord | None,
+    size: tuple[int, int] | None,
+    lights: list[_LightRecord],
+    ambient: tuple[float, float, float],
+) -> bytes:
+    """A scene file's bytes from mesh records (dicts: name, opaque, positions, colors, indices,
+    primitive, surface), a camera record, the size, lights and the ambient term."""
+
+def decode_scene(
+    data: bytes,
+) -> tuple[list[dict[str, Any]], _CameraRecord | None, tuple[int, int] | None, list[_LightRecord], list[float]]:
+    """A scene file's records from its bytes: mesh dicts (a surface has only the arrays the file
+    has), the camera record, the size, the lights and the ambient term."""
+
+def scene_file_format() -> tuple[bytes, int]:
+    """The file's magic bytes and its newest version."""
+
 # Every entry above runs under the binding's panic guard (crates/oit-py/src/guard.rs): a panic is
 # a RuntimeError that says it is a bug. `_GUARDED` names the guarded entries ("Scene.add_mesh",
 # "methods", ...) and `_panic_for_test` panics on purpose (tests/test_load_entry_points.py).

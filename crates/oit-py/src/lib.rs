@@ -13,6 +13,7 @@ mod primitives;
 mod reference;
 mod renderer;
 mod scene;
+mod scenefile;
 mod surface;
 
 use guard::guarded;
@@ -40,10 +41,13 @@ fn _oit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(info::stats_schema, m)?)?;
     m.add_function(wrap_pyfunction!(info::extra_merge_rules, m)?)?;
     m.add_function(wrap_pyfunction!(load::load_file, m)?)?;
+    m.add_function(wrap_pyfunction!(scenefile::encode_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(scenefile::decode_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(scenefile::scene_file_format, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     let classes = [("Scene", scene::Scene::GUARDED), ("Renderer", renderer::Renderer::GUARDED)];
     let mut guarded: Vec<String> = classes.iter().flat_map(|(c, names)| names.iter().map(move |n| format!("{c}.{n}"))).collect();
-    let functions = [info::GUARDED, reference::GUARDED, load::GUARDED, GUARDED];
+    let functions = [info::GUARDED, reference::GUARDED, load::GUARDED, scenefile::GUARDED, GUARDED];
     guarded.extend(functions.iter().flat_map(|names| names.iter()).map(|n| n.to_string()));
     m.add("_GUARDED", guarded)?;
     Ok(())

@@ -63,6 +63,39 @@ impl Surface<'_> {
     }
 }
 
+impl Surface<'_> {
+    /// The surface as a scene file's record of a mesh of `n` vertices (texels as they are).
+    pub fn into_file(self, n: usize) -> PyResult<oit_core::scenefile::FileSurface> {
+        let texture = match self.texture {
+            Some(t) => {
+                let (h, w, _) = t.as_array().dim();
+                let flat: Vec<f32> = t.as_array().iter().copied().collect();
+                let texels = flat.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+                Some(oit_core::scenefile::FileTexture { width: w as u32, height: h as u32, texels })
+            }
+            None => None,
+        };
+        let normals: Vec<[f32; 3]> = self.normals.map(|a| rows(&a, "normals")).transpose()?.unwrap_or_default();
+        let uvs: Vec<[f32; 2]> = self.uvs.map(|a| rows(&a, "uvs")).transpose()?.unwrap_or_default();
+        for (what, len) in [("normals", normals.len()), ("uvs", uvs.len())] {
+            if len != 0 && len != n {
+                return Err(PyValueError::new_err(format!("{what} has {len} rows for {n} vertices: give one a vertex")));
+            }
+        }
+        Ok(oit_core::scenefile::FileSurface {
+            shading: oit_core::Shading::from_name(&self.shading).map_err(Error::from)?,
+            two_sided: self.two_sided,
+            cull_back_faces: self.cull_back_faces,
+            specular: self.specular,
+            shininess: self.shininess,
+            opacity: self.opacity,
+            normals,
+            uvs,
+            texture,
+        })
+    }
+}
+
 /// The surface words of a strand set (a particle set's are fixed but for its opacity).
 #[derive(FromPyObject)]
 #[pyo3(from_item_all)]
