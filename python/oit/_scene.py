@@ -83,10 +83,8 @@ class Scene(PrimitiveMethods):
                 raise ValueError(f"indices has an entry {bad}; indices must be in [0, {len(pos)})")
         idx = np.ascontiguousarray(idx, dtype=np.uint32)
         col, opaque = _colors(colors, len(pos), "vertex"), _bool(opaque, "opaque")
-        # The native layer takes the surface as one value with every key (crates/oit-py/src/surface.rs).
-        surface = {"normals": None, "uvs": None, "texture": None,
-                   **_surface(len(pos), normals, uvs, texture, shading, specular, shininess, opacity, two_sided,
-                              cull_back_faces)}
+        surface = _surface(len(pos), normals, uvs, texture, shading, specular, shininess, opacity, two_sided,
+                           cull_back_faces)
         place = None
         if transform is not None:
             if np.shape(transform) != (4, 4):

@@ -102,10 +102,8 @@ def _record(i: int, m: MeshArrays, name: str) -> dict[str, Any]:
     surface = None
     if m.surface:
         s = m.surface
-        surface = {"normals": None, "uvs": None, "texture": None,
-                   **_surface(len(pos), *(s.get(k) for k in ("normals", "uvs", "texture", "shading")),
-                              *(s.get(k, SURFACE[k]) for k in ("specular", "shininess", "opacity", "two_sided",
-                                                                "cull_back_faces")))}
+        surface = _surface(len(pos), *(s.get(k) for k in ("normals", "uvs", "texture", "shading")),
+                           *(s.get(k, SURFACE[k]) for k in ("specular", "shininess", "opacity", "two_sided", "cull_back_faces")))
     return {"name": name, "opaque": bool(m.opaque), "positions": pos, "colors": col,
             "indices": np.ascontiguousarray(m.indices, dtype=np.uint32).reshape(-1, 3), "primitive": primitive,
             "surface": surface}
