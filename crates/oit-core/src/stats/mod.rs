@@ -8,6 +8,13 @@
 
 use crate::method::{AntialiasMode, Params};
 
+mod extras;
+mod shape;
+
+pub(crate) use extras::ExtraMerge;
+pub use extras::{merge_rule, EXTRAS};
+use shape::Add;
+
 /// How a number combines over the parts of a frame: a key of [`Stats`] over the samples of an
 /// antialiased frame, an extra number over tiles and samples.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -172,134 +179,6 @@ stats_table! {
     }
 }
 
-/// How a field shows outside Rust: None leaves its key out.
-mod shape {
-    use super::{declared_rule, StatValue, Stats};
-
-    /// A value as it is.
-    pub(super) fn plain<'a, T: Plain>(_: &Stats, v: &'a T) -> Option<StatValue<'a>> {
-        Some(v.plain())
-    }
-
-    /// A count the census makes: None without one.
-    pub(super) fn counted<'a, T: Plain>(s: &Stats, v: &'a T) -> Option<StatValue<'a>> {
-        Some(if s.census { v.plain() } else { StatValue::Int(None) })
-    }
-
-    /// Present only with a value.
-    pub(super) fn if_some(_: &Stats, v: &Option<f64>) -> Option<StatValue<'static>> {
-        v.map(|v| StatValue::Float(Some(v)))
-    }
-
-    /// Bytes by primitive kind as named numbers.
-    pub(super) fn by_primitive(_: &Stats, b: &[u64; 3]) -> Option<StatValue<'static>> {
-        Some(StatValue::Numbers(vec![("triangles", b[0] as f64), ("strands", b[1] as f64), ("particles", b[2] as f64)]))
-    }
-
-    /// Named numbers with repeats added up, in the order of first appearance (a pass that ran
-    /// more than once: antialiasing samples, auto's attempts).
-    pub(super) fn summed(_: &Stats, pairs: &[(&'static str, f64)]) -> Option<StatValue<'static>> {
-        let mut out: Vec<(&'static str, f64)> = Vec::new();
-        for &(k, v) in pairs {
-            match out.iter_mut().find(|(name, _)| *name == k) {
-                Some((_, total)) => *total += v,
-                None => out.push((k, v)),
-            }
-        }
-        Some(StatValue::Numbers(out))
-    }
-
-    /// Extra numbers, each declared in `EXTRAS` (an undeclared one panics: a method's bug).
-    pub(super) fn declared(_: &Stats, pairs: &[(&'static str, f64)]) -> Option<StatValue<'static>> {
-        pairs.iter().for_each(|(name, _)| _ = declared_rule(name));
-        Some(StatValue::Numbers(pairs.to_vec()))
-    }
-
-    /// A field's value as a plain [`StatValue`].
-    pub(super) trait Plain {
-        fn plain(&self) -> StatValue<'_>;
-    }
-
-    impl Plain for String {
-        fn plain(&self) -> StatValue<'_> {
-            StatValue::Str(self)
-        }
-    }
-
-    impl Plain for crate::method::Params {
-        fn plain(&self) -> StatValue<'_> {
-            StatValue::Params(self)
-        }
-    }
-
-    impl Plain for bool {
-        fn plain(&self) -> StatValue<'_> {
-            StatValue::Bool(*self)
-        }
-    }
-
-    impl Plain for u64 {
-        fn plain(&self) -> StatValue<'_> {
-            StatValue::Int(Some(*self))
-        }
-    }
-
-    impl Plain for u32 {
-        fn plain(&self) -> StatValue<'_> {
-            StatValue::Int(Some(*self as u64))
-        }
-    }
-
-    impl Plain for f64 {
-        fn plain(&self) -> StatValue<'_> {
-            StatValue::Float(Some(*self))
-        }
-    }
-
-    impl Plain for Option<f64> {
-        fn plain(&self) -> StatValue<'_> {
-            StatValue::Float(*self)
-        }
-    }
-
-    impl Plain for crate::method::AntialiasMode {
-        fn plain(&self) -> StatValue<'_> {
-            StatValue::Str(self.name())
-        }
-    }
-}
-
-/// The `Sum` merge of a field's type.
-trait Add {
-    fn add(&mut self, other: Self);
-}
-
-impl Add for u64 {
-    fn add(&mut self, other: Self) {
-        *self += other;
-    }
-}
-
-impl Add for u32 {
-    fn add(&mut self, other: Self) {
-        *self += other;
-    }
-}
-
-/// Unknown (None) where any part's is.
-impl Add for Option<f64> {
-    fn add(&mut self, other: Self) {
-        *self = self.zip(other).map(|(a, b)| a + b);
-    }
-}
-
-/// Named numbers: the later part's follow (`shape::summed` adds up the repeats).
-impl Add for Vec<(&'static str, f64)> {
-    fn add(&mut self, other: Self) {
-        self.extend(other);
-    }
-}
-
 impl Stats {
     /// What the renderer knows once the frame is whole: the adapter, and the bound's largest
     /// value.
@@ -330,64 +209,6 @@ impl SampleMerge {
         let mut stats = self.stats.unwrap_or_default();
         stats.extra = self.extra.finish();
         stats
-    }
-}
-
-/// Every extra number a method reports, with its merge rule (`Sum`, `Max` or `Mean`): declared
-/// once (tests/test_contract.py checks that every method's extras are here).
-pub const EXTRAS: &[(&str, Merge)] = &[
-    ("tail_fragments", Merge::Sum),
-    ("geometry_passes", Merge::Sum),
-    ("peeled_fragments", Merge::Sum),
-    ("pool_regrown", Merge::Sum),
-    ("resolve_sweeps", Merge::Max),
-    ("pool_nodes", Merge::Sum),
-    ("counted_in_capture", Merge::Max),
-    ("auto_k", Merge::Max),
-    ("auto_mean_k", Merge::Mean),
-    ("auto_slots", Merge::Sum),
-    ("auto_predicted_k", Merge::Max),
-    ("auto_exact", Merge::Max),
-    ("auto_attempts", Merge::Max),
-    ("lock_failures", Merge::Sum),
-    ("lock_waits", Merge::Sum),
-];
-
-/// The merge rule of extra `name`, None where [`EXTRAS`] does not declare it.
-pub fn merge_rule(name: &str) -> Option<Merge> {
-    EXTRAS.iter().find(|(n, _)| *n == name).map(|(_, m)| *m)
-}
-
-/// The merge rule of an extra a method reported: one not in [`EXTRAS`] is a bug in that method,
-/// and panics (the binding reports a panic as a bug).
-fn declared_rule(name: &str) -> Merge {
-    merge_rule(name).unwrap_or_else(|| panic!("extra number '{name}' has no merge rule: declare it in stats::EXTRAS"))
-}
-
-/// Extra numbers of several parts of a frame (tiles or samples), merged by their rules; each part
-/// has a weight (its pixels, or 1 a sample) for the means.
-#[derive(Default)]
-pub(crate) struct ExtraMerge {
-    values: Vec<(&'static str, Merge, f64, f64)>,
-}
-
-impl ExtraMerge {
-    pub fn add(&mut self, extra: &[(&'static str, f64)], weight: f64) {
-        for &(name, v) in extra {
-            let rule = declared_rule(name);
-            let x = if rule == Merge::Mean { v * weight } else { v };
-            match self.values.iter_mut().find(|(n, ..)| *n == name) {
-                Some((_, _, total, w)) => {
-                    *total = if rule == Merge::Max { total.max(x) } else { *total + x };
-                    *w += weight;
-                }
-                None => self.values.push((name, rule, x, weight)),
-            }
-        }
-    }
-
-    pub fn finish(self) -> Vec<(&'static str, f64)> {
-        self.values.into_iter().map(|(name, rule, v, w)| (name, if rule == Merge::Mean && w > 0.0 { v / w } else { v })).collect()
     }
 }
 
