@@ -240,7 +240,7 @@ def test_census_must_be_a_bool(renderer):
 
 
 def test_the_stats_types_are_the_cores():
-    """`oit.Stats` names the core's keys (crates/oit-core/src/stats.rs) with its types, in its
+    """`oit.Stats` names the core's keys (crates/oit-core/src/stats/) with its types, in its
     order; the native module's stub takes it from there rather than writing the keys again."""
     schema = [(name, ty) for name, ty, _ in oit._oit.stats_schema()]
     # Annotations are kept as written (this module's `from __future__ import annotations`):

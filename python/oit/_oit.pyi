@@ -8,7 +8,7 @@ import numpy as np
 import numpy.typing as npt
 
 # A frame's stats: the TypedDict is written once, in the public API, and tests/test_contract.py
-# holds it to the core's table (crates/oit-core/src/stats.rs).
+# holds it to the core's table (crates/oit-core/src/stats/).
 from oit._api import Stats as _Stats
 
 _ParamValue = int | float | str
@@ -218,7 +218,7 @@ def extra_merge_rules() -> list[tuple[str, str]]:
     """Every extra number a method reports and how tiles and samples merge it: sum, max or mean."""
 
 def stats_schema() -> list[tuple[str, str, str]]:
-    """The keys of a frame's stats: (name, Python type, meaning), in order (crates/oit-core/src/stats.rs)."""
+    """The keys of a frame's stats: (name, Python type, meaning), in order (crates/oit-core/src/stats/)."""
 
 class _SurfaceDefaults(TypedDict):
     shading: str

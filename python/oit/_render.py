@@ -20,7 +20,7 @@ from .imageio import encode_png
 class Stats(TypedDict, total=False):
     """`frame.stats`: what every frame reports; method-specific figures are under `extra`. The
     keys, their types and meanings are the core's (`oit._oit.stats_schema()`,
-    crates/oit-core/src/stats.rs); tests/test_contract.py holds this class to them."""
+    crates/oit-core/src/stats/); tests/test_contract.py holds this class to them."""
 
     method: str  # the method's name
     params: dict[str, Any]  # every parameter, defaults filled in

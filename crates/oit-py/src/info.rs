@@ -89,14 +89,14 @@ pub fn memory_bytes(method: &str, width: i64, height: i64, params: Bound<'_, PyD
 }
 
 /// The keys of a frame's stats: (name, Python type, meaning), in order
-/// (crates/oit-core/src/stats.rs).
+/// (crates/oit-core/src/stats/).
 #[pyfunction]
 pub fn stats_schema() -> Vec<(&'static str, &'static str, &'static str)> {
     oit_core::stats::SCHEMA.iter().map(|k| (k.name, k.ty, k.doc)).collect()
 }
 
 /// Every extra number a method reports, with how tiles and samples merge it ('sum', 'max',
-/// 'mean'; crates/oit-core/src/stats.rs, EXTRAS).
+/// 'mean'; crates/oit-core/src/stats/extras.rs, EXTRAS).
 #[pyfunction]
 pub fn extra_merge_rules() -> Vec<(&'static str, &'static str)> {
     oit_core::stats::EXTRAS.iter().map(|(n, m)| (*n, m.name())).collect()
