@@ -239,23 +239,19 @@ def test_census_must_be_a_bool(renderer):
         renderer(4, 4).render(oit.Scene(), IDENTITY, method="unsorted", census=1)
 
 
-def _stub_class_annotations(name: str) -> dict[str, str]:
-    """A TypedDict's annotations in the native module's stub, as written."""
-    tree = ast.parse((Path(oit.__file__).parent / "_oit.pyi").read_text())
-    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == name)
-    return {n.target.id: ast.unparse(n.annotation) for n in cls.body if isinstance(n, ast.AnnAssign)}
-
-
 def test_the_stats_types_are_the_cores():
-    """`oit.Stats` and the stub's `_Stats` name the core's keys (crates/oit-core/src/stats.rs)
-    with its types, in its order."""
+    """`oit.Stats` names the core's keys (crates/oit-core/src/stats/) with its types, in its
+    order; the native module's stub takes it from there rather than writing the keys again."""
     schema = [(name, ty) for name, ty, _ in oit._oit.stats_schema()]
     # Annotations are kept as written (this module's `from __future__ import annotations`):
     # TypedDict wraps each in a ForwardRef.
     written = [(k, getattr(v, "__forward_arg__", v)) for k, v in oit.Stats.__annotations__.items()]
     assert written == schema
-    assert list(_stub_class_annotations("_Stats").items()) == schema
     assert all(doc for _, _, doc in oit._oit.stats_schema())
+    stub = ast.parse((Path(oit.__file__).parent / "_oit.pyi").read_text())
+    imports = [(n.module, a.name, a.asname) for n in stub.body if isinstance(n, ast.ImportFrom) for a in n.names]
+    assert ("oit._api", "Stats", "_Stats") in imports
+    assert not any(isinstance(n, ast.ClassDef) and n.name == "_Stats" for n in stub.body)
 
 
 def test_the_stats_comments_are_the_schemas_meanings():
@@ -289,3 +285,16 @@ def test_every_extra_a_method_reports_has_a_declared_merge_rule(renderer, method
     scene = build_scene([layer(0.3, (1.0, 0.0, 0.0, 0.5)), layer(0.6, (0.0, 0.0, 1.0, 0.5))])
     frame = renderer(16, 16).render(scene, IDENTITY, method=method)
     assert set(frame.stats["extra"]) <= set(rules), set(frame.stats["extra"]) - set(rules)
+
+
+def test_the_surface_keywords_default_to_the_cores_material():
+    """Every surface keyword with a default takes the core's (`Material::default()`), held once."""
+    core = oit._oit.surface_defaults()
+    assert core == {"shading": "unlit", "specular": 0.0, "shininess": 32.0, "opacity": 1.0, "two_sided": True,
+                    "cull_back_faces": False}
+    for fn in (oit.Scene.add_mesh, oit.Scene.add_strands, oit.Scene.add_particles, oit.Scene.from_trimesh):
+        params = inspect.signature(fn).parameters
+        for name, default in core.items():
+            if name in params and name != "shading":
+                assert params[name].default == default, (fn.__name__, name)
+    assert inspect.signature(oit.Scene.add_strands).parameters["shading"].default == core["shading"]

@@ -235,7 +235,9 @@ def test_the_gil_is_released_during_gpu_work(renderer):
         try:
             started.set()
             before = count[0]
-            r._native.render(deep.scene._native, IDENTITY.view_proj, NAMES[0], (1.0, 1.0, 1.0), {}, 1, "frames", 0, False)
+            options = {"background": (1.0, 1.0, 1.0), "antialias": 1, "antialias_mode": "frames", "shading_cost": 0,
+                       "census": False}
+            r._native.render(deep.scene._native, IDENTITY.view_proj, NAMES[0], {}, options)
             seen.append(count[0] - before)
         except Exception as e:  # reported below
             failure.append(e)

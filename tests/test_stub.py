@@ -1,6 +1,6 @@
 """python/oit/_oit.pyi describes the native module oit._oit: the same public names, the same
 members of each class, and the same parameters (names and defaults) as the signatures PyO3
-reports. When crates/oit-py/src/lib.rs gains or changes a function, the stub changes with it."""
+reports. When crates/oit-py/src gains or changes a function, the stub changes with it."""
 
 from __future__ import annotations
 

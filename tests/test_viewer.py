@@ -125,6 +125,23 @@ def test_scene_file_round_trip(tmp_path):
         scenefile.save_scene(built.scene, path)
 
 
+def test_scene_files_keep_texels_exactly_and_name_a_bad_file(tmp_path):
+    """The core's codec writes the arrays as given (a texture between 8-bit levels included),
+    and a file it cannot read is refused with its path and where it went wrong."""
+    texture = np.random.default_rng(3).uniform(0.0, 1.0, (2, 3, 4)).astype(np.float32)
+    uvs = np.float32([[0, 0], [1, 0], [0, 1]])
+    mesh = MeshArrays(np.float32([[0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.uint32([[0, 1, 2]]), np.float32([[1, 0, 0, 0.5]] * 3),
+                      surface={"uvs": uvs, "texture": texture, "shading": "flat", "cull_back_faces": True})
+    path = tmp_path / "textured.oitscene"
+    scenefile.save_scene([mesh], path)
+    (back,), _, _ = scenefile.load_scene(path)
+    assert back.surface["shading"] == "flat" and back.surface["cull_back_faces"] and "normals" not in back.surface
+    assert np.array_equal(back.surface["texture"], texture) and np.array_equal(back.surface["uvs"], uvs)
+    path.write_bytes(path.read_bytes()[:-5])
+    with pytest.raises(ValueError, match=r"textured\.oitscene: file ends inside the ambient term"):
+        scenefile.load_scene(path)
+
+
 # tests/data/two_quads.oitscene: one file that this test and crates/oit-viewer/src/scenefile.rs
 # (`the_shared_scene_file`) both read and check value by value. Written by save_scene from
 # the values below; every number is exact in f32.

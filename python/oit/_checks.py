@@ -8,7 +8,12 @@ from typing import Any
 
 import numpy as np
 
+from . import _oit
 from ._trimesh import srgb_to_linear
+
+# A surface's defaults, the core's (`Material::default()`): every keyword of the API that has one
+# takes it from here.
+SURFACE: dict[str, Any] = _oit.surface_defaults()
 
 
 def _float_array(value: Any, name: str) -> np.ndarray:
@@ -91,9 +96,10 @@ def _texture(texture: Any) -> np.ndarray:
 
 
 def _surface(n: int, normals: Any, uvs: Any, texture: Any, shading: str | None, specular: float, shininess: float,
-             opacity: float, two_sided: bool, cull_back_faces: bool = False) -> dict[str, Any]:
-    """The keyword arguments of the native add_mesh that describe the surface, checked."""
-    out: dict[str, Any] = {}
+             opacity: float, two_sided: bool, cull_back_faces: bool = SURFACE["cull_back_faces"]) -> dict[str, Any]:
+    """The surface as the native layer takes it, one dict with every key (None: no such array),
+    types checked (crates/oit-py/src/surface.rs)."""
+    out: dict[str, Any] = {"normals": None, "uvs": None, "texture": None}
     if normals is not None:
         out["normals"] = _rows(_float_array(normals, "normals"), 3, "normals")
     if uvs is not None:

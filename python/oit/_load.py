@@ -62,6 +62,6 @@ def _hair_scene(path: str, alpha: float | None, specular: float) -> Any:
         colors[:, 3] = alpha
     native = _oit.Scene()
     native.add_strands(np.ascontiguousarray(h.points, dtype=np.float32), np.ascontiguousarray(h.counts, dtype=np.uint32),
-                       np.ascontiguousarray(h.widths, dtype=np.float32), colors, False, shading="hair",
-                       specular=specular, shininess=48.0)
+                       np.ascontiguousarray(h.widths, dtype=np.float32), colors, False,
+                       {"shading": "hair", "specular": specular, "shininess": 48.0, "opacity": 1.0})
     return native

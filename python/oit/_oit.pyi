@@ -1,11 +1,15 @@
-# The native module (crates/oit-py/src/lib.rs). It is private: python/oit/_api.py wraps it. Keep
-# this file in step with the #[pyclass], #[pymethods] and #[pyfunction] items there;
+# The native module (crates/oit-py/src). It is private: python/oit/_scene.py and _render.py wrap
+# it. Keep this file in step with the #[pyclass], #[pymethods] and #[pyfunction] items there;
 # tests/test_stub.py checks that the names match.
 
 from typing import Any, Literal, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
+
+# A frame's stats: the TypedDict is written once, in the public API, and tests/test_contract.py
+# holds it to the core's table (crates/oit-core/src/stats/).
+from oit._api import Stats as _Stats
 
 _ParamValue = int | float | str
 
@@ -41,32 +45,30 @@ class _TilingInfo(TypedDict, total=False):
     per_fragment: int
     per_triangle: int
 
-class _Stats(TypedDict, total=False):
-    # crates/oit-core/src/stats.rs, SCHEMA; tests/test_contract.py checks these against it.
-    method: str
-    params: dict[str, Any]
-    census: bool
-    fragments: int | None
-    max_depth_complexity: int | None
-    memory_bytes: int
-    target_bytes: int
-    scene_bytes: int
-    expanded_bytes: int
-    texture_bytes: int
-    scene_bytes_by_primitive: dict[str, float]
-    gpu_time_ms: float | None
-    pass_times_ms: dict[str, float]
-    overflow_fragments: int
-    wall_time_ms: float
+# The values passed as one argument (crates/oit-py/src/surface.rs), every key present.
+class _Surface(TypedDict):
+    normals: npt.NDArray[np.float32] | None
+    uvs: npt.NDArray[np.float32] | None
+    texture: npt.NDArray[np.float32] | None
+    shading: str
+    specular: float
+    shininess: float
+    opacity: float
+    two_sided: bool
+    cull_back_faces: bool
+
+class _Look(TypedDict):
+    shading: str
+    specular: float
+    shininess: float
+    opacity: float
+
+class _FrameOptions(TypedDict):
+    background: tuple[float, float, float]
     antialias: int
     antialias_mode: str
-    tiles: int
-    geometry_chunks: int
-    instances: int
-    peak_memory_bytes: int
-    adapter: str
-    extra: dict[str, float]
-    error_bound_max: float
+    shading_cost: int
+    census: bool
 
 class _MethodInfo(TypedDict):
     name: str
@@ -96,21 +98,14 @@ class Scene:
         indices: npt.NDArray[np.uint32],
         colors: npt.NDArray[np.float32],
         opaque: bool,
-        normals: npt.NDArray[np.float32] | None = None,
-        uvs: npt.NDArray[np.float32] | None = None,
-        texture: npt.NDArray[np.float32] | None = None,
-        shading: str = "unlit",
-        specular: float = 0.0,
-        shininess: float = 32.0,
-        opacity: float = 1.0,
-        two_sided: bool = True,
-        cull_back_faces: bool = False,
+        surface: _Surface,
         transform: npt.NDArray[np.float64] | None = None,
     ) -> int:
         """positions (n, 3) float32, indices (m, 3) uint32, colors (n, 4) or (1, 4) float32; the
-        surface: normals (n, 3) and uvs (n, 2) float32, texture (h, w, 4) float32 linear RGBA,
-        shading "unlit", "flat", "smooth" or "hair". `transform` (4, 4) float64 places it (else it is
-        drawn where its vertices are)."""
+        surface a dict (surface.rs): normals (n, 3) and uvs (n, 2) float32 or None, texture (h, w,
+        4) float32 linear RGBA or None, shading "unlit", "flat", "smooth" or "hair", specular,
+        shininess, opacity, two_sided, cull_back_faces. `transform` (4, 4) float64 places it (else
+        it is drawn where its vertices are)."""
     def add_strands(
         self,
         points: npt.NDArray[np.float32],
@@ -118,13 +113,11 @@ class Scene:
         widths: npt.NDArray[np.float32],
         colors: npt.NDArray[np.float32],
         opaque: bool,
-        shading: str = "unlit",
-        specular: float = 0.0,
-        shininess: float = 32.0,
-        opacity: float = 1.0,
+        look: _Look,
     ) -> int:
         """A strand set: points (n, 3), counts (strands,) uint32, widths (n,) or (1,), colors (n, 4)
-        or (1, 4) float32; shading "unlit" or "hair"."""
+        or (1, 4) float32; the look a dict of shading ("unlit" or "hair"), specular, shininess and
+        opacity."""
     def add_particles(
         self,
         centers: npt.NDArray[np.float32],
@@ -207,15 +200,12 @@ class Renderer:
         scene: Scene,
         view_proj: npt.NDArray[np.float64],
         method: str,
-        background: tuple[float, float, float],
         params: dict[str, _ParamValue],
-        antialias: int = 1,
-        antialias_mode: str = "frames",
-        shading_cost: int = 0,
-        census: bool = False,
+        options: _FrameOptions,
     ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32] | None, _Stats, npt.NDArray[np.float32] | None]:
         """Returns (image (h, w, 4) float32, depth complexity (h, w) uint32 or None without a
-        census, stats dict, error bound (h, w) float32 or None)."""
+        census, stats dict, error bound (h, w) float32 or None); `options` a dict (surface.rs):
+        background, antialias, antialias_mode, shading_cost, census."""
 
 def methods() -> list[_MethodInfo]:
     """Every method: name, summary, exact, bounded memory, passes, parameters."""
@@ -228,7 +218,18 @@ def extra_merge_rules() -> list[tuple[str, str]]:
     """Every extra number a method reports and how tiles and samples merge it: sum, max or mean."""
 
 def stats_schema() -> list[tuple[str, str, str]]:
-    """The keys of a frame's stats: (name, Python type, meaning), in order (crates/oit-core/src/stats.rs)."""
+    """The keys of a frame's stats: (name, Python type, meaning), in order (crates/oit-core/src/stats/)."""
+
+class _SurfaceDefaults(TypedDict):
+    shading: str
+    specular: float
+    shininess: float
+    opacity: float
+    two_sided: bool
+    cull_back_faces: bool
+
+def surface_defaults() -> _SurfaceDefaults:
+    """The surface a mesh has unless told otherwise (the core's `Material::default()`)."""
 
 def constants() -> dict[str, Any]:
     """The numbers shared by the core, its shaders and Python (crates/oit-core/src/consts.rs)."""
@@ -260,6 +261,31 @@ def load_file(
     cloud's particles (None: 1/200 of its box's diagonal). Returns the scene, its mesh names, the
     file's cameras, the note and the loader's warnings (one sentence a feature not drawn). A
     panic while reading is a RuntimeError naming the file."""
+
+# A scene file's records (crates/oit-py/src/scenefile.rs): a camera is (1, 16 row-major
+# view-projection values) or (2, eye, target, up, fov_y, near, far); a light (direction, color,
+# intensity).
+_CameraRecord = tuple[int, list[float]]
+_LightRecord = tuple[tuple[float, float, float], tuple[float, float, float], float]
+
+def encode_scene(
+    meshes: list[dict[str, Any]],
+    camera: _CameraRecord | None,
+    size: tuple[int, int] | None,
+    lights: list[_LightRecord],
+    ambient: tuple[float, float, float],
+) -> bytes:
+    """A scene file's bytes from mesh records (dicts: name, opaque, positions, colors, indices,
+    primitive, surface), a camera record, the size, lights and the ambient term."""
+
+def decode_scene(
+    data: bytes,
+) -> tuple[list[dict[str, Any]], _CameraRecord | None, tuple[int, int] | None, list[_LightRecord], list[float]]:
+    """A scene file's records from its bytes: mesh dicts (a surface has only the arrays the file
+    has), the camera record, the size, the lights and the ambient term."""
+
+def scene_file_format() -> tuple[bytes, int]:
+    """The file's magic bytes and its newest version."""
 
 # Every entry above runs under the binding's panic guard (crates/oit-py/src/guard.rs): a panic is
 # a RuntimeError that says it is a bug. `_GUARDED` names the guarded entries ("Scene.add_mesh",

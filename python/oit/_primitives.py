@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import _U32_MAX, _bool, _colors, _float_array, _rows
+from ._checks import _U32_MAX, SURFACE, _bool, _colors, _float_array, _rows
 
 
 def _sizes(value: Any, name: str) -> np.ndarray:
@@ -25,8 +25,8 @@ class PrimitiveMethods:
     _mesh_index: Any
 
     def add_strands(self, points: Any, counts: Any, width: Any, colors: Any, opaque: bool = False, *,
-                    shading: str = "unlit", specular: float = 0.0, shininess: float = 32.0,
-                    opacity: float = 1.0) -> int:
+                    shading: str = SURFACE["shading"], specular: float = SURFACE["specular"],
+                    shininess: float = SURFACE["shininess"], opacity: float = SURFACE["opacity"]) -> int:
         """Adds a strand set and returns its index (a mesh index: `add_instances`,
         `set_mesh_alpha` and the rest take it).
 
@@ -48,11 +48,11 @@ class PrimitiveMethods:
                              "counts[i] is the number of points of strand i, at least 2")
         cnt = np.ascontiguousarray(cnt, dtype=np.uint32)
         return self._native.add_strands(pts, cnt, _sizes(width, "width"), _colors(colors, len(pts), "point"),
-                                        _bool(opaque, "opaque"), shading=shading, specular=float(specular),
-                                        shininess=float(shininess), opacity=float(opacity))
+                                        _bool(opaque, "opaque"), {"shading": shading, "specular": float(specular),
+                                        "shininess": float(shininess), "opacity": float(opacity)})
 
     def add_particles(self, centers: Any, radius: Any, colors: Any, opaque: bool = False, *,
-                      falloff: str = "hard", opacity: float = 1.0) -> int:
+                      falloff: str = "hard", opacity: float = SURFACE["opacity"]) -> int:
         """Adds a particle set and returns its index (a mesh index).
 
         centers: (n, 3) float; radius: world units, one number or (n,); colors: (n, 4) per

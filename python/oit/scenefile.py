@@ -2,50 +2,30 @@
 
 `oit.Scene` keeps its arrays in Rust, so a file is written from the arrays themselves: a
 `BuiltScene` from `oit.scenes` (which carries its meshes), or a list of `MeshArrays`. The
-layout (docs/viewer.md; crates/oit-viewer/src/scenefile.rs reads it), all little-endian:
-
-    b"OITSCENE", version u32 = 1, width u32, height u32 (0: no size),
-    camera kind u32: 0 none | 1 view-projection, 16 f64 row-major | 2 look-at, 12 f64:
-        eye xyz, target xyz, up xyz, fov_y (degrees), near, far
-    mesh count u32, then per mesh: flags u32 (bit 0: opaque, bit 1: a surface follows),
-        name length u32, name UTF-8, vertices n u32, triangles m u32, positions n*3 f32,
-        colors n*4 f32 (straight linear RGBA), indices m*3 u32, and with bit 1 (version 2):
-        shading u32 (0 unlit, 1 flat, 2 smooth), two-sided u32, specular, shininess, opacity
-        f32, normals count u32 (0 or n) and n*3 f32, UV count u32 (0 or n) and n*2 f32,
-        texture height h u32 and width w u32 (0 0: none) and h*w*4 f32 linear RGBA
-    version 2 only, after the meshes: light count u32, per light direction xyz, color rgb,
-        intensity (7 f32); ambient rgb (3 f32)
-    version 3: as version 2, and a mesh's flags bit 2 says it is a strand or particle set
-        (oit.Scene.add_strands, add_particles): its n vertices are the points, it has no
-        triangles (m = 0), and after its indices come kind u32 (1 strands, 2 particles), then
-        for strands the strand count s u32, the points per strand s*u32 and the widths n*f32,
-        for particles the falloff u32 (1 hard, 2 linear, 3 gaussian) and the radii n*f32; its
-        surface (bit 1) has no normals, UVs or texture, and shading 3 is "hair"
-
-A file is written as version 1 when no mesh has a surface and there are no lights or
-ambient term, so that older readers still read unlit scenes; as version 3 only when it holds
-a strand or particle set or "hair" shading.
+layout is docs/viewer.md's; its one reader and writer is the core's
+(crates/oit-core/src/scenefile/), which the viewer uses too. A file is written in the oldest
+version that holds it (1 without surfaces, lights or ambient term, so that older readers still
+read unlit scenes; 3 only with a strand or particle set or "hair" shading), and every version is
+read.
 """
 
 from __future__ import annotations
 
 import os
-import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Union
 
 import numpy as np
 
+from . import _oit
 from ._api import Camera, Scene
+from ._checks import SURFACE, _surface
 from .scenes import BuiltScene, MeshArrays
 
 __all__ = ["LookAt", "save_scene", "load_scene", "load_lights", "scene_of", "MAGIC", "VERSION"]
 
-MAGIC = b"OITSCENE"
-VERSION = 3
-SHADING_CODES = {"unlit": 0, "flat": 1, "smooth": 2, "hair": 3}
-FALLOFF_CODES = {"hard": 1, "linear": 2, "gaussian": 3}
+MAGIC, VERSION = _oit.scene_file_format()
 
 
 @dataclass(frozen=True)
@@ -86,45 +66,47 @@ def save_scene(scene: SceneLike, path: str | os.PathLike, camera: Camera | LookA
     # The file has no instances: a mesh drawn more than once is written once per instance.
     names = [(names[i] if names else f"mesh {i}") + (f" #{j}" if m.transforms is not None and j else "")
              for i, m in enumerate(meshes) for j in range(len(m.placed()))]
-    meshes = [p for m in meshes for p in m.placed()]
-    lights = list(lights or [])
-    ambient = tuple(float(a) for a in (ambient if ambient is not None else (0.0, 0.0, 0.0)))
-    version = 2 if lights or any(ambient) or any(m.surface for m in meshes) else 1
-    if any(m.primitive is not None or m.surface.get("shading") == "hair" for m in meshes):
-        version = 3
-    out = [MAGIC, struct.pack("<3I", version, *(size or (0, 0)))]
+    records = [_record(i, p, names[i]) for i, p in enumerate(p for m in meshes for p in m.placed())]
     if camera is None:
-        out.append(struct.pack("<I", 0))
+        spec = None
     elif isinstance(camera, LookAt):
-        values = [*camera.eye, *camera.target, *camera.up, camera.fov_y, camera.near, camera.far]
-        out.append(struct.pack("<I12d", 2, *map(float, values)))
+        spec = (2, [float(v) for v in (*camera.eye, *camera.target, *camera.up, camera.fov_y, camera.near, camera.far)])
     elif isinstance(camera, Camera):
-        out.append(struct.pack("<I", 1) + np.ascontiguousarray(camera.view_proj, dtype="<f8").tobytes())
+        spec = (1, np.asarray(camera.view_proj, dtype=np.float64).reshape(-1).tolist())
     else:
         raise TypeError(f"camera must be an oit.Camera or a scenefile.LookAt, got {type(camera).__name__}")
-    out.append(struct.pack("<I", len(meshes)))
-    for i, m in enumerate(meshes):
-        pos = np.ascontiguousarray(m.positions, dtype="<f4").reshape(-1, 3)
-        col = np.asarray(m.colors, dtype="<f4")
-        col = np.ascontiguousarray(np.broadcast_to(col.reshape(-1, 4), (len(pos), 4)) if col.size == 4 else col.reshape(-1, 4))
-        idx = np.ascontiguousarray(m.indices, dtype="<u4").reshape(-1, 3)
-        if len(col) != len(pos):
-            raise ValueError(f"mesh {i}: {len(col)} colors for {len(pos)} vertices")
-        name = names[i].encode()
-        flags = int(bool(m.opaque)) | (2 if m.surface else 0) | (4 if m.primitive is not None else 0)
-        out += [struct.pack("<2I", flags, len(name)), name, struct.pack("<2I", len(pos), len(idx)),
-                pos.tobytes(), col.tobytes(), idx.tobytes()]
-        if m.primitive is not None:
-            out.append(_primitive_bytes(m.primitive, len(pos)))
-        if m.surface:
-            out.append(_surface_bytes(m.surface, len(pos)))
-    if version >= 2:
-        out.append(struct.pack("<I", len(lights)))
-        for d, c, intensity in lights:
-            out.append(struct.pack("<7f", *map(float, d), *map(float, c), float(intensity)))
-        out.append(struct.pack("<3f", *ambient))
+    lights = [(tuple(map(float, d)), tuple(map(float, c)), float(i)) for d, c, i in (lights or [])]
+    ambient = tuple(float(a) for a in (ambient if ambient is not None else (0.0, 0.0, 0.0)))
+    data = _oit.encode_scene(records, spec, tuple(size) if size else None, lights, ambient)
     with open(path, "wb") as f:
-        f.write(b"".join(out))
+        f.write(data)
+
+
+def _record(i: int, m: MeshArrays, name: str) -> dict[str, Any]:
+    """A mesh as the core's codec takes it (crates/oit-py/src/scenefile.rs)."""
+    pos = np.ascontiguousarray(m.positions, dtype=np.float32).reshape(-1, 3)
+    col = np.asarray(m.colors, dtype=np.float32)
+    col = np.ascontiguousarray(np.broadcast_to(col.reshape(-1, 4), (len(pos), 4)) if col.size == 4 else col.reshape(-1, 4))
+    if len(col) != len(pos):
+        raise ValueError(f"mesh {i}: {len(col)} colors for {len(pos)} vertices")
+    primitive = None
+    if m.primitive is not None:
+        p, n = m.primitive, len(pos)
+        if p["kind"] not in ("strands", "particles"):
+            raise ValueError(f"primitive kind must be 'strands' or 'particles', got {p['kind']!r}")
+        size = p["widths"] if p["kind"] == "strands" else p["radii"]
+        primitive = {"kind": p["kind"], "counts": None, "falloff": p.get("falloff"),
+                     "sizes": np.ascontiguousarray(np.broadcast_to(np.asarray(size, np.float32).reshape(-1), (n,)))}
+        if p["kind"] == "strands":
+            primitive["counts"] = np.ascontiguousarray(p["counts"], dtype=np.uint32).reshape(-1)
+    surface = None
+    if m.surface:
+        s = m.surface
+        surface = _surface(len(pos), *(s.get(k) for k in ("normals", "uvs", "texture", "shading")),
+                           *(s.get(k, SURFACE[k]) for k in ("specular", "shininess", "opacity", "two_sided", "cull_back_faces")))
+    return {"name": name, "opaque": bool(m.opaque), "positions": pos, "colors": col,
+            "indices": np.ascontiguousarray(m.indices, dtype=np.uint32).reshape(-1, 3), "primitive": primitive,
+            "surface": surface}
 
 
 def load_scene(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | None]:
@@ -140,57 +122,25 @@ def load_lights(path: str | os.PathLike) -> tuple[list, tuple[float, float, floa
 def _load(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | None, list, tuple[float, float, float]]:
     with open(path, "rb") as f:
         data = f.read()
-    if data[:8] != MAGIC:
-        raise ValueError(f"{path}: not an oit scene file")
-    at = 8
-    version, w, h, kind = struct.unpack_from("<4I", data, at)
-    at += 16
-    if version not in (1, 2, VERSION):
-        raise ValueError(f"{path}: scene file version {version}; this reads versions 1 to {VERSION}")
+    try:
+        records, spec, size, lights, ambient = _oit.decode_scene(data)
+    except ValueError as e:
+        raise ValueError(f"{path}: {e}") from None
     camera: Any = None
-    if kind == 1:
-        camera = Camera(np.frombuffer(data, "<f8", 16, at).reshape(4, 4))
-        at += 128
-    elif kind == 2:
-        v = struct.unpack_from("<12d", data, at)
+    if spec is not None and spec[0] == 1:
+        camera = Camera(np.array(spec[1], dtype=np.float64).reshape(4, 4))
+    elif spec is not None:
+        v = spec[1]
         camera = LookAt(tuple(v[0:3]), tuple(v[3:6]), tuple(v[6:9]), v[9], v[10], v[11])
-        at += 96
-    (count,) = struct.unpack_from("<I", data, at)
-    at += 4
     meshes = []
-    for _ in range(count):
-        flags, name_len = struct.unpack_from("<2I", data, at)
-        at += 8 + name_len
-        n, m = struct.unpack_from("<2I", data, at)
-        at += 8
-        pos = np.frombuffer(data, "<f4", n * 3, at).reshape(n, 3)
-        at += n * 12
-        col = np.frombuffer(data, "<f4", n * 4, at).reshape(n, 4)
-        at += n * 16
-        idx = np.frombuffer(data, "<u4", m * 3, at).reshape(m, 3)
-        at += m * 12
-        primitive = None
-        if flags & 4:
-            primitive, at = _read_primitive(data, at, n)
-        surface: dict[str, Any] = {}
-        if flags & 2:
-            surface, at = _read_surface(data, at, n)
-            if primitive is not None:
-                surface = {k: surface[k] for k in ("shading", "specular", "shininess", "opacity")}
-                if primitive["kind"] == "particles":
-                    surface = {"opacity": surface["opacity"]}
-        meshes.append(MeshArrays(pos, idx, col, bool(flags & 1), surface, primitive=primitive))
-    lights: list = []
-    ambient = (0.0, 0.0, 0.0)
-    if version >= 2:
-        (count,) = struct.unpack_from("<I", data, at)
-        at += 4
-        for _ in range(count):
-            v = struct.unpack_from("<7f", data, at)
-            lights.append((tuple(v[0:3]), tuple(v[3:6]), v[6]))
-            at += 28
-        ambient = struct.unpack_from("<3f", data, at)
-    return meshes, camera, ((w, h) if w and h else None), lights, tuple(ambient)
+    for r in records:
+        surface, primitive = r["surface"] or {}, r["primitive"]
+        if surface and primitive is not None:
+            # A set's surface: the words add_strands takes, or a particle set's opacity.
+            keys = ("opacity",) if primitive["kind"] == "particles" else ("shading", "specular", "shininess", "opacity")
+            surface = {k: surface[k] for k in keys}
+        meshes.append(MeshArrays(r["positions"], r["indices"], r["colors"], r["opaque"], surface, primitive=primitive))
+    return meshes, camera, size, [(tuple(d), tuple(c), i) for d, c, i in lights], tuple(ambient)
 
 
 def scene_of(meshes: Sequence[MeshArrays], lights: Sequence[tuple[Any, Any, float]] = (),
@@ -204,72 +154,3 @@ def scene_of(meshes: Sequence[MeshArrays], lights: Sequence[tuple[Any, Any, floa
         scene.add_light(d, c, i)
     scene.ambient = tuple(ambient)
     return scene
-
-
-def _primitive_bytes(p: dict[str, Any], n: int) -> bytes:
-    """A strand or particle set's block (version 3): its kind and per-point sizes."""
-    if p["kind"] == "strands":
-        counts = np.ascontiguousarray(p["counts"], dtype="<u4").reshape(-1)
-        sizes = np.broadcast_to(np.asarray(p["widths"], dtype="<f4").reshape(-1), (n,))
-        head = struct.pack("<2I", 1, len(counts)) + counts.tobytes()
-    elif p["kind"] == "particles":
-        sizes = np.broadcast_to(np.asarray(p["radii"], dtype="<f4").reshape(-1), (n,))
-        head = struct.pack("<2I", 2, FALLOFF_CODES[p["falloff"]])
-    else:
-        raise ValueError(f"primitive kind must be 'strands' or 'particles', got {p['kind']!r}")
-    return head + np.ascontiguousarray(sizes).tobytes()
-
-
-def _read_primitive(data: bytes, at: int, n: int) -> tuple[dict[str, Any], int]:
-    kind, value = struct.unpack_from("<2I", data, at)
-    at += 8
-    if kind == 1:
-        counts = np.frombuffer(data, "<u4", value, at)
-        at += 4 * value
-        widths = np.frombuffer(data, "<f4", n, at)
-        return {"kind": "strands", "counts": counts, "widths": widths}, at + 4 * n
-    if kind == 2:
-        falloff = {v: k for k, v in FALLOFF_CODES.items()}[value]
-        return {"kind": "particles", "radii": np.frombuffer(data, "<f4", n, at), "falloff": falloff}, at + 4 * n
-    raise ValueError(f"unknown primitive kind {kind} (1: strands, 2: particles)")
-
-
-def _surface_bytes(surface: dict[str, Any], n: int) -> bytes:
-    from ._checks import _surface
-
-    s = _surface(n, surface.get("normals"), surface.get("uvs"), surface.get("texture"), surface.get("shading"),
-                 surface.get("specular", 0.0), surface.get("shininess", 32.0), surface.get("opacity", 1.0),
-                 surface.get("two_sided", True), surface.get("cull_back_faces", False))
-    # The sidedness word: bit 0 two-sided lighting, bit 1 back faces culled (docs/viewer.md).
-    sides = int(s["two_sided"]) | int(s["cull_back_faces"]) << 1
-    out = [struct.pack("<2I3f", SHADING_CODES[s["shading"]], sides, s["specular"], s["shininess"], s["opacity"])]
-    for key, width in (("normals", 3), ("uvs", 2)):
-        a = s.get(key)
-        out.append(struct.pack("<I", 0 if a is None else n))
-        if a is not None:
-            out.append(np.ascontiguousarray(a, dtype="<f4").reshape(n, width).tobytes())
-    t = s.get("texture")
-    out.append(struct.pack("<2I", *((0, 0) if t is None else t.shape[:2])))
-    if t is not None:
-        out.append(np.ascontiguousarray(t, dtype="<f4").tobytes())
-    return b"".join(out)
-
-
-def _read_surface(data: bytes, at: int, n: int) -> tuple[dict[str, Any], int]:
-    code, sides, specular, shininess, opacity = struct.unpack_from("<2I3f", data, at)
-    at += 20
-    surface: dict[str, Any] = {"shading": {v: k for k, v in SHADING_CODES.items()}[code], "two_sided": bool(sides & 1),
-                               "cull_back_faces": bool(sides & 2),
-                               "specular": specular, "shininess": shininess, "opacity": opacity}
-    for key, width in (("normals", 3), ("uvs", 2)):
-        (count,) = struct.unpack_from("<I", data, at)
-        at += 4
-        if count:
-            surface[key] = np.frombuffer(data, "<f4", count * width, at).reshape(count, width)
-            at += count * width * 4
-    h, w = struct.unpack_from("<2I", data, at)
-    at += 8
-    if h and w:
-        surface["texture"] = np.frombuffer(data, "<f4", h * w * 4, at).reshape(h, w, 4)
-        at += h * w * 16
-    return surface, at

@@ -18,6 +18,7 @@ pub mod renderer;
 pub mod resources;
 mod scan;
 pub mod scene;
+pub mod scenefile;
 pub mod shader;
 pub mod shading;
 pub mod stats;

@@ -25,7 +25,7 @@ use crate::method::{self, AntialiasMode, Limits, Method, MethodInfo, ParamValue,
 use crate::scene::{Camera, Scene};
 use crate::shader::SceneVariant;
 use crate::shading::{Light, Lighting};
-use crate::stats::ExtraMerge;
+use crate::stats::SampleMerge;
 pub use crate::stats::Stats;
 use crate::targets::Targets;
 use crate::timer::PassTimer;
@@ -224,10 +224,9 @@ impl Renderer {
     /// Renders `antialias` sample frames, each with the camera moved onto one position of the
     /// standard pattern (`antialias::sample_offsets`), and averages them: every method gets
     /// antialiasing with its own buffers reused from sample to sample (memory as at one
-    /// sample, time about `antialias` times). Stats: fragments and overflow are summed over
-    /// the samples, depth complexity is the largest per pixel, GPU time the sum, memory the
-    /// largest of the samples; the error bound is the mean of the samples' bounds (the
-    /// error of a mean is at most the mean of the errors).
+    /// sample, time about `antialias` times). The samples' stats merge by each key's rule
+    /// (`stats::SCHEMA`); depth complexity is the largest per pixel, and the error bound the mean
+    /// of the samples' bounds (the error of a mean is at most the mean of the errors).
     ///
     /// `AntialiasMode::Coverage` instead rasterizes the transparent geometry once,
     /// multisampled, and stores one fragment per pixel with its sample mask (the methods of
@@ -274,9 +273,8 @@ impl Renderer {
         let mut image = vec![0.0f64; pixels * 4];
         let mut bound: Option<Vec<f64>> = None;
         let mut depth_complexity = Vec::new();
-        let mut stats = Stats::default();
-        let mut extra = ExtraMerge::default();
-        for (i, offset) in offsets.iter().enumerate() {
+        let mut merged = SampleMerge::default();
+        for offset in &offsets {
             let jittered = camera.jittered(*offset, self.width, self.height);
             let f = self.render_sample(&Job { camera: &jittered, info, params: &params, background, coverage: false })?;
             image.iter_mut().zip(&f.image).for_each(|(a, &v)| *a += v as f64);
@@ -288,23 +286,9 @@ impl Renderer {
                 depth_complexity = vec![0u32; f.depth_complexity.len()];
             }
             depth_complexity.iter_mut().zip(&f.depth_complexity).for_each(|(a, &v)| *a = (*a).max(v));
-            let s = f.stats;
-            if i == 0 {
-                stats = Stats { fragments: 0, overflow_fragments: 0, memory_bytes: 0, gpu_time_ms: Some(0.0), ..s.clone() };
-            }
-            stats.fragments += s.fragments;
-            stats.overflow_fragments += s.overflow_fragments;
-            stats.max_depth_complexity = stats.max_depth_complexity.max(s.max_depth_complexity);
-            stats.memory_bytes = stats.memory_bytes.max(s.memory_bytes);
-            stats.peak_memory_bytes = stats.peak_memory_bytes.max(s.peak_memory_bytes);
-            stats.gpu_time_ms = stats.gpu_time_ms.zip(s.gpu_time_ms).map(|(a, b)| a + b);
-            if i > 0 {
-                stats.tiles += s.tiles;
-                stats.pass_times_ms.extend(s.pass_times_ms);
-            }
-            extra.add(&s.extra, 1.0);
+            merged.add(f.stats);
         }
-        stats.extra = extra.finish();
+        let mut stats = merged.finish();
         let n = offsets.len() as f64;
         stats.wall_time_ms = start.elapsed().as_secs_f64() * 1e3;
         stats.antialias = antialias;

@@ -1,9 +1,13 @@
-//! numpy arrays into the core's types and back: rows of N values, 4 x 4 matrices, instance lists. Shapes
-//! are checked here, where the arrays are taken apart; their values are the core's to check.
+//! Python values into the core's types and back: rows of N values, 4 x 4 matrices, instance lists,
+//! method parameters. Shapes and types are checked here, where the values are taken apart; the
+//! values themselves are the core's to check.
 
 use numpy::{IntoPyArray, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use oit_core::ParamValue;
 
 pub(crate) fn rows<T: Copy + numpy::Element, const N: usize>(a: &PyReadonlyArray2<'_, T>, name: &str) -> PyResult<Vec<[T; N]>> {
     let shape = a.as_array().shape().to_vec();
@@ -63,4 +67,38 @@ pub(crate) fn instances(
             oit_core::Instance::from_rows(rows, colors[i]).map_err(|e| PyValueError::new_err(format!("instance {i}: {e}")))
         })
         .collect()
+}
+
+fn param_value(v: &Bound<'_, PyAny>, name: &str) -> PyResult<ParamValue> {
+    if v.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(PyValueError::new_err(format!("parameter '{name}' must be a number or a string, not a bool")));
+    }
+    if let Ok(i) = v.extract::<i64>() {
+        return Ok(ParamValue::Int(i));
+    }
+    if let Ok(f) = v.extract::<f64>() {
+        return Ok(ParamValue::Float(f));
+    }
+    if let Ok(s) = v.extract::<String>() {
+        return Ok(ParamValue::Str(s));
+    }
+    Err(PyValueError::new_err(format!("parameter '{name}' must be a number or a string, got {}", v.get_type().name()?)))
+}
+
+/// A parameter dict as the core takes it: names with ints, floats or strings.
+pub(crate) fn param_list(params: &Bound<'_, PyDict>) -> PyResult<Vec<(String, ParamValue)>> {
+    let mut plist = Vec::new();
+    for (k, v) in params.iter() {
+        let name: String = k.extract()?;
+        plist.push((name.clone(), param_value(&v, &name)?));
+    }
+    Ok(plist)
+}
+
+pub(crate) fn value_to_py<'py>(py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        ParamValue::Int(i) => i.into_pyobject(py)?.into_any(),
+        ParamValue::Float(f) => f.into_pyobject(py)?.into_any(),
+        ParamValue::Str(s) => s.into_pyobject(py)?.into_any(),
+    })
 }

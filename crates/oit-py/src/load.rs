@@ -9,8 +9,9 @@ use pyo3::types::{PyDict, PyList};
 
 use oit_core::load::{self, Projection, Surface};
 
+use crate::error::Error;
 use crate::guard::{self, guarded};
-use crate::{Error, Scene};
+use crate::scene::Scene;
 
 guarded! { fns GUARDED;
 

@@ -5,18 +5,11 @@ use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{array, matrix, rows};
-use crate::Error;
+use crate::error::Error;
+use crate::surface::Look;
 
-/// The surface words shared by strands and particles.
-pub(crate) struct Look<'a> {
-    pub shading: &'a str,
-    pub specular: f32,
-    pub shininess: f32,
-    pub opacity: f32,
-}
-
-fn surfaced(mesh: oit_core::Mesh, look: &Look<'_>) -> PyResult<oit_core::Mesh> {
-    let shading = oit_core::Shading::from_name(look.shading).map_err(Error::from)?;
+fn surfaced(mesh: oit_core::Mesh, look: &Look) -> PyResult<oit_core::Mesh> {
+    let shading = oit_core::Shading::from_name(&look.shading).map_err(Error::from)?;
     Ok(mesh.with_primitive_surface(shading, look.specular, look.shininess, look.opacity).map_err(Error::from)?)
 }
 
@@ -26,7 +19,7 @@ pub(crate) fn strands(
     widths: &PyReadonlyArray1<'_, f32>,
     colors: &PyReadonlyArray2<'_, f32>,
     opaque: bool,
-    look: &Look<'_>,
+    look: &Look,
 ) -> PyResult<oit_core::Mesh> {
     let counts = counts.as_array().to_vec();
     let widths = widths.as_array().to_vec();
@@ -46,7 +39,7 @@ pub(crate) fn particles(
     let radii = radii.as_array().to_vec();
     let mesh =
         oit_core::Mesh::particles(rows(centers, "centers")?, radii, rows(colors, "colors")?, opaque, falloff).map_err(Error::from)?;
-    surfaced(mesh, &Look { shading: "unlit", specular: 0.0, shininess: 32.0, opacity })
+    surfaced(mesh, &Look { shading: "unlit".into(), specular: 0.0, shininess: 32.0, opacity })
 }
 
 /// Positions (n, 3), indices (m, 3), colors (n, 4), normals (n, 3) or None, uvs (n, 2) or None.

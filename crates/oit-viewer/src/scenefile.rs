@@ -1,25 +1,13 @@
-//! The scene interchange file (`.oitscene`): what `python -m oit view --scene NAME` exports
-//! and the viewer reads. The layout is specified in docs/viewer.md; python/oit/scenefile.py
-//! writes it and mirrors this file.
+//! The scene interchange file (`.oitscene`) as the viewer reads it: the core's codec
+//! (`oit_core::scenefile`, which Python's `oit.scenefile` calls too), each mesh record made a
+//! checked core mesh. The layout is specified in docs/viewer.md.
 
 use std::path::Path;
 
-use oit_core::{Falloff, Light, Material, Mesh, Primitive, Shading, Texture, TextureMap};
+use oit_core::scenefile::{FileMesh, SceneFile};
+use oit_core::Light;
 
-pub const MAGIC: &[u8; 8] = b"OITSCENE";
-/// The newest version; a file without surfaces, lights or ambient term is written as 1, one
-/// without strands, particles or "hair" shading as 2.
-pub const VERSION: u32 = 3;
-
-/// A camera as a scene file stores it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum CameraSpec {
-    /// View-projection, row-major (`clip = M @ [x, y, z, 1]`), wgpu clip space, made for
-    /// the file's size (its aspect ratio).
-    Matrix([[f64; 4]; 4]),
-    /// A right-handed perspective camera; `fov_y` in degrees.
-    LookAt { eye: [f64; 3], target: [f64; 3], up: [f64; 3], fov_y: f64, near: f64, far: f64 },
-}
+pub use oit_core::scenefile::{CameraSpec, MAGIC, VERSION};
 
 /// A mesh and its name, as the core's loader gives them.
 pub use oit_core::load::NamedMesh;
@@ -36,168 +24,16 @@ pub struct SceneData {
     pub ambient: [f32; 3],
 }
 
-struct Reader<'a> {
-    data: &'a [u8],
-    at: usize,
-}
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], String> {
-        let end = self.at.checked_add(n).filter(|&e| e <= self.data.len());
-        let end = end.ok_or_else(|| format!("file ends inside {what} (at byte {}, {n} bytes needed)", self.at))?;
-        let s = &self.data[self.at..end];
-        self.at = end;
-        Ok(s)
-    }
-    fn u32(&mut self, what: &str) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.take(4, what)?.try_into().unwrap()))
-    }
-    fn f32s<const N: usize>(&mut self, what: &str) -> Result<[f32; N], String> {
-        let b = self.take(4 * N, what)?;
-        Ok(std::array::from_fn(|i| f32::from_le_bytes(b[4 * i..4 * i + 4].try_into().unwrap())))
-    }
-    fn f64s<const N: usize>(&mut self, what: &str) -> Result<[f64; N], String> {
-        let b = self.take(8 * N, what)?;
-        Ok(std::array::from_fn(|i| f64::from_le_bytes(b[8 * i..8 * i + 8].try_into().unwrap())))
-    }
-    fn array<T: bytemuck::Pod>(&mut self, count: usize, what: &str) -> Result<Vec<T>, String> {
-        let bytes = count.checked_mul(std::mem::size_of::<T>()).ok_or_else(|| format!("{what}: count {count} too large"))?;
-        Ok(bytemuck::pod_collect_to_vec(self.take(bytes, what)?))
-    }
-}
-
 /// Parses a scene file's bytes; errors say where the file is wrong.
 pub fn parse(data: &[u8]) -> Result<SceneData, String> {
-    let mut r = Reader { data, at: 0 };
-    if r.take(8, "the header")? != MAGIC {
-        return Err("not an oit scene file (it does not start with OITSCENE)".into());
+    let file = SceneFile::parse(data).map_err(|e| e.to_string())?;
+    let mut meshes = Vec::with_capacity(file.meshes.len());
+    for (i, m) in file.meshes.iter().enumerate() {
+        let mesh = m.to_mesh().map_err(|e| format!("mesh {i} ('{}'): {e}", m.name))?;
+        meshes.push(NamedMesh::new(if m.name.is_empty() { format!("mesh {i}") } else { m.name.clone() }, mesh));
     }
-    let version = r.u32("the version")?;
-    if !(1..=VERSION).contains(&version) {
-        return Err(format!("scene file version {version}; this viewer reads versions 1 to {VERSION}"));
-    }
-    let (w, h) = (r.u32("the size")?, r.u32("the size")?);
-    let size = (w > 0 && h > 0).then_some((w, h));
-    let camera = match r.u32("the camera kind")? {
-        0 => None,
-        1 => {
-            let m: [f64; 16] = r.f64s("the camera matrix")?;
-            Some(CameraSpec::Matrix(std::array::from_fn(|i| std::array::from_fn(|j| m[4 * i + j]))))
-        }
-        2 => {
-            let v: [f64; 12] = r.f64s("the look-at camera")?;
-            Some(CameraSpec::LookAt {
-                eye: [v[0], v[1], v[2]],
-                target: [v[3], v[4], v[5]],
-                up: [v[6], v[7], v[8]],
-                fov_y: v[9],
-                near: v[10],
-                far: v[11],
-            })
-        }
-        k => return Err(format!("unknown camera kind {k} (0: none, 1: matrix, 2: look-at)")),
-    };
-    let count = r.u32("the mesh count")?;
-    let mut meshes = Vec::new();
-    for i in 0..count {
-        let flags = r.u32("mesh flags")?;
-        let name_len = r.u32("a mesh name")? as usize;
-        let name = String::from_utf8_lossy(r.take(name_len, "a mesh name")?).into_owned();
-        let n = r.u32("the vertex count")? as usize;
-        let m = r.u32("the triangle count")? as usize;
-        let positions: Vec<[f32; 3]> = r.array(n, "positions")?;
-        let colors: Vec<[f32; 4]> = r.array(n, "colors")?;
-        let indices: Vec<[u32; 3]> = r.array(m, "indices")?;
-        let opaque = flags & 1 != 0;
-        let mut mesh = if flags & 4 != 0 {
-            read_primitive(&mut r, positions, colors, opaque, n)
-        } else {
-            Mesh::new(positions, indices, colors, opaque).map_err(|e| e.to_string())
-        }
-        .map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
-        if flags & 2 != 0 {
-            mesh = read_surface(&mut r, mesh, n).map_err(|e| format!("mesh {i} ('{name}'): {e}"))?;
-        }
-        meshes.push(NamedMesh::new(if name.is_empty() { format!("mesh {i}") } else { name }, mesh));
-    }
-    let (mut lights, mut ambient) = (Vec::new(), [0.0; 3]);
-    if version >= 2 {
-        for _ in 0..r.u32("the light count")? {
-            let v: [f32; 7] = r.f32s("a light")?;
-            lights.push(Light::new([v[0], v[1], v[2]], [v[3], v[4], v[5]], v[6]).map_err(|e| e.to_string())?);
-        }
-        ambient = r.f32s("the ambient term")?;
-    }
-    if r.at != data.len() {
-        return Err(format!("{} bytes after the last mesh", data.len() - r.at));
-    }
-    Ok(SceneData { meshes, camera, size, lights, ambient })
-}
-
-/// A strand or particle set (flags bit 2, version 3): its kind, then the points per strand and
-/// the widths, or the falloff and the radii.
-fn read_primitive(r: &mut Reader<'_>, points: Vec<[f32; 3]>, colors: Vec<[f32; 4]>, opaque: bool, n: usize) -> Result<Mesh, String> {
-    let (kind, value) = (r.u32("the primitive kind")?, r.u32("the primitive block")?);
-    match kind {
-        1 => {
-            let counts: Vec<u32> = r.array(value as usize, "the strand counts")?;
-            let widths: Vec<f32> = r.array(n, "the widths")?;
-            Mesh::strands(points, counts, widths, colors, opaque).map_err(|e| e.to_string())
-        }
-        2 => {
-            let falloff = match value {
-                1 => Falloff::Hard,
-                2 => Falloff::Linear,
-                3 => Falloff::Gaussian,
-                k => return Err(format!("unknown falloff {k} (1: hard, 2: linear, 3: gaussian)")),
-            };
-            let radii: Vec<f32> = r.array(n, "the radii")?;
-            Mesh::particles(points, radii, colors, opaque, falloff).map_err(|e| e.to_string())
-        }
-        k => Err(format!("unknown primitive kind {k} (1: strands, 2: particles)")),
-    }
-}
-
-/// A mesh's surface (flags bit 1): shading, two-sidedness, specular, shininess, opacity, then
-/// optional normals, UVs and texture. A strand or particle set's has none of those three.
-fn read_surface(r: &mut Reader<'_>, mesh: Mesh, n: usize) -> Result<Mesh, String> {
-    let shading = match r.u32("the shading")? {
-        0 => Shading::Unlit,
-        1 => Shading::Flat,
-        2 => Shading::Smooth,
-        3 => Shading::Hair,
-        k => return Err(format!("unknown shading {k} (0: unlit, 1: flat, 2: smooth, 3: hair)")),
-    };
-    // The sidedness word: bit 0 two-sided lighting, bit 1 back faces culled.
-    let sides = r.u32("two-sidedness")?;
-    let (two_sided, cull_back_faces) = (sides & 1 != 0, sides & 2 != 0);
-    let [specular, shininess, opacity] = r.f32s("the material")?;
-    let count = |r: &mut Reader<'_>, what: &str| -> Result<usize, String> {
-        match r.u32(what)? as usize {
-            0 => Ok(0),
-            c if c == n => Ok(c),
-            c => Err(format!("{c} {what} for {n} vertices")),
-        }
-    };
-    let k = count(r, "normals")?;
-    let normals: Option<Vec<[f32; 3]>> = (k > 0).then(|| r.array(k, "normals")).transpose()?;
-    let k = count(r, "uvs")?;
-    let uvs: Option<Vec<[f32; 2]>> = (k > 0).then(|| r.array(k, "uvs")).transpose()?;
-    let (h, w) = (r.u32("the texture height")?, r.u32("the texture width")?);
-    let texture = if h > 0 && w > 0 {
-        let texels = r.array((h as usize).saturating_mul(w as usize), "texels")?;
-        Some(TextureMap::new(std::sync::Arc::new(Texture::new(w, h, texels).map_err(|e| e.to_string())?)))
-    } else {
-        None
-    };
-    if mesh.primitive != Primitive::Triangles {
-        if normals.is_some() || uvs.is_some() || texture.is_some() {
-            return Err(format!("{} carry no normals, UVs or texture", mesh.primitive.name()));
-        }
-        return mesh.with_primitive_surface(shading, specular, shininess, opacity).map_err(|e| e.to_string());
-    }
-    let material = Material { shading, specular, shininess, opacity, two_sided, cull_back_faces, texture, ..Default::default() };
-    mesh.with_surface(normals, uvs, material).map_err(|e| e.to_string())
+    let lights = file.lights.iter().map(|l| Light::new(l.direction, l.color, l.intensity).map_err(|e| e.to_string()));
+    Ok(SceneData { meshes, camera: file.camera, size: file.size, lights: lights.collect::<Result<_, _>>()?, ambient: file.ambient })
 }
 
 pub fn read(path: &Path) -> Result<SceneData, String> {
@@ -207,87 +43,14 @@ pub fn read(path: &Path) -> Result<SceneData, String> {
 
 /// The file's bytes (the viewer only reads scene files; tests write them with this).
 pub fn encode(scene: &SceneData) -> Vec<u8> {
-    let mut out = Vec::new();
-    let u32s = |out: &mut Vec<u8>, v: &[u32]| v.iter().for_each(|x| out.extend(x.to_le_bytes()));
-    let f64s = |out: &mut Vec<u8>, v: &[f64]| v.iter().for_each(|x| out.extend(x.to_le_bytes()));
-    out.extend(MAGIC);
-    let (w, h) = scene.size.unwrap_or((0, 0));
-    // A particle set's falloff is in its primitive block, not its surface.
-    let surfaced = |m: &Mesh| !m.material.is_plain_surface() || !m.normals.is_empty() || !m.uvs.is_empty();
-    let newest = |m: &Mesh| m.primitive != Primitive::Triangles || m.material.shading == Shading::Hair;
-    let version = if scene.meshes.iter().any(|m| newest(&m.mesh)) {
-        VERSION
-    } else if scene.lights.is_empty() && scene.ambient == [0.0; 3] && !scene.meshes.iter().any(|m| surfaced(&m.mesh)) {
-        1
-    } else {
-        2
-    };
-    u32s(&mut out, &[version, w, h]);
-    match scene.camera {
-        None => u32s(&mut out, &[0]),
-        Some(CameraSpec::Matrix(m)) => {
-            u32s(&mut out, &[1]);
-            f64s(&mut out, m.as_flattened());
-        }
-        Some(CameraSpec::LookAt { eye, target, up, fov_y, near, far }) => {
-            u32s(&mut out, &[2]);
-            f64s(&mut out, &[eye, target, up].concat());
-            f64s(&mut out, &[fov_y, near, far]);
-        }
-    }
-    u32s(&mut out, &[scene.meshes.len() as u32]);
-    for m in &scene.meshes {
-        let surface = surfaced(&m.mesh);
-        let set = m.mesh.primitive != Primitive::Triangles;
-        u32s(&mut out, &[m.mesh.opaque as u32 | if surface { 2 } else { 0 } | if set { 4 } else { 0 }, m.name.len() as u32]);
-        out.extend(m.name.as_bytes());
-        u32s(&mut out, &[m.mesh.positions.len() as u32, m.mesh.indices.len() as u32]);
-        out.extend(bytemuck::cast_slice(&m.mesh.positions));
-        out.extend(bytemuck::cast_slice(&m.mesh.colors));
-        out.extend(bytemuck::cast_slice(&m.mesh.indices));
-        match &m.mesh.primitive {
-            Primitive::Triangles => {}
-            Primitive::Strands { counts, widths } => {
-                u32s(&mut out, &[1, counts.len() as u32]);
-                u32s(&mut out, counts);
-                out.extend(bytemuck::cast_slice(widths));
-            }
-            Primitive::Particles { radii } => {
-                u32s(&mut out, &[2, m.mesh.material.falloff.code()]);
-                out.extend(bytemuck::cast_slice(radii));
-            }
-        }
-        if surface {
-            let mat = &m.mesh.material;
-            u32s(&mut out, &[mat.shading.code(), mat.two_sided as u32 | (mat.cull_back_faces as u32) << 1]);
-            out.extend(bytemuck::cast_slice(&[mat.specular, mat.shininess, mat.opacity]));
-            u32s(&mut out, &[m.mesh.normals.len() as u32]);
-            out.extend(bytemuck::cast_slice(&m.mesh.normals));
-            u32s(&mut out, &[m.mesh.uvs.len() as u32]);
-            out.extend(bytemuck::cast_slice(&m.mesh.uvs));
-            match &mat.texture {
-                Some(t) => {
-                    u32s(&mut out, &[t.image.height, t.image.width]);
-                    out.extend(bytemuck::cast_slice(&t.image.linear_texels()));
-                }
-                None => u32s(&mut out, &[0, 0]),
-            }
-        }
-    }
-    if version >= 2 {
-        u32s(&mut out, &[scene.lights.len() as u32]);
-        for l in &scene.lights {
-            out.extend(bytemuck::cast_slice(&[l.direction, l.color].concat()));
-            out.extend(l.intensity.to_le_bytes());
-        }
-        out.extend(bytemuck::cast_slice(&scene.ambient));
-    }
-    out
+    let meshes = scene.meshes.iter().map(FileMesh::from_mesh).collect();
+    SceneFile { size: scene.size, camera: scene.camera, meshes, lights: scene.lights.clone(), ambient: scene.ambient }.encode()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use oit_core::{Falloff, Material, Mesh, Shading, Texture, TextureMap};
 
     #[test]
     fn strands_and_particles_round_trip_as_version_3() {
