@@ -1,7 +1,7 @@
 //! The CPU float64 reference: a ray through each pixel center between the near and far
 //! planes, every intersection found with a BVH (obvhs), sorted by depth and composited
 //! front to back in f64; the nearest opaque hit ends the ray. Each hit is shaded with the
-//! model of src/shading.rs at its ray barycentrics (perspective-correct). The edge and tie
+//! model of src/shading/model.rs at its ray barycentrics (perspective-correct). The edge and tie
 //! rule is in docs/methods.md ("The reference").
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3A};
@@ -279,8 +279,8 @@ fn trace_frame(
                         let mut hits: Vec<Hit> = Vec::new();
                         let mut edge = false;
                         if let Some(bvh) = bvh {
-                            let at = (center, DVec2::new(x, y), DVec2::new(wf, hf));
-                            trace(bvh, tris, looks, o, d, at, &vp, &mut hits, &mut edge);
+                            let ray = PixelRay { o, d, center, ndc: DVec2::new(x, y), size: DVec2::new(wf, hf) };
+                            trace(bvh, tris, looks, &ray, &vp, &mut hits, &mut edge);
                         }
                         let (rgba, n, tie) = composite(&mut hits, background);
                         img[4 * k..4 * k + 4].copy_from_slice(&rgba);
@@ -317,18 +317,19 @@ fn report_progress<T>(workers: &[std::thread::ScopedJoinHandle<'_, T>], rows_don
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn trace(
-    bvh: &Bvh2,
-    tris: &[Tri],
-    looks: &Looks<'_>,
+/// The ray through one pixel center: from its near-plane point `o` along `d` to the far plane;
+/// the center in pixels, in NDC, and the frame's size in pixels (for the UV footprint).
+struct PixelRay {
     o: DVec3,
     d: DVec3,
-    (center, ndc, size): (DVec2, DVec2, DVec2),
-    vp: &DMat4,
-    hits: &mut Vec<Hit>,
-    edge: &mut bool,
-) {
+    center: DVec2,
+    ndc: DVec2,
+    size: DVec2,
+}
+
+/// Every hit of `ray` into `hits`; `edge` set where the pixel is ambiguous.
+fn trace(bvh: &Bvh2, tris: &[Tri], looks: &Looks<'_>, ray: &PixelRay, vp: &DMat4, hits: &mut Vec<Hit>, edge: &mut bool) {
+    let PixelRay { o, d, center, ndc, size } = *ray;
     let to_eye = -d.normalize();
     let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()), -1e-3, 1.0 + 1e-3);
     bvh.ray_traverse_anyhit(ray, |_, id| {
