@@ -289,12 +289,12 @@ fn decimals_parse_as_the_standard_parser_does() {
             s.insert(0, '-');
         }
         let want = s.parse::<f64>().ok();
-        if let Some(got) = crate::load::obj::decimal(s.as_bytes()) {
+        if let Some(got) = crate::load::text::decimal(s.as_bytes()) {
             assert_eq!(Some(got), want, "{s}");
         }
     }
-    assert_eq!(crate::load::obj::decimal(b"12345678901234567890123"), None);
-    assert_eq!(crate::load::obj::decimal(b"1e"), None);
+    assert_eq!(crate::load::text::decimal(b"12345678901234567890123"), None);
+    assert_eq!(crate::load::text::decimal(b"1e"), None);
 }
 
 /// A small deterministic generator (xorshift64*).

@@ -5,9 +5,12 @@
 //! and the viewer add on top.
 
 mod gltf;
+mod keys;
+mod mtl;
 mod obj;
 mod ply;
 mod stl;
+mod text;
 
 use std::path::Path;
 
