@@ -1,11 +1,18 @@
 //! Chunk contents on the host while they are gathered: a mesh's vertices and indices, a strand
-//! or particle set's points, and flat-shaded meshes split into corners.
+//! or particle set's points, and flat-shaded meshes split into corners; the segments that say
+//! where a mesh's triangles went.
 
 use crate::error::{OitError, Result};
 use crate::primitive::{self, Primitive, PRIM_MESH, PRIM_PARTICLES, PRIM_STRANDS};
 use crate::scene::Mesh;
 
-use super::geometry::Segment;
+/// A mesh's triangles within one chunk: local triangles `lo .. hi`.
+#[derive(Clone, Copy, Debug)]
+pub struct Segment {
+    pub chunk: usize,
+    pub lo: u32,
+    pub hi: u32,
+}
 
 /// Chunk contents on the host while they are gathered. A chunk of strands or particles
 /// (`kind`) holds one set's points (x, y, z and half the width or the radius), their colors,

@@ -11,8 +11,8 @@ use crate::scene::{Instance, Mesh};
 use crate::shading::Shading;
 use crate::targets::storage_buffer;
 
-use super::gather::{flat_corners, upload_set, Gather};
-use super::SceneBindings;
+use super::atlas::Atlas;
+use super::gather::{flat_corners, upload_set, Gather, Segment};
 
 /// One instance of a mesh, in the drawn order: its centroid in world space, its mesh (within
 /// this geometry) and its row of the instance table.
@@ -21,14 +21,6 @@ pub struct Placement {
     pub centroid: Vec3,
     pub mesh: usize,
     pub instance: u32,
-}
-
-/// A mesh's triangles within one chunk: local triangles `lo .. hi`.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Segment {
-    pub chunk: usize,
-    pub lo: u32,
-    pub hi: u32,
 }
 
 /// A run of triangles uploaded as one set of buffers that each fit a binding.
@@ -123,6 +115,21 @@ impl Geometry {
     }
 }
 
+/// What every chunk's group 0 binds besides its own buffers: the layouts, the frame uniform,
+/// the surfaces table and the atlas, and how the scene compiles (shaded, instanced).
+pub(super) struct SceneBindings<'a> {
+    pub layout: &'a wgpu::BindGroupLayout,
+    /// Group 0 of the expansion pass (`Layout::Expand`).
+    pub expand_layout: &'a wgpu::BindGroupLayout,
+    pub uniform: &'a wgpu::Buffer,
+    pub surfaces: &'a wgpu::Buffer,
+    pub atlas: &'a Atlas,
+    pub shaded: bool,
+    pub instanced: bool,
+}
+
+/// Uploads `meshes` (the scene's mesh number, the mesh, its instances) in chunks whose buffers
+/// each fit `max_binding_bytes`, each chunk's group 0 binding `bindings`.
 pub(super) fn upload<'a>(
     gpu: &GpuContext,
     label: &str,

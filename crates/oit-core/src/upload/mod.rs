@@ -15,7 +15,7 @@ use crate::scene::Scene;
 use crate::shading::{Shading, Texture, TextureMap};
 use crate::targets::storage_buffer;
 use atlas::Atlas;
-use geometry::Geometry;
+use geometry::{Geometry, SceneBindings};
 
 pub struct GpuScene {
     pub transparent: Geometry,
@@ -47,19 +47,6 @@ pub struct GpuScene {
     /// The matrices (`execute::expansion_view`) the corners in `expanded` were last built
     /// under; None until the first expansion.
     pub expanded_view: std::cell::Cell<Option<[u32; 32]>>,
-}
-
-/// What every chunk's group 0 binds besides its own buffers: the layouts, the frame uniform,
-/// the surfaces table and the atlas, and how the scene compiles (shaded, instanced).
-struct SceneBindings<'a> {
-    layout: &'a wgpu::BindGroupLayout,
-    /// Group 0 of the expansion pass (`Layout::Expand`).
-    expand_layout: &'a wgpu::BindGroupLayout,
-    uniform: &'a wgpu::Buffer,
-    surfaces: &'a wgpu::Buffer,
-    atlas: &'a Atlas,
-    shaded: bool,
-    instanced: bool,
 }
 
 impl GpuScene {
