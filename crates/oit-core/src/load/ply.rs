@@ -50,15 +50,6 @@ impl<R: Read> Input<R> {
         self.text.line_number
     }
 
-    /// A header line without its end (None at the end of the file).
-    fn header_line(&mut self) -> Result<Option<&[u8]>, String> {
-        let line = self.text.line().map_err(io)?;
-        Ok(line.map(|l| match l.strip_suffix(b"\n") {
-            Some(l) => l.strip_suffix(b"\r").unwrap_or(l),
-            None => l,
-        }))
-    }
-
     fn binary(&mut self, s: Scalar, format: Format) -> Result<f64, String> {
         let n = s.size() as usize;
         let bytes = self.text.peek(n).map_err(io)?;
@@ -130,7 +121,7 @@ struct Vertices {
 /// `len` bytes of PLY as one mesh named `name` (points only where it has no faces).
 fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
     let mut input = Input::new(r, len);
-    let (format, elements) = header(&mut input)?;
+    let (format, elements) = header(&mut input.text)?;
     let at = |input: &Input<_>, what: &str, i: u64, e: String| match format {
         Format::Ascii => format!("line {}: {what} {i}: {e}", input.line()),
         _ => format!("{what} {i}: {e}"),

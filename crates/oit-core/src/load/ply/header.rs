@@ -3,7 +3,7 @@
 
 use std::io::Read;
 
-use super::Input;
+use crate::load::text::Text;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Scalar {
@@ -100,17 +100,17 @@ pub enum Format {
 }
 
 /// The header, read up to its `end_header` line.
-pub fn header<R: Read>(input: &mut Input<R>) -> Result<(Format, Vec<Element>), String> {
+pub fn header<R: Read>(input: &mut Text<R>) -> Result<(Format, Vec<Element>), String> {
     let bad = |line: usize, e: &str| format!("header line {line}: {e}");
-    match input.header_line()? {
+    match header_line(input)? {
         Some(b"ply") => {}
         _ => return Err("not a PLY file: it does not start with 'ply'".into()),
     }
     let mut format = None;
     let mut elements: Vec<Element> = Vec::new();
     loop {
-        let n = input.line();
-        let Some(line) = input.header_line()? else { return Err("the header has no 'end_header'".into()) };
+        let n = input.line_number;
+        let Some(line) = header_line(input)? else { return Err("the header has no 'end_header'".into()) };
         let mut t = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty());
         match t.next() {
             None | Some(b"comment" | b"obj_info") => {}
@@ -153,4 +153,13 @@ pub fn header<R: Read>(input: &mut Input<R>) -> Result<(Format, Vec<Element>), S
         }
     }
     Ok((format.ok_or("the header has no 'format' line")?, elements))
+}
+
+/// A header line without its end: its LF and a CR before it (None at the end of the file).
+fn header_line<R: Read>(input: &mut Text<R>) -> Result<Option<&[u8]>, String> {
+    let line = input.line().map_err(|e| format!("cannot read it ({e})"))?;
+    Ok(line.map(|l| match l.strip_suffix(b"\n") {
+        Some(l) => l.strip_suffix(b"\r").unwrap_or(l),
+        None => l,
+    }))
 }
