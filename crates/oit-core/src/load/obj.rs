@@ -28,7 +28,7 @@ const NONE: u32 = u32::MAX;
 pub fn read(path: &Path, point_radius: Option<f32>) -> Result<LoadedFile, LoadError> {
     let file = std::fs::File::open(path).map_err(|e| LoadError::Invalid(format!("cannot read it ({e})")))?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let mut obj = Obj::default();
+    let mut obj = ObjFile::default();
     let mut lines = Lines::new(file);
     while let Some((number, line)) = lines.next().map_err(|e| LoadError::Invalid(format!("cannot read it ({e})")))? {
         obj.statement(line, number, dir)?;
@@ -59,7 +59,7 @@ impl Group {
 }
 
 #[derive(Default)]
-struct Obj {
+struct ObjFile {
     positions: Vec<[f32; 3]>,
     /// Vertex colors (sRGB), NaN for vertices written without one; empty while none has one.
     colors: Vec<[f32; 3]>,
@@ -78,7 +78,7 @@ struct Obj {
     dangling: [usize; 2],
 }
 
-impl Obj {
+impl ObjFile {
     fn statement(&mut self, line: &[u8], at: usize, dir: &Path) -> Result<(), LoadError> {
         if words(line).next() == Some(b"mtllib") {
             return self.materials.library(&rest(line), at, dir);

@@ -14,7 +14,7 @@ use std::path::Path;
 use super::keys::KeyMap;
 use super::text::{decimal, whitespace, Text};
 use super::{named, srgb_to_linear, LoadError, NamedMesh, DEFAULT_RGB};
-use header::{header, Element, Format, Kind, Scalar};
+use header::{header, Element, Format, PropertyKind, Scalar};
 
 pub fn load_ply(path: &Path) -> Result<NamedMesh, LoadError> {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh").to_string();
@@ -179,8 +179,9 @@ fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
             }
             vertices = Some(v);
         } else if e.name == "face" {
-            let list_at = props.iter().position(|(n, k)| matches!(k, Kind::List { .. }) && (n == "vertex_indices" || n == "vertex_index"));
-            let list_at = list_at.or_else(|| props.iter().position(|(_, k)| matches!(k, Kind::List { .. })));
+            let list_at =
+                props.iter().position(|(n, k)| matches!(k, PropertyKind::List { .. }) && (n == "vertex_indices" || n == "vertex_index"));
+            let list_at = list_at.or_else(|| props.iter().position(|(_, k)| matches!(k, PropertyKind::List { .. })));
             let Some(list_at) = list_at else { return Err("faces need a 'vertex_indices' list".into()) };
             let color = color(e);
             indices.reserve(e.count as usize);
@@ -239,8 +240,8 @@ fn read_face<R: Read>(
     let mut other = Vec::new();
     for (k, (_, kind)) in e.props.iter().enumerate() {
         match *kind {
-            Kind::Scalar(s) => values[k] = input.value(s, format)?,
-            Kind::List { count, item } => {
+            PropertyKind::Scalar(s) => values[k] = input.value(s, format)?,
+            PropertyKind::List { count, item } => {
                 let n = input.list_len(count, item, format)?;
                 let into = if k == list_at { &mut *list } else { &mut other };
                 into.clear();

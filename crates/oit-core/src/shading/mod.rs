@@ -13,9 +13,9 @@ use glam::{DVec2, DVec3};
 
 use crate::error::{invalid, Result};
 
-pub use model::{shade, uv_footprint, Lighting, Surface};
+pub use model::{shade, uv_footprint, Lighting, SurfacePoint};
 pub use sampler::{Filter, Sampler, Wrap};
-pub use texture::{srgb_table, srgb_to_linear, Level, Real, Texture, TextureMap, UV_IDENTITY};
+pub use texture::{srgb_table, srgb_to_linear, MipLevel, Real, Texture, TextureMap, UV_IDENTITY};
 
 /// The most directional lights a scene holds (the frame uniform's light array).
 pub const MAX_LIGHTS: u32 = 8;

@@ -51,7 +51,7 @@ pub fn uv_footprint(clip: [DVec4; 3], uv: [DVec2; 3], ndc: DVec2, size: DVec2) -
 }
 
 /// One surface point for the model: interpolated color and the attributes it shades with.
-pub struct Surface<'a> {
+pub struct SurfacePoint<'a> {
     pub color: DVec4,
     /// The shading normal before renormalization (interpolated or the face normal).
     pub normal: DVec3,
@@ -67,7 +67,7 @@ pub struct Surface<'a> {
 
 /// The model of docs/shading.md in float64; returns straight RGBA and whether N . V is so close
 /// to 0 that float32 may turn the normal the other way (an ambiguous pixel).
-pub fn shade(s: &Surface<'_>, lighting: &Lighting) -> (DVec4, bool) {
+pub fn shade(s: &SurfacePoint<'_>, lighting: &Lighting) -> (DVec4, bool) {
     let m = s.material;
     let mut base = s.color;
     let maps = [&m.texture, &m.emissive_texture];
@@ -115,7 +115,7 @@ pub fn shade(s: &Surface<'_>, lighting: &Lighting) -> (DVec4, bool) {
 /// Kajiya and Kay's strand model with the tangent T (the surface's `normal`): diffuse
 /// sin(T, L) = sqrt(1 - (T·L)²), and a highlight sin(T, H)^shininess with H the half vector of
 /// L and V (docs/shading.md).
-fn hair(base: DVec4, s: &Surface<'_>, lighting: &Lighting) -> DVec4 {
+fn hair(base: DVec4, s: &SurfacePoint<'_>, lighting: &Lighting) -> DVec4 {
     let m = s.material;
     let t = s.normal.normalize();
     let sine = |c: f64| (1.0 - c * c).max(0.0).sqrt();
@@ -138,7 +138,7 @@ mod tests {
     fn the_model_lights_ambient_specular_and_two_sidedness() {
         let lighting = Lighting { lights: vec![(DVec3::Z, DVec3::splat(0.5))], ambient: DVec3::splat(0.1) };
         let m = Material { shading: Shading::Smooth, specular: 0.25, ..Default::default() };
-        let s = |normal, material| Surface {
+        let s = |normal, material| SurfacePoint {
             color: DVec4::new(0.8, 0.6, 0.4, 0.5),
             normal,
             uv: DVec2::ZERO,

@@ -9,7 +9,7 @@ use crate::error::{invalid, Result};
 
 /// One level of a texture's mip chain: 8-bit RGBA texels, row-major.
 #[derive(Clone, Debug)]
-pub struct Level {
+pub struct MipLevel {
     pub width: u32,
     pub height: u32,
     pub texels: Vec<[u8; 4]>,
@@ -24,7 +24,7 @@ pub struct Texture {
     pub width: u32,
     pub height: u32,
     pub srgb: bool,
-    levels: Vec<Level>,
+    levels: Vec<MipLevel>,
 }
 
 /// f32 or f64: the sRGB transfer function is written once and computed in either, each in its
@@ -103,7 +103,7 @@ impl Texture {
             return Err(invalid!("texture has {} bytes for {width} x {height} RGBA texels", rgba.len()));
         }
         let texels = bytemuck::cast_slice::<u8, [u8; 4]>(&rgba).to_vec();
-        let mut levels = vec![Level { width, height, texels }];
+        let mut levels = vec![MipLevel { width, height, texels }];
         let decode: [f64; 256] = std::array::from_fn(|c| if srgb { srgb_decode(c as u8) } else { c as f64 / 255.0 });
         while let Some(last) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
             let (w, h) = ((last.width / 2).max(1), (last.height / 2).max(1));
@@ -125,7 +125,7 @@ impl Texture {
                     texels.push([encode(mean[0]), encode(mean[1]), encode(mean[2]), (mean[3] * 255.0).round() as u8]);
                 }
             }
-            levels.push(Level { width: w, height: h, texels });
+            levels.push(MipLevel { width: w, height: h, texels });
         }
         Ok(Self { width, height, srgb, levels })
     }
@@ -153,7 +153,7 @@ impl Texture {
     }
 
     /// The mip chain, level 0 first.
-    pub fn levels(&self) -> &[Level] {
+    pub fn levels(&self) -> &[MipLevel] {
         &self.levels
     }
 

@@ -56,7 +56,7 @@ impl Scalar {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Kind {
+pub enum PropertyKind {
     Scalar(Scalar),
     List { count: Scalar, item: Scalar },
 }
@@ -64,18 +64,18 @@ pub enum Kind {
 pub struct Element {
     pub name: String,
     pub count: u64,
-    pub props: Vec<(String, Kind)>,
+    pub props: Vec<(String, PropertyKind)>,
 }
 
 impl Element {
     pub fn find(&self, names: &[&str]) -> Option<usize> {
-        names.iter().find_map(|n| self.props.iter().position(|(p, k)| p == n && matches!(k, Kind::Scalar(_))))
+        names.iter().find_map(|n| self.props.iter().position(|(p, k)| p == n && matches!(k, PropertyKind::Scalar(_))))
     }
 
     pub fn scalar(&self, i: usize) -> Scalar {
         match self.props[i].1 {
-            Kind::Scalar(s) => s,
-            Kind::List { item, .. } => item,
+            PropertyKind::Scalar(s) => s,
+            PropertyKind::List { item, .. } => item,
         }
     }
 
@@ -85,8 +85,8 @@ impl Element {
             .iter()
             .map(|(_, k)| match (format, k) {
                 (Format::Ascii, _) => 1,
-                (_, Kind::Scalar(s)) => s.size(),
-                (_, Kind::List { count, .. }) => count.size(),
+                (_, PropertyKind::Scalar(s)) => s.size(),
+                (_, PropertyKind::List { count, .. }) => count.size(),
             })
             .sum()
     }
@@ -135,12 +135,12 @@ pub fn header<R: Read>(input: &mut Text<R>) -> Result<(Format, Vec<Element>), St
                     let count = t.next().and_then(Scalar::from_name);
                     let item = t.next().and_then(Scalar::from_name);
                     match (count, item) {
-                        (Some(count), Some(item)) if !matches!(count, Scalar::F32 | Scalar::F64) => Kind::List { count, item },
+                        (Some(count), Some(item)) if !matches!(count, Scalar::F32 | Scalar::F64) => PropertyKind::List { count, item },
                         _ => return Err(bad(n, "a list property needs an integer count type and an item type")),
                     }
                 } else {
                     let name = String::from_utf8_lossy(ty).chars().take(20).collect::<String>();
-                    Kind::Scalar(Scalar::from_name(ty).ok_or_else(|| bad(n, &format!("unknown property type '{name}'")))?)
+                    PropertyKind::Scalar(Scalar::from_name(ty).ok_or_else(|| bad(n, &format!("unknown property type '{name}'")))?)
                 };
                 let name = t.next().ok_or_else(|| bad(n, "a property needs a name"))?;
                 e.props.push((String::from_utf8_lossy(name).into_owned(), kind));

@@ -36,9 +36,9 @@ fn fuzz_seed() -> Doc {
 }
 
 /// A fixed-seed xorshift generator.
-struct Rng(u64);
+struct XorShift(u64);
 
-impl Rng {
+impl XorShift {
     fn next(&mut self) -> u64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
@@ -52,7 +52,7 @@ impl Rng {
 }
 
 /// A random place in the JSON tree: an object and one of its keys, or an array and an index.
-fn mutate_json(v: &mut Value, rng: &mut Rng) {
+fn mutate_json(v: &mut Value, rng: &mut XorShift) {
     let odd = [
         json!(null),
         json!(-1),
@@ -108,7 +108,7 @@ fn gltf_text(json: &Value, bin: &[u8]) -> Vec<u8> {
 }
 
 /// One broken version of `seed`, as GLB or as .gltf text, and how it was broken.
-fn fuzz_case(seed: &Doc, rng: &mut Rng) -> (Vec<u8>, &'static str) {
+fn fuzz_case(seed: &Doc, rng: &mut XorShift) -> (Vec<u8>, &'static str) {
     let pack = if rng.below(2) == 0 { glb } else { gltf_text };
     let base = pack(&seed.json, &seed.bin);
     match rng.below(6) {
@@ -149,7 +149,7 @@ fn fuzzed_files_never_panic() {
     let seed = fuzz_seed();
     from_bytes(&seed.glb(), &dir(), None).expect("the seed loads");
     from_bytes(&gltf_text(&seed.json, &seed.bin), &dir(), None).expect("the seed loads as .gltf");
-    let mut rng = Rng(0x5eed_0172);
+    let mut rng = XorShift(0x5eed_0172);
     let start = Instant::now();
     let (mut cases, mut loaded) = (0, 0);
     let mut slowest = Duration::ZERO;
