@@ -4,11 +4,13 @@
 pub mod antialias;
 pub mod bindings;
 pub mod cache;
+mod camera;
 pub mod consts;
 pub mod context;
 pub mod error;
 pub mod gpu_types;
 pub mod load;
+mod mesh;
 pub mod method;
 mod passes;
 mod pipeline;

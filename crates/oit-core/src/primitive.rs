@@ -9,51 +9,18 @@
 
 use glam::{DMat4, DVec2, DVec3, DVec4};
 
+use crate::camera::Camera;
 use crate::error::{invalid, Result};
-use crate::scene::{Camera, Instance, Mesh};
+use crate::mesh::{Instance, Mesh};
 use crate::shading::{Falloff, Material, Shading};
 
-/// What a chunk of uploaded geometry holds (the chunk uniform's `kind`).
-pub const PRIM_MESH: u32 = 0;
-pub const PRIM_STRANDS: u32 = 1;
-pub const PRIM_PARTICLES: u32 = 2;
+pub use crate::mesh::{Primitive, PRIM_MESH, PRIM_PARTICLES, PRIM_STRANDS};
+
 /// A strand segment's word: its first point within the chunk, and whether it is its strand's
 /// first segment (no point before it) or last (no point after it).
 pub const POINT_MASK: u32 = 0x3fff_ffff;
 pub const FIRST_SEGMENT: u32 = 0x4000_0000;
 pub const LAST_SEGMENT: u32 = 0x8000_0000;
-
-/// How a mesh's triangles come about.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub enum Primitive {
-    /// Its own positions and indices.
-    #[default]
-    Triangles,
-    /// Polylines of `counts[i]` points each (the mesh's positions, in order), `widths` per point
-    /// in world units: a ribbon two triangles a segment.
-    Strands { counts: Vec<u32>, widths: Vec<f32> },
-    /// A disc per position of radius `radii` (per point, world units): a quad, two triangles.
-    Particles { radii: Vec<f32> },
-}
-
-impl Primitive {
-    /// The chunk kind the shaders read.
-    pub fn kind(&self) -> u32 {
-        match self {
-            Self::Triangles => PRIM_MESH,
-            Self::Strands { .. } => PRIM_STRANDS,
-            Self::Particles { .. } => PRIM_PARTICLES,
-        }
-    }
-
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::Triangles => "triangles",
-            Self::Strands { .. } => "strands",
-            Self::Particles { .. } => "particles",
-        }
-    }
-}
 
 /// `values` with one entry expanded to `n`, checked finite and > 0.
 fn per_point(mut values: Vec<f32>, n: usize, what: &str) -> Result<Vec<f32>> {
@@ -120,15 +87,6 @@ impl Mesh {
         material.validate()?;
         self.material = material;
         Ok(self)
-    }
-
-    /// Segments of a strand set, particles of a particle set, triangles of a mesh.
-    pub fn primitive_count(&self) -> usize {
-        match &self.primitive {
-            Primitive::Triangles => self.indices.len(),
-            Primitive::Strands { counts, .. } => self.positions.len() - counts.len(),
-            Primitive::Particles { .. } => self.positions.len(),
-        }
     }
 }
 

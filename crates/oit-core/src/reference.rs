@@ -1,7 +1,7 @@
 //! The CPU float64 reference: a ray through each pixel center between the near and far
 //! planes, every intersection found with a BVH (obvhs), sorted by depth and composited
 //! front to back in f64; the nearest opaque hit ends the ray. Each hit is shaded with the
-//! model of src/shading.rs at its ray barycentrics (perspective-correct). The edge and tie
+//! model of src/shading/model.rs at its ray barycentrics (perspective-correct). The edge and tie
 //! rule is in docs/methods.md ("The reference").
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3A};
@@ -182,7 +182,7 @@ pub fn reference_antialiased(
         }
     }
     let materials: Vec<&Material> = scene.meshes().iter().map(|m| &m.material).collect();
-    let looks = |camera: &Camera| Looks { materials: &materials, lighting: scene.lighting(camera), shaded: scene.shaded() };
+    let appearance = |camera: &Camera| Appearance { materials: &materials, lighting: scene.lighting(camera), shaded: scene.shaded() };
     // The BVH is f32: pad each box so that rounding cannot drop a triangle the f64 test hits,
     // and by a thousandth of the scene, so that a pixel center just outside a triangle (within
     // the edge margin, where the rasterizer's snapping may cover it) still reaches the edge test.
@@ -200,12 +200,12 @@ pub fn reference_antialiased(
         .collect();
     let bvh = if tris.is_empty() { None } else { Some(build_bvh2(&bounds, BvhBuildParams::fast_build(), &mut Default::default())) };
     if offsets.len() == 1 {
-        return Ok(trace_frame(&mut tris, bvh.as_ref(), camera, &looks(camera), width, height, background));
+        return Ok(trace_frame(&mut tris, bvh.as_ref(), camera, &appearance(camera), width, height, background));
     }
     let mut out: Option<ReferenceImage> = None;
     for offset in &offsets {
         let jittered = camera.jittered(*offset, width, height);
-        let r = trace_frame(&mut tris, bvh.as_ref(), &jittered, &looks(&jittered), width, height, background);
+        let r = trace_frame(&mut tris, bvh.as_ref(), &jittered, &appearance(&jittered), width, height, background);
         match &mut out {
             None => out = Some(r),
             Some(o) => {
@@ -222,7 +222,7 @@ pub fn reference_antialiased(
 }
 
 /// What the hits are shaded with: each mesh's material, the lights under the frame's camera.
-struct Looks<'a> {
+struct Appearance<'a> {
     materials: &'a [&'a Material],
     lighting: Lighting,
     /// Whether any mesh is shaded (else a hit keeps its interpolated color).
@@ -234,7 +234,7 @@ fn trace_frame(
     tris: &mut [Tri],
     bvh: Option<&Bvh2>,
     camera: &Camera,
-    looks: &Looks<'_>,
+    appearance: &Appearance<'_>,
     width: u32,
     height: u32,
     background: [f64; 3],
@@ -279,8 +279,8 @@ fn trace_frame(
                         let mut hits: Vec<Hit> = Vec::new();
                         let mut edge = false;
                         if let Some(bvh) = bvh {
-                            let at = (center, DVec2::new(x, y), DVec2::new(wf, hf));
-                            trace(bvh, tris, looks, o, d, at, &vp, &mut hits, &mut edge);
+                            let ray = PixelRay { o, d, center, ndc: DVec2::new(x, y), size: DVec2::new(wf, hf) };
+                            trace(bvh, tris, appearance, &ray, &vp, &mut hits, &mut edge);
                         }
                         let (rgba, n, tie) = composite(&mut hits, background);
                         img[4 * k..4 * k + 4].copy_from_slice(&rgba);
@@ -317,18 +317,19 @@ fn report_progress<T>(workers: &[std::thread::ScopedJoinHandle<'_, T>], rows_don
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn trace(
-    bvh: &Bvh2,
-    tris: &[Tri],
-    looks: &Looks<'_>,
+/// The ray through one pixel center: from its near-plane point `o` along `d` to the far plane;
+/// the center in pixels, in NDC, and the frame's size in pixels (for the UV footprint).
+struct PixelRay {
     o: DVec3,
     d: DVec3,
-    (center, ndc, size): (DVec2, DVec2, DVec2),
-    vp: &DMat4,
-    hits: &mut Vec<Hit>,
-    edge: &mut bool,
-) {
+    center: DVec2,
+    ndc: DVec2,
+    size: DVec2,
+}
+
+/// Every hit of `ray` into `hits`; `edge` set where the pixel is ambiguous.
+fn trace(bvh: &Bvh2, tris: &[Tri], appearance: &Appearance<'_>, ray: &PixelRay, vp: &DMat4, hits: &mut Vec<Hit>, edge: &mut bool) {
+    let PixelRay { o, d, center, ndc, size } = *ray;
     let to_eye = -d.normalize();
     let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()), -1e-3, 1.0 + 1e-3);
     bvh.ray_traverse_anyhit(ray, |_, id| {
@@ -359,14 +360,14 @@ fn trace(
             let c = *vp * p.extend(1.0);
             let w = 1.0 - u - v;
             let mut color = t.c[0] * w + t.c[1] * u + t.c[2] * v;
-            if looks.shaded {
-                let material = looks.materials[t.mesh];
+            if appearance.shaded {
+                let material = appearance.materials[t.mesh];
                 let (duv_dx, duv_dy) = if material.texture.is_some() || material.emissive_texture.is_some() {
                     shading::uv_footprint(t.v.map(|p| *vp * p.extend(1.0)), t.uv, ndc, size)
                 } else {
                     (DVec2::ZERO, DVec2::ZERO)
                 };
-                let surface = shading::Surface {
+                let surface = shading::SurfacePoint {
                     color,
                     normal: t.n[0] * w + t.n[1] * u + t.n[2] * v,
                     uv: t.uv[0] * w + t.uv[1] * u + t.uv[2] * v,
@@ -375,7 +376,7 @@ fn trace(
                     to_eye,
                     material,
                 };
-                let (shaded, grazing) = shading::shade(&surface, &looks.lighting);
+                let (shaded, grazing) = shading::shade(&surface, &appearance.lighting);
                 color = shaded;
                 *edge |= grazing;
             }

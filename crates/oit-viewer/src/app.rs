@@ -1,19 +1,21 @@
 //! The application state and its frame loop: settings, meshes, camera, and when to render.
 //! The engine renders only when something it depends on changed; the picture on screen is
-//! recomposed (CPU) when only the way of showing it changed.
+//! recomposed (CPU) when only the way of showing it changed. The window around it is
+//! window.rs; screenshots are screenshot.rs.
 
-use std::path::PathBuf;
 use std::sync::Arc;
 
-use eframe::egui::{self, Color32, ColorImage, Rect, TextureHandle, TextureId, TextureOptions};
+use eframe::egui::{self, ColorImage, Rect, TextureHandle, TextureId, TextureOptions};
 use oit_core::{AntialiasMode, Camera, Frame, GpuContext, ParamValue, Renderer, Scene};
 
+use crate::gpu;
 use crate::heatmap::{self, ErrorMap};
 use crate::native::Native;
 use crate::orbit::ViewCamera;
 use crate::scenefile::SceneData;
-use crate::state::{Action, Compare, MeshControl, Settings, ViewMode, EXACT};
-use crate::{gpu, panels, screenshot, view};
+use crate::state::{Compare, MeshControl, Settings, ViewMode, EXACT};
+
+pub use crate::screenshot::ScreenshotJob;
 
 /// Everything one engine render depends on.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,22 +41,6 @@ struct ShowKey {
     show_exact: bool,
     split: f32,
     error_scale: f32,
-}
-
-/// `--screenshot`: after `frames` frames, grab the window, save it, and maybe quit.
-#[derive(Clone, Debug)]
-pub struct ScreenshotJob {
-    pub path: PathBuf,
-    pub frames: u32,
-    pub crop_view: bool,
-    pub exit: bool,
-    requested: bool,
-}
-
-impl ScreenshotJob {
-    pub fn new(path: PathBuf, frames: u32, crop_view: bool, exit: bool) -> Self {
-        Self { path, frames, crop_view, exit, requested: false }
-    }
 }
 
 pub struct ViewerApp {
@@ -324,178 +310,5 @@ impl ViewerApp {
             }
         }
         self.texture.as_ref().map(TextureHandle::id)
-    }
-
-    /// Saves the window picture of a finished screenshot request.
-    fn take_screenshot(&mut self, ctx: &egui::Context) {
-        let Some(job) = self.screenshot.as_mut() else { return };
-        let events = ctx.input(|i| i.raw.events.clone());
-        for e in events {
-            let egui::Event::Screenshot { image, .. } = e else { continue };
-            if let Some(err) = self.render_error.as_ref().filter(|_| job.exit) {
-                // A picture of the error banner is no screenshot: fail as the command line does.
-                eprintln!("oit-viewer: error: {err}");
-                std::process::exit(1);
-            }
-            let ppp = ctx.pixels_per_point();
-            let img = if job.crop_view { image.region(&self.view_rect, Some(ppp)) } else { (*image).clone() };
-            let result = screenshot::write_png(&job.path, &img);
-            let ok = result.is_ok();
-            let job = self.screenshot.take().expect("checked above");
-            match result {
-                Ok(()) => {
-                    self.status = format!("saved {}", job.path.display());
-                    println!("oit-viewer: wrote {} ({} x {})", job.path.display(), img.width(), img.height());
-                }
-                Err(e) => {
-                    self.status = format!("screenshot failed: {e}");
-                    eprintln!("oit-viewer: {}", self.status);
-                }
-            }
-            if job.exit {
-                if !ok {
-                    std::process::exit(1);
-                }
-                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-            }
-            return;
-        }
-        if job.frames > 0 {
-            job.frames -= 1;
-        } else if !job.requested {
-            job.requested = true;
-            ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(Default::default()));
-        }
-        ctx.request_repaint();
-    }
-
-    /// A screenshot of the window into the working directory, named by the time.
-    pub fn request_screenshot(&mut self) {
-        let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
-        self.screenshot = Some(ScreenshotJob::new(PathBuf::from(format!("oit-viewer-{secs}.png")), 0, false, false));
-    }
-}
-
-impl ViewerApp {
-    /// Carries out what the panel and the view asked for, in order.
-    pub fn apply(&mut self, actions: impl IntoIterator<Item = Action>) {
-        for action in actions {
-            let s = &mut self.settings;
-            match action {
-                Action::SetMethod(m) => s.method = m,
-                Action::SetParam(name, value) => s.set_param(&name, value),
-                Action::SetView(v) => s.view = v,
-                Action::SetCompare(c) => s.compare = c,
-                Action::SetShowExact(b) => s.show_exact = b,
-                Action::FlipExact => {
-                    if s.compare == Compare::Toggle {
-                        s.show_exact = !s.show_exact;
-                    }
-                }
-                Action::SetSplit(x) => s.split = x,
-                Action::SetErrorScale(x) => s.error_scale = x,
-                Action::SetBackground(rgb) => s.background = rgb,
-                Action::SetAntialias(n) => s.antialias = n,
-                Action::SetCoverage(b) => s.coverage = b,
-                Action::SetRenderScale(x) => s.render_scale = x,
-                Action::SetShowOpaque(b) => {
-                    s.show_opaque = b;
-                    self.meshes_changed();
-                }
-                Action::SetLit(b) => {
-                    s.lit = b;
-                    self.meshes_changed();
-                }
-                Action::SetHeadlight(b) => {
-                    s.headlight = b;
-                    self.meshes_changed();
-                }
-                Action::SetAmbient(g) => {
-                    s.ambient = [g.clamp(0.0, 1.0); 3];
-                    self.meshes_changed();
-                }
-                Action::SetMeshVisible(i, b) => {
-                    if let Some(m) = self.meshes.get_mut(i) {
-                        m.visible = b;
-                        self.meshes_changed();
-                    }
-                }
-                Action::SetMeshAlpha(i, a) => {
-                    if let Some(m) = self.meshes.get_mut(i) {
-                        m.alpha = a;
-                        self.meshes_changed();
-                    }
-                }
-                Action::Orbit { dx, dy } => self.camera.moved().rotate(dx, dy),
-                Action::Pan { dx, dy, height } => self.camera.moved().pan(dx, dy, height),
-                Action::Zoom(amount) => self.camera.moved().zoom(amount),
-                Action::ResetView => self.camera.reset(),
-                Action::Screenshot => self.request_screenshot(),
-                Action::TogglePanel => self.show_panel = !self.show_panel,
-            }
-        }
-    }
-
-    /// What the side panel shows.
-    fn panel_data(&self) -> panels::PanelData<'_> {
-        panels::PanelData {
-            title: &self.title,
-            adapter: self.gpu.as_ref().ok().map(|g| g.info.name.as_str()),
-            settings: &self.settings,
-            meshes: &self.meshes,
-            lights: self.lights.len(),
-            camera_at_home: self.camera.is_home(),
-            status: &self.status,
-            frame: self.frame.as_ref(),
-            triangles: self.triangle_count(),
-            error: self.error.as_ref(),
-        }
-    }
-
-    /// The central view: camera input, rendering at the view's pixel size, the picture.
-    fn central(&mut self, ui: &mut egui::Ui) {
-        let max = self.gpu.as_ref().map_or(8192, |g| g.limits.max_texture_dimension_2d);
-        let (response, layout) = view::layout(ui, self.settings.render_scale, max);
-        let actions = view::camera_input(ui, &response);
-        self.apply(actions);
-        if layout.has_area() && self.update_frames(layout.size) {
-            ui.ctx().request_repaint(); // the side panel shows the new stats next frame
-        }
-        self.view_rect = layout.image;
-        let texture = self.texture(ui.ctx());
-        let overlay = view::Overlay {
-            settings: &self.settings,
-            frame: self.frame.as_ref(),
-            exact_available: self.exact_frame().is_some(),
-            render_error: self.render_error.as_deref(),
-        };
-        view::paint(ui, &layout, texture, &overlay);
-    }
-
-    /// One frame of the whole window.
-    pub fn show(&mut self, ui: &mut egui::Ui) {
-        let ctx = ui.ctx().clone();
-        self.take_screenshot(&ctx);
-        if self.show_panel {
-            egui::Panel::left("settings").default_size(290.0).resizable(true).show(ui, |ui| {
-                let actions = egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(ui, &self.panel_data())).inner;
-                self.apply(actions);
-            });
-        }
-        egui::CentralPanel::no_frame().show(ui, |ui| self.central(ui));
-        if !ctx.egui_wants_keyboard_input() {
-            self.apply(view::shortcuts(&ctx));
-        }
-    }
-}
-
-impl eframe::App for ViewerApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        self.show(ui);
-    }
-
-    fn clear_color(&self, _visuals: &egui::Visuals) -> [f32; 4] {
-        let c = Color32::from_gray(40);
-        egui::Rgba::from(c).to_array()
     }
 }

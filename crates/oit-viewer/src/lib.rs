@@ -13,6 +13,7 @@ pub mod scenefile;
 pub mod screenshot;
 pub mod state;
 pub mod view;
+mod window;
 
 pub use app::ViewerApp;
 pub use args::Options;

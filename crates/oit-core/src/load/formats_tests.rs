@@ -275,7 +275,7 @@ fn ply_huge_counts_are_refused_before_allocating() {
 
 #[test]
 fn decimals_parse_as_the_standard_parser_does() {
-    let mut rng = Rng(7);
+    let mut rng = XorShiftStar(7);
     for _ in 0..100_000 {
         let digits = 1 + rng.below(12);
         let mut s: String = (0..digits).map(|_| (b'0' + rng.below(10) as u8) as char).collect();
@@ -289,18 +289,18 @@ fn decimals_parse_as_the_standard_parser_does() {
             s.insert(0, '-');
         }
         let want = s.parse::<f64>().ok();
-        if let Some(got) = crate::load::obj::decimal(s.as_bytes()) {
+        if let Some(got) = crate::load::text::decimal(s.as_bytes()) {
             assert_eq!(Some(got), want, "{s}");
         }
     }
-    assert_eq!(crate::load::obj::decimal(b"12345678901234567890123"), None);
-    assert_eq!(crate::load::obj::decimal(b"1e"), None);
+    assert_eq!(crate::load::text::decimal(b"12345678901234567890123"), None);
+    assert_eq!(crate::load::text::decimal(b"1e"), None);
 }
 
 /// A small deterministic generator (xorshift64*).
-struct Rng(u64);
+struct XorShiftStar(u64);
 
-impl Rng {
+impl XorShiftStar {
     fn next(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
@@ -313,7 +313,7 @@ impl Rng {
     }
 }
 
-fn mutate(rng: &mut Rng, data: &[u8]) -> Vec<u8> {
+fn mutate(rng: &mut XorShiftStar, data: &[u8]) -> Vec<u8> {
     let mut d = data.to_vec();
     const HUGE: [&[u8]; 8] = [b"4294967295", b"4294967296", b"-1", b"99999999999999999999", b"2147483648", b"nan", b"1e39", b"0"];
     for _ in 0..1 + rng.below(3) {
@@ -390,7 +390,7 @@ fn fuzzed_files_never_panic_or_hang() {
     for (name, data) in &bases {
         std::fs::write(d.join(name), data).unwrap();
     }
-    let mut rng = Rng(0x0123_4567_89ab_cdef);
+    let mut rng = XorShiftStar(0x0123_4567_89ab_cdef);
     let start = Instant::now();
     let mut runs = 0;
     while start.elapsed() < Duration::from_secs(4) {

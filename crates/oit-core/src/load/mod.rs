@@ -5,9 +5,12 @@
 //! and the viewer add on top.
 
 mod gltf;
+mod keys;
+mod mtl;
 mod obj;
 mod ply;
 mod stl;
+mod text;
 
 use std::path::Path;
 
@@ -15,6 +18,7 @@ use glam::DVec3;
 
 use crate::error::{invalid, OitError, Result};
 use crate::scene::{Instance, Mesh, Scene};
+pub(crate) use crate::shading::srgb_to_linear;
 use crate::shading::{Material, Shading, Texture, TextureMap};
 
 /// The alpha every mesh gets when nothing in a file is transparent (the command line and the
@@ -229,14 +233,6 @@ impl LoadedFile {
         }
         scene.set_ambient(AMBIENT).expect("a valid ambient term");
         scene
-    }
-}
-
-pub(crate) fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
     }
 }
 

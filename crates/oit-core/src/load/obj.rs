@@ -7,13 +7,12 @@
 //! names is `NotFound` naming it and the MTL line.
 
 use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
-use super::{
-    decode_image, fit_texture, named, srgb_to_linear, texture_map, LoadError, LoadedFile, NamedMesh, DEFAULT_RGB, MAX_TEXTURE_SIZE,
-};
+use super::keys::{key3, KeyMap};
+use super::mtl::{load_texture, Materials, Mtl};
+use super::text::{number, rest, short, words, Lines};
+use super::{named, srgb_to_linear, LoadError, LoadedFile, NamedMesh, DEFAULT_RGB, MAX_TEXTURE_SIZE};
 use crate::scene::Mesh;
 use crate::shading::{Falloff, Material, TextureMap};
 
@@ -29,208 +28,13 @@ const NONE: u32 = u32::MAX;
 pub fn read(path: &Path, point_radius: Option<f32>) -> Result<LoadedFile, LoadError> {
     let file = std::fs::File::open(path).map_err(|e| LoadError::Invalid(format!("cannot read it ({e})")))?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let mut obj = Obj::default();
-    let mut lines = Lines::new(std::io::BufReader::with_capacity(1 << 16, file));
+    let mut obj = ObjFile::default();
+    let mut lines = Lines::new(file);
     while let Some((number, line)) = lines.next().map_err(|e| LoadError::Invalid(format!("cannot read it ({e})")))? {
         obj.statement(line, number, dir)?;
     }
     obj.finish_group();
     obj.build(point_radius)
-}
-
-/// Physical lines joined where one ends in a backslash, each with its first line's number.
-pub(super) struct Lines<R> {
-    reader: R,
-    buf: Vec<u8>,
-    next_number: usize,
-}
-
-impl<R: BufRead> Lines<R> {
-    pub fn new(reader: R) -> Self {
-        Self { reader, buf: Vec::new(), next_number: 1 }
-    }
-
-    pub fn next(&mut self) -> std::io::Result<Option<(usize, &[u8])>> {
-        self.buf.clear();
-        let number = self.next_number;
-        loop {
-            let start = self.buf.len();
-            if self.reader.read_until(b'\n', &mut self.buf)? == 0 {
-                return Ok((!self.buf.is_empty() || start > 0).then_some((number, &self.buf[..])));
-            }
-            self.next_number += 1;
-            while self.buf.last().is_some_and(|b| matches!(b, b'\n' | b'\r')) {
-                self.buf.pop();
-            }
-            if self.buf.last() == Some(&b'\\') {
-                self.buf.pop();
-                self.buf.push(b' ');
-                continue;
-            }
-            return Ok(Some((number, &self.buf[..])));
-        }
-    }
-}
-
-/// The whitespace-separated words of a line.
-pub(super) fn tokens(line: &[u8]) -> Tokens<'_> {
-    Tokens(line)
-}
-
-pub(super) struct Tokens<'a>(&'a [u8]);
-
-impl<'a> Iterator for Tokens<'a> {
-    type Item = &'a [u8];
-
-    fn next(&mut self) -> Option<&'a [u8]> {
-        let s = self.0;
-        let mut i = 0;
-        while i < s.len() && s[i].is_ascii_whitespace() {
-            i += 1;
-        }
-        let start = i;
-        while i < s.len() && !s[i].is_ascii_whitespace() {
-            i += 1;
-        }
-        self.0 = &s[i..];
-        (i > start).then(|| &s[start..i])
-    }
-}
-
-/// A number of a text format, finite.
-pub(super) fn number(token: Option<&[u8]>, what: &str) -> Result<f32, String> {
-    let t = token.ok_or_else(|| format!("{what} is missing"))?;
-    match decimal(t).or_else(|| std::str::from_utf8(t).ok()?.parse::<f64>().ok()).map(|x| x as f32) {
-        Some(x) if x.is_finite() => Ok(x),
-        _ => Err(format!("{what} '{}' is not a finite number", short(&String::from_utf8_lossy(t)))),
-    }
-}
-
-/// The common case of a decimal (`-12.5`, `3e-4`, at most 19 digits) exactly, as the
-/// standard parser would give it; None for anything else (the caller falls back to it).
-pub(super) fn decimal(t: &[u8]) -> Option<f64> {
-    const POW10: [f64; 23] =
-        [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22];
-    let (negative, mut t) = match t.first()? {
-        b'-' => (true, &t[1..]),
-        b'+' => (false, &t[1..]),
-        _ => (false, t),
-    };
-    let (mut mantissa, mut scale) = (0u64, 0i32);
-    let mut any = false;
-    while let [d @ b'0'..=b'9', tail @ ..] = t {
-        mantissa = mantissa.checked_mul(10)?.checked_add((d - b'0') as u64)?;
-        any = true;
-        t = tail;
-    }
-    if let [b'.', tail @ ..] = t {
-        t = tail;
-        while let [d @ b'0'..=b'9', tail @ ..] = t {
-            mantissa = mantissa.checked_mul(10)?.checked_add((d - b'0') as u64)?;
-            scale -= 1;
-            any = true;
-            t = tail;
-        }
-    }
-    if !any {
-        return None;
-    }
-    if let [b'e' | b'E', tail @ ..] = t {
-        let (negative, mut e) = match tail.first()? {
-            b'-' => (true, &tail[1..]),
-            b'+' => (false, &tail[1..]),
-            _ => (false, tail),
-        };
-        let mut exponent = 0i32;
-        let mut any = false;
-        while let [d @ b'0'..=b'9', tail @ ..] = e {
-            exponent = (exponent * 10 + (d - b'0') as i32).min(10_000);
-            any = true;
-            e = tail;
-        }
-        if !any {
-            return None;
-        }
-        scale += if negative { -exponent } else { exponent };
-        t = e;
-    }
-    // Exact: the mantissa and the power of ten are both representable, one rounding.
-    if !t.is_empty() || mantissa > 1 << 53 || scale.unsigned_abs() > 22 {
-        return None;
-    }
-    let x = mantissa as f64;
-    let x = if scale < 0 { x / POW10[(-scale) as usize] } else { x * POW10[scale as usize] };
-    Some(if negative { -x } else { x })
-}
-
-fn short(s: &str) -> String {
-    s.chars().take(40).collect()
-}
-
-/// The text after the keyword, trimmed (names and file names may hold spaces).
-fn rest(line: &[u8]) -> String {
-    let line = trim(line);
-    let start = line.iter().position(|b| b.is_ascii_whitespace()).unwrap_or(line.len());
-    String::from_utf8_lossy(trim(&line[start..])).into_owned()
-}
-
-fn trim(mut s: &[u8]) -> &[u8] {
-    while let [first, tail @ ..] = s {
-        if !first.is_ascii_whitespace() {
-            break;
-        }
-        s = tail;
-    }
-    while let [head @ .., last] = s {
-        if !last.is_ascii_whitespace() {
-            break;
-        }
-        s = head;
-    }
-    s
-}
-
-/// A fast hash for vertex keys: FxHash's step a word, MurmurHash3's finalizer.
-#[derive(Default, Clone, Copy)]
-pub(super) struct KeyHasher(u64);
-
-impl Hasher for KeyHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for c in bytes.chunks(8) {
-            let mut w = [0u8; 8];
-            w[..c.len()].copy_from_slice(c);
-            self.write_u64(u64::from_le_bytes(w));
-        }
-    }
-
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-
-    fn write_u32(&mut self, i: u32) {
-        self.write_u64(i as u64);
-    }
-
-    fn write_usize(&mut self, i: usize) {
-        self.write_u64(i as u64);
-    }
-
-    fn finish(&self) -> u64 {
-        // MurmurHash3's finalizer: every input bit reaches the table's index and tag bits.
-        let mut h = self.0;
-        h ^= h >> 33;
-        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
-        h ^= h >> 33;
-        h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
-        h ^ (h >> 33)
-    }
-}
-
-pub(super) type KeyMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
-
-/// Three words as a key that hashes in two steps.
-pub(super) fn key3(k: [u32; 3]) -> (u64, u32) {
-    ((k[0] as u64) << 32 | k[1] as u64, k[2])
 }
 
 /// A run of statements under one object name and material.
@@ -255,32 +59,7 @@ impl Group {
 }
 
 #[derive(Default)]
-struct Mtl {
-    rgb: Option<[f32; 3]>,
-    dissolve: Option<f32>,
-    tr: Option<f32>,
-    /// (image, the MTL file and line naming it).
-    map_kd: Option<(PathBuf, String)>,
-    map_d: Option<(PathBuf, String)>,
-}
-
-impl Mtl {
-    /// The rule of docs/loading.md: `d` wins; `Tr` alone is 1 - d, except `Tr 1`, which
-    /// MeshLab and several exporters write meaning opaque, and which would otherwise hide
-    /// the mesh.
-    fn alpha(&self) -> f32 {
-        let a = match (self.dissolve, self.tr) {
-            (Some(d), _) => d,
-            (None, Some(t)) if t >= 1.0 => 1.0,
-            (None, Some(t)) => 1.0 - t,
-            (None, None) => 1.0,
-        };
-        a.clamp(0.0, 1.0)
-    }
-}
-
-#[derive(Default)]
-struct Obj {
+struct ObjFile {
     positions: Vec<[f32; 3]>,
     /// Vertex colors (sRGB), NaN for vertices written without one; empty while none has one.
     colors: Vec<[f32; 3]>,
@@ -288,7 +67,7 @@ struct Obj {
     normals: Vec<[f32; 3]>,
     group: Group,
     groups: Vec<Group>,
-    materials: HashMap<String, Mtl>,
+    materials: Materials,
     corners: Vec<[u32; 3]>,
     /// For faces of positions alone: (group, its vertex) of each position.
     slot: Vec<(u32, u32)>,
@@ -297,19 +76,18 @@ struct Obj {
     short_lines: usize,
     /// Texture coordinate and normal indices past what the file defines: left out.
     dangling: [usize; 2],
-    missing_mtl: Vec<String>,
 }
 
-impl Obj {
+impl ObjFile {
     fn statement(&mut self, line: &[u8], at: usize, dir: &Path) -> Result<(), LoadError> {
-        if tokens(line).next() == Some(b"mtllib") {
-            return self.mtllib(&rest(line), at, dir);
+        if words(line).next() == Some(b"mtllib") {
+            return self.materials.library(&rest(line), at, dir);
         }
         self.geometry(line).map_err(|e| LoadError::Invalid(format!("line {at}: {e}")))
     }
 
     fn geometry(&mut self, line: &[u8]) -> Result<(), String> {
-        let mut t = tokens(line);
+        let mut t = words(line);
         let Some(key) = t.next() else { return Ok(()) };
         match key {
             b"v" => {
@@ -450,79 +228,6 @@ impl Obj {
         self.groups.push(done);
     }
 
-    /// `mtllib a.mtl [b.mtl ...]`: the whole text as one name first (names may hold spaces).
-    fn mtllib(&mut self, names: &str, line: usize, dir: &Path) -> Result<(), LoadError> {
-        if names.is_empty() {
-            return Ok(());
-        }
-        let whole = dir.join(names.replace('\\', "/"));
-        let files: Vec<String> =
-            if whole.is_file() { vec![names.to_string()] } else { names.split_whitespace().map(str::to_string).collect() };
-        for name in files {
-            let file = dir.join(name.replace('\\', "/"));
-            if !file.is_file() {
-                // OBJ files are often shared without their .mtl: drawn gray, as other viewers do.
-                self.missing_mtl.push(format!("'{name}' (line {line})"));
-                continue;
-            }
-            let label = file.file_name().map_or(name.clone(), |n| n.to_string_lossy().into_owned());
-            self.read_mtl(&file, &label)?;
-        }
-        Ok(())
-    }
-
-    fn read_mtl(&mut self, file: &Path, label: &str) -> Result<(), LoadError> {
-        let at = |n: usize| move |e: String| LoadError::Invalid(format!("{label}, line {n}: {e}"));
-        let f = std::fs::File::open(file).map_err(|e| LoadError::Invalid(format!("cannot read {label} ({e})")))?;
-        let dir = file.parent().unwrap_or(Path::new("."));
-        let mut lines = Lines::new(std::io::BufReader::new(f));
-        let mut current: Option<String> = None;
-        while let Some((n, line)) = lines.next().map_err(|e| LoadError::Invalid(format!("cannot read {label} ({e})")))? {
-            let mut t = tokens(line);
-            let Some(key) = t.next() else { continue };
-            if key == b"newmtl" {
-                let name = rest(line);
-                self.materials.insert(name.clone(), Mtl::default());
-                current = Some(name);
-                continue;
-            }
-            let Some(m) = current.as_ref().and_then(|c| self.materials.get_mut(c)) else { continue };
-            match key {
-                b"Kd" => {
-                    let r = t.next();
-                    if r == Some(b"spectral") || r == Some(b"xyz") {
-                        continue;
-                    }
-                    let r = number(r, "Kd's red").map_err(at(n))?;
-                    let (g, b) = match (t.next(), t.next()) {
-                        (Some(g), Some(b)) => (number(Some(g), "Kd's green").map_err(at(n))?, number(Some(b), "Kd's blue").map_err(at(n))?),
-                        _ => (r, r),
-                    };
-                    m.rgb = Some([r, g, b]);
-                }
-                b"d" => {
-                    let v = t.find(|x| *x != b"-halo");
-                    m.dissolve = Some(number(v, "d").map_err(at(n))?);
-                }
-                b"Tr" => m.tr = Some(number(t.next(), "Tr").map_err(at(n))?),
-                b"map_Kd" | b"map_d" => {
-                    let name = map_file(t);
-                    if name.is_empty() {
-                        continue;
-                    }
-                    let entry = (dir.join(name.replace('\\', "/")), format!("{label}, line {n}"));
-                    if key == b"map_Kd" {
-                        m.map_kd = Some(entry);
-                    } else {
-                        m.map_d = Some(entry);
-                    }
-                }
-                _ => {}
-            }
-        }
-        Ok(())
-    }
-
     fn build(self, point_radius: Option<f32>) -> Result<LoadedFile, LoadError> {
         let mut out = LoadedFile::default();
         let diagonal = diagonal(&self.positions);
@@ -531,7 +236,7 @@ impl Obj {
         let mut downscaled = 0;
         for (i, g) in self.groups.iter().enumerate() {
             let mtl = g.material.as_ref().and_then(|name| {
-                let m = self.materials.get(name);
+                let m = self.materials.by_name.get(name);
                 if m.is_none() {
                     unknown.insert(name.clone());
                 }
@@ -612,15 +317,15 @@ impl Obj {
                 Mesh::particles(self.positions.clone(), vec![radius], colors, true, Falloff::Hard).map_err(|e| format!("'{name}': {e}"))?;
             out.meshes.push(NamedMesh::new(name, mesh));
         }
-        if !self.missing_mtl.is_empty() {
+        if !self.materials.missing.is_empty() {
             out.warnings.push(format!(
                 "the material librar{} {} named by mtllib {} not there: its meshes are drawn gray",
-                if self.missing_mtl.len() == 1 { "y" } else { "ies" },
-                self.missing_mtl.join(", "),
-                if self.missing_mtl.len() == 1 { "is" } else { "are" }
+                if self.materials.missing.len() == 1 { "y" } else { "ies" },
+                self.materials.missing.join(", "),
+                if self.materials.missing.len() == 1 { "is" } else { "are" }
             ));
         }
-        if !unknown.is_empty() && self.missing_mtl.is_empty() {
+        if !unknown.is_empty() && self.materials.missing.is_empty() {
             let names: Vec<String> = unknown.iter().map(|n| format!("'{n}'")).collect();
             out.warnings.push(format!(
                 "{} material{} named by usemtl {} in no .mtl file ({}): drawn gray",
@@ -664,36 +369,6 @@ fn index(token: &[u8], n: usize, statement: &str, what: &str) -> Result<u32, Str
     Ok(k as u32)
 }
 
-/// The file name of a `map_*` statement after its options (`-s 1 1 1`, `-bm 0.5`, ...).
-fn map_file<'a>(mut t: impl Iterator<Item = &'a [u8]>) -> String {
-    let mut words = Vec::new();
-    while let Some(w) = t.next() {
-        let args = match w {
-            b"-blendu" | b"-blendv" | b"-cc" | b"-clamp" | b"-imfchan" | b"-bm" | b"-boost" | b"-texres" | b"-type" => 1,
-            b"-mm" => 2,
-            b"-o" | b"-s" | b"-t" => 3,
-            _ if words.is_empty() && w.starts_with(b"-") && w.len() > 1 && !w[1].is_ascii_digit() => 0,
-            _ => {
-                words.push(String::from_utf8_lossy(w).into_owned());
-                continue;
-            }
-        };
-        // -o/-s/-t take one to three numbers.
-        let mut left = args;
-        let mut peek = Vec::new();
-        while left > 0 {
-            let Some(x) = t.next() else { break };
-            if args == 3 && left < 3 && std::str::from_utf8(x).ok().and_then(|s| s.parse::<f32>().ok()).is_none() {
-                peek.push(String::from_utf8_lossy(x).into_owned());
-                break;
-            }
-            left -= 1;
-        }
-        words.extend(peek);
-    }
-    words.join(" ")
-}
-
 /// The diagonal of the box around the positions, where it is finite and > 0.
 fn diagonal(positions: &[[f32; 3]]) -> Option<f32> {
     let mut lo = [f64::INFINITY; 3];
@@ -706,35 +381,4 @@ fn diagonal(positions: &[[f32; 3]]) -> Option<f32> {
     }
     let d = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt() as f32;
     (d.is_finite() && d > 0.0).then_some(d)
-}
-
-/// `map_Kd` times `map_d` (whose first channel is the alpha), either optional, and whether it
-/// was downscaled to MAX_TEXTURE_SIZE.
-fn load_texture(
-    diffuse: Option<&(PathBuf, String)>,
-    dissolve: Option<&(PathBuf, String)>,
-) -> Result<(Option<TextureMap>, bool), LoadError> {
-    let read = |(file, at): &(PathBuf, String)| -> Result<image::RgbaImage, LoadError> {
-        if !file.is_file() {
-            return Err(LoadError::NotFound(format!("{at}: the image {} is not there", file.display())));
-        }
-        let unreadable = |e: String| LoadError::Invalid(format!("{at}: the image {} is not readable ({e})", file.display()));
-        let bytes = std::fs::read(file).map_err(|e| unreadable(e.to_string()))?;
-        decode_image(&bytes).map_err(unreadable)
-    };
-    let mask = dissolve.map(read).transpose()?;
-    let mut image = match (diffuse, &mask) {
-        (Some(d), _) => read(d)?,
-        (None, Some(m)) => image::RgbaImage::from_pixel(m.width(), m.height(), image::Rgba([255; 4])),
-        (None, None) => return Ok((None, false)),
-    };
-    if let Some(mask) = mask {
-        let (w, h) = (image.width(), image.height());
-        let mask = image::imageops::resize(&mask, w, h, image::imageops::FilterType::Triangle);
-        image.pixels_mut().zip(mask.pixels()).for_each(|(p, m)| p[3] = m[0]);
-    }
-    let (image, large) = fit_texture(image);
-    let at = diffuse.or(dissolve).map_or(String::new(), |x| x.1.clone());
-    let map = texture_map(image.width(), image.height(), image.into_raw()).map_err(|e| format!("{at}: {e}"))?;
-    Ok((Some(map), large))
 }

@@ -3,13 +3,18 @@
 //! file has before anything is allocated for it. Vertex and face colors with alpha (integer
 //! ones are sRGB, float ones linear; a face's color wins over its vertices', and vertices
 //! shared by faces of different colors are split), vertex normals; polygons fanned into
-//! triangles. A PLY of points only becomes particles in `load_file`.
+//! triangles. A PLY of points only becomes particles in `load_file`. The header is
+//! ply/header.rs.
+
+mod header;
 
 use std::io::Read;
 use std::path::Path;
 
-use super::obj::KeyMap;
+use super::keys::KeyMap;
+use super::text::{decimal, whitespace, Text};
 use super::{named, srgb_to_linear, LoadError, NamedMesh, DEFAULT_RGB};
+use header::{header, Element, Format, PropertyKind, Scalar};
 
 pub fn load_ply(path: &Path) -> Result<NamedMesh, LoadError> {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh").to_string();
@@ -18,176 +23,42 @@ pub fn load_ply(path: &Path) -> Result<NamedMesh, LoadError> {
     parse(file, len, stem)
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    F32,
-    F64,
-}
-
-impl Scalar {
-    fn from_name(name: &[u8]) -> Option<Self> {
-        Some(match name {
-            b"char" | b"int8" => Self::I8,
-            b"uchar" | b"uint8" => Self::U8,
-            b"short" | b"int16" => Self::I16,
-            b"ushort" | b"uint16" => Self::U16,
-            b"int" | b"int32" => Self::I32,
-            b"uint" | b"uint32" => Self::U32,
-            b"float" | b"float32" => Self::F32,
-            b"double" | b"float64" => Self::F64,
-            _ => return None,
-        })
-    }
-
-    fn size(self) -> u64 {
-        match self {
-            Self::I8 | Self::U8 => 1,
-            Self::I16 | Self::U16 => 2,
-            Self::I32 | Self::U32 | Self::F32 => 4,
-            Self::F64 => 8,
-        }
-    }
-
-    /// The largest value of an integer type (colors scale by it); None for floats.
-    fn unit(self) -> Option<f64> {
-        match self {
-            Self::I8 => Some(127.0),
-            Self::U8 => Some(255.0),
-            Self::I16 => Some(32767.0),
-            Self::U16 => Some(65535.0),
-            Self::I32 => Some(i32::MAX as f64),
-            Self::U32 => Some(u32::MAX as f64),
-            Self::F32 | Self::F64 => None,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Kind {
-    Scalar(Scalar),
-    List { count: Scalar, item: Scalar },
-}
-
-struct Element {
-    name: String,
-    count: u64,
-    props: Vec<(String, Kind)>,
-}
-
-impl Element {
-    fn find(&self, names: &[&str]) -> Option<usize> {
-        names.iter().find_map(|n| self.props.iter().position(|(p, k)| p == n && matches!(k, Kind::Scalar(_))))
-    }
-
-    fn scalar(&self, i: usize) -> Scalar {
-        match self.props[i].1 {
-            Kind::Scalar(s) => s,
-            Kind::List { item, .. } => item,
-        }
-    }
-
-    /// The fewest bytes an item takes: binary, its scalars and list counts; ASCII, one a value.
-    fn min_bytes(&self, format: Format) -> u64 {
-        self.props
-            .iter()
-            .map(|(_, k)| match (format, k) {
-                (Format::Ascii, _) => 1,
-                (_, Kind::Scalar(s)) => s.size(),
-                (_, Kind::List { count, .. }) => count.size(),
-            })
-            .sum()
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Format {
-    Ascii,
-    Little,
-    Big,
-}
-
-/// A buffered reader that knows how many bytes are left and which line it is on.
+/// The file's text after the header: its bytes left, values read as the format says.
 struct Input<R> {
-    r: R,
-    buf: Vec<u8>,
-    pos: usize,
-    end: usize,
-    /// Bytes from `pos` to the end of the file.
-    left: u64,
-    line: usize,
-    token: Vec<u8>,
+    text: Text<R>,
+    /// The file's length.
+    len: u64,
 }
 
-const BUF: usize = 1 << 16;
+fn io(e: std::io::Error) -> String {
+    format!("cannot read it ({e})")
+}
+
+const CUT_SHORT: &str = "the file ends inside its data (cut short?)";
 
 impl<R: Read> Input<R> {
     fn new(r: R, len: u64) -> Self {
-        Self { r, buf: vec![0; BUF], pos: 0, end: 0, left: len, line: 1, token: Vec::new() }
+        Self { text: Text::new(r), len }
     }
 
-    /// At least `n` (<= 8) bytes buffered unless the file ends first.
-    fn fill(&mut self, n: usize) -> Result<(), String> {
-        if self.end - self.pos >= n {
-            return Ok(());
-        }
-        self.buf.copy_within(self.pos..self.end, 0);
-        self.end -= self.pos;
-        self.pos = 0;
-        while self.end < n {
-            let k = self.r.read(&mut self.buf[self.end..]).map_err(|e| format!("cannot read it ({e})"))?;
-            if k == 0 {
-                break;
-            }
-            self.end += k;
-        }
-        Ok(())
+    /// Bytes from the current one to the end of the file.
+    fn left(&self) -> u64 {
+        self.len.saturating_sub(self.text.offset())
     }
 
-    fn byte(&mut self) -> Result<Option<u8>, String> {
-        self.fill(1)?;
-        if self.pos == self.end {
-            return Ok(None);
-        }
-        self.pos += 1;
-        self.left = self.left.saturating_sub(1);
-        Ok(Some(self.buf[self.pos - 1]))
-    }
-
-    /// A header line without its end (None at the end of the file).
-    fn header_line(&mut self) -> Result<Option<Vec<u8>>, String> {
-        let mut line = Vec::new();
-        loop {
-            match self.byte()? {
-                None if line.is_empty() => return Ok(None),
-                None => return Ok(Some(line)),
-                Some(b'\n') => {
-                    self.line += 1;
-                    if line.last() == Some(&b'\r') {
-                        line.pop();
-                    }
-                    return Ok(Some(line));
-                }
-                Some(b) => line.push(b),
-            }
-        }
+    fn line(&self) -> usize {
+        self.text.line_number
     }
 
     fn binary(&mut self, s: Scalar, format: Format) -> Result<f64, String> {
         let n = s.size() as usize;
-        self.fill(n)?;
-        if self.end - self.pos < n {
-            return Err("the file ends inside its data (cut short?)".into());
+        let bytes = self.text.peek(n).map_err(io)?;
+        if bytes.len() < n {
+            return Err(CUT_SHORT.into());
         }
         let mut b = [0u8; 8];
-        b[..n].copy_from_slice(&self.buf[self.pos..self.pos + n]);
-        self.pos += n;
-        self.left = self.left.saturating_sub(n as u64);
+        b[..n].copy_from_slice(&bytes[..n]);
+        self.text.consume(n);
         if format == Format::Big {
             b[..n].reverse();
         }
@@ -203,67 +74,20 @@ impl<R: Read> Input<R> {
         })
     }
 
-    /// The next whitespace-separated word of ASCII data.
-    fn word(&mut self) -> Result<&[u8], String> {
-        self.token.clear();
-        loop {
-            self.fill(1)?;
-            if self.pos == self.end {
-                break;
-            }
-            let chunk = &self.buf[self.pos..self.end];
-            let mut used = 0;
-            let mut done = false;
-            for &b in chunk {
-                if b.is_ascii_whitespace() {
-                    if !self.token.is_empty() {
-                        done = true;
-                        break;
-                    }
-                    self.line += (b == b'\n') as usize;
-                } else {
-                    self.token.push(b);
-                }
-                used += 1;
-            }
-            self.pos += used;
-            self.left = self.left.saturating_sub(used as u64);
-            if done {
-                break;
-            }
-        }
-        if self.token.is_empty() {
-            return Err("the file ends inside its data (cut short?)".into());
-        }
-        Ok(&self.token)
-    }
-
     /// After an item of ASCII data, the rest of its line: words past the header's properties
     /// (some writers add a texture number and more) are not read as the next item.
     fn end_item(&mut self, format: Format) -> Result<(), String> {
-        if format != Format::Ascii {
-            return Ok(());
+        if format == Format::Ascii {
+            self.text.line().map_err(io)?;
         }
-        loop {
-            self.fill(1)?;
-            if self.pos == self.end {
-                return Ok(());
-            }
-            let b = self.buf[self.pos];
-            self.pos += 1;
-            self.left = self.left.saturating_sub(1);
-            if b == b'\n' {
-                self.line += 1;
-                return Ok(());
-            }
-        }
+        Ok(())
     }
 
     fn ascii(&mut self, s: Scalar) -> Result<f64, String> {
-        let w = self.word()?;
+        let w = self.text.word(whitespace).map_err(io)?.ok_or(CUT_SHORT)?;
         let text = std::str::from_utf8(w).unwrap_or("");
         let v = match s {
-            Scalar::F32 | Scalar::F64 => crate::load::obj::decimal(w).or_else(|| text.parse::<f64>().ok()),
+            Scalar::F32 | Scalar::F64 => decimal(w).or_else(|| text.parse::<f64>().ok()),
             _ => text.parse::<i64>().ok().map(|i| i as f64).or_else(|| text.parse::<f64>().ok()),
         };
         v.ok_or_else(|| format!("'{}' is not a number", String::from_utf8_lossy(&w[..w.len().min(40)])))
@@ -280,8 +104,8 @@ impl<R: Read> Input<R> {
     fn list_len(&mut self, count: Scalar, item: Scalar, format: Format) -> Result<usize, String> {
         let n = self.value(count, format)?;
         let per = if format == Format::Ascii { 2 } else { item.size() };
-        if !(n >= 0.0 && n.fract() == 0.0) || n * per as f64 > self.left as f64 + 1.0 {
-            return Err(format!("a list of {n} values does not fit in the {} bytes left", self.left));
+        if !(n >= 0.0 && n.fract() == 0.0) || n * per as f64 > self.left() as f64 + 1.0 {
+            return Err(format!("a list of {n} values does not fit in the {} bytes left", self.left()));
         }
         Ok(n as usize)
     }
@@ -297,18 +121,18 @@ struct Vertices {
 /// `len` bytes of PLY as one mesh named `name` (points only where it has no faces).
 fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
     let mut input = Input::new(r, len);
-    let (format, elements) = header(&mut input)?;
+    let (format, elements) = header(&mut input.text)?;
     let at = |input: &Input<_>, what: &str, i: u64, e: String| match format {
-        Format::Ascii => format!("line {}: {what} {i}: {e}", input.line),
+        Format::Ascii => format!("line {}: {what} {i}: {e}", input.line()),
         _ => format!("{what} {i}: {e}"),
     };
     // Every element's items must fit in what is left: a count is never trusted on its own.
     let need: u128 = elements.iter().map(|e| e.count as u128 * e.min_bytes(format) as u128).sum();
-    if need > input.left as u128 {
+    if need > input.left() as u128 {
         let e = elements.iter().max_by_key(|e| e.count as u128 * e.min_bytes(format) as u128).map_or("", |e| e.name.as_str());
         return Err(format!(
             "the header's counts need at least {need} bytes of data, the file has {} (a wrong count in 'element {e}'?)",
-            input.left
+            input.left()
         )
         .into());
     }
@@ -355,8 +179,9 @@ fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
             }
             vertices = Some(v);
         } else if e.name == "face" {
-            let list_at = props.iter().position(|(n, k)| matches!(k, Kind::List { .. }) && (n == "vertex_indices" || n == "vertex_index"));
-            let list_at = list_at.or_else(|| props.iter().position(|(_, k)| matches!(k, Kind::List { .. })));
+            let list_at =
+                props.iter().position(|(n, k)| matches!(k, PropertyKind::List { .. }) && (n == "vertex_indices" || n == "vertex_index"));
+            let list_at = list_at.or_else(|| props.iter().position(|(_, k)| matches!(k, PropertyKind::List { .. })));
             let Some(list_at) = list_at else { return Err("faces need a 'vertex_indices' list".into()) };
             let color = color(e);
             indices.reserve(e.count as usize);
@@ -397,61 +222,6 @@ fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
     Ok(mesh)
 }
 
-fn header<R: Read>(input: &mut Input<R>) -> Result<(Format, Vec<Element>), String> {
-    let bad = |line: usize, e: &str| format!("header line {line}: {e}");
-    match input.header_line()? {
-        Some(l) if l == b"ply" => {}
-        _ => return Err("not a PLY file: it does not start with 'ply'".into()),
-    }
-    let mut format = None;
-    let mut elements: Vec<Element> = Vec::new();
-    loop {
-        let n = input.line;
-        let Some(line) = input.header_line()? else { return Err("the header has no 'end_header'".into()) };
-        let mut t = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty());
-        match t.next() {
-            None | Some(b"comment" | b"obj_info") => {}
-            Some(b"format") => {
-                format = Some(match t.next() {
-                    Some(b"ascii") => Format::Ascii,
-                    Some(b"binary_little_endian") => Format::Little,
-                    Some(b"binary_big_endian") => Format::Big,
-                    _ => return Err(bad(n, "the format is none of ascii, binary_little_endian, binary_big_endian")),
-                })
-            }
-            Some(b"element") => {
-                let name = t.next().ok_or_else(|| bad(n, "an element needs a name and a count"))?;
-                let count = t.next().and_then(|c| std::str::from_utf8(c).ok()?.parse::<u64>().ok());
-                let count = count.ok_or_else(|| bad(n, "an element's count must be a whole number >= 0"))?;
-                elements.push(Element { name: String::from_utf8_lossy(name).into_owned(), count, props: Vec::new() });
-            }
-            Some(b"property") => {
-                let e = elements.last_mut().ok_or_else(|| bad(n, "a property comes before any element"))?;
-                let ty = t.next().ok_or_else(|| bad(n, "a property needs a type and a name"))?;
-                let kind = if ty == b"list" {
-                    let count = t.next().and_then(Scalar::from_name);
-                    let item = t.next().and_then(Scalar::from_name);
-                    match (count, item) {
-                        (Some(count), Some(item)) if !matches!(count, Scalar::F32 | Scalar::F64) => Kind::List { count, item },
-                        _ => return Err(bad(n, "a list property needs an integer count type and an item type")),
-                    }
-                } else {
-                    let name = String::from_utf8_lossy(ty).chars().take(20).collect::<String>();
-                    Kind::Scalar(Scalar::from_name(ty).ok_or_else(|| bad(n, &format!("unknown property type '{name}'")))?)
-                };
-                let name = t.next().ok_or_else(|| bad(n, "a property needs a name"))?;
-                e.props.push((String::from_utf8_lossy(name).into_owned(), kind));
-            }
-            Some(b"end_header") => break,
-            Some(w) => {
-                let w: String = String::from_utf8_lossy(w).chars().take(20).collect();
-                return Err(bad(n, &format!("'{w}' is not a PLY header keyword")));
-            }
-        }
-    }
-    Ok((format.ok_or("the header has no 'format' line")?, elements))
-}
-
 /// One item into `values` (lists read and dropped).
 fn read_item<R: Read>(input: &mut Input<R>, e: &Element, format: Format, values: &mut [f64], list: &mut Vec<f64>) -> Result<(), String> {
     read_face(input, e, format, values, list, usize::MAX)
@@ -470,8 +240,8 @@ fn read_face<R: Read>(
     let mut other = Vec::new();
     for (k, (_, kind)) in e.props.iter().enumerate() {
         match *kind {
-            Kind::Scalar(s) => values[k] = input.value(s, format)?,
-            Kind::List { count, item } => {
+            PropertyKind::Scalar(s) => values[k] = input.value(s, format)?,
+            PropertyKind::List { count, item } => {
                 let n = input.list_len(count, item, format)?;
                 let into = if k == list_at { &mut *list } else { &mut other };
                 into.clear();

@@ -6,8 +6,9 @@
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
-use crate::load::obj::{key3, number, KeyMap};
-use crate::load::{named, LoadError, NamedMesh, DEFAULT_RGB};
+use super::keys::{key3, KeyMap};
+use super::text::{control, number, Text};
+use super::{named, LoadError, NamedMesh, DEFAULT_RGB};
 
 /// The file's solids, one mesh each, in file order (empty solids left out).
 pub fn read(path: &Path) -> Result<Vec<NamedMesh>, LoadError> {
@@ -72,31 +73,31 @@ fn binary(mut r: impl Read, n: u64, stem: &str) -> Result<Vec<NamedMesh>, LoadEr
 
 fn ascii(r: impl Read, stem: &str) -> Result<Vec<NamedMesh>, LoadError> {
     let mut out = Vec::new();
-    let mut words = Words::new(r);
+    let mut words = Text::new(r);
     let mut solid: Option<Solid> = None;
     let mut polygon: Vec<[f32; 3]> = Vec::new();
     let io = |e: std::io::Error| format!("cannot read it ({e})");
-    while let Some(key) = words.next().map_err(io)? {
+    while let Some(key) = words.word(control).map_err(io)? {
         match key {
             b"solid" => {
                 if let Some(s) = solid.take() {
                     out.extend(s.mesh()?);
                 }
-                let name = String::from_utf8_lossy(words.rest_of_line().map_err(io)?.trim_ascii()).into_owned();
+                let name = String::from_utf8_lossy(words.line().map_err(io)?.unwrap_or_default().trim_ascii()).into_owned();
                 solid = Some(Solid::new(if name.is_empty() { stem.to_string() } else { name }, 0));
             }
             b"facet" | b"outer" | b"loop" => polygon.clear(),
             // The facet's normal: oit computes its own.
             b"normal" => {
                 for _ in 0..3 {
-                    words.next().map_err(io)?;
+                    words.word(control).map_err(io)?;
                 }
             }
             b"vertex" => {
                 let mut v = [0f32; 3];
                 for (k, x) in v.iter_mut().enumerate() {
-                    let line = words.line;
-                    *x = number(words.next().map_err(io)?, ["x", "y", "z"][k]).map_err(|e| format!("line {line}: {e}"))?;
+                    let line = words.line_number;
+                    *x = number(words.word(control).map_err(io)?, ["x", "y", "z"][k]).map_err(|e| format!("line {line}: {e}"))?;
                 }
                 polygon.push(v);
             }
@@ -109,14 +110,14 @@ fn ascii(r: impl Read, stem: &str) -> Result<Vec<NamedMesh>, LoadError> {
                 polygon.clear();
             }
             b"endsolid" => {
-                words.rest_of_line().map_err(io)?;
+                words.line().map_err(io)?;
                 if let Some(s) = solid.take() {
                     out.extend(s.mesh()?);
                 }
             }
             other => {
                 let word: String = String::from_utf8_lossy(other).chars().take(20).collect();
-                let line = words.line;
+                let line = words.line_number;
                 return Err(format!(
                     "line {line}: '{word}' is not an ASCII STL keyword (solid, facet normal, outer loop, vertex, endloop, endfacet, endsolid)"
                 )
@@ -128,81 +129,6 @@ fn ascii(r: impl Read, stem: &str) -> Result<Vec<NamedMesh>, LoadError> {
         out.extend(s.mesh()?);
     }
     Ok(out)
-}
-
-/// The words of a text read in large blocks, each a slice of the block, with the line the
-/// last one is on.
-struct Words<R> {
-    r: R,
-    buf: Vec<u8>,
-    pos: usize,
-    end: usize,
-    eof: bool,
-    line: usize,
-}
-
-impl<R: Read> Words<R> {
-    fn new(r: R) -> Self {
-        Self { r, buf: vec![0; 1 << 20], pos: 0, end: 0, eof: false, line: 1 }
-    }
-
-    /// Moves what is left to the front and reads more (growing the block when one word fills it).
-    fn refill(&mut self) -> std::io::Result<()> {
-        self.buf.copy_within(self.pos..self.end, 0);
-        self.end -= self.pos;
-        self.pos = 0;
-        if self.end == self.buf.len() {
-            self.buf.resize(self.buf.len() * 2, 0);
-        }
-        let n = self.r.read(&mut self.buf[self.end..])?;
-        self.end += n;
-        self.eof = n == 0;
-        Ok(())
-    }
-
-    fn next(&mut self) -> std::io::Result<Option<&[u8]>> {
-        loop {
-            // Every control byte separates words (as space, tab, CR and LF do).
-            while self.pos < self.end && self.buf[self.pos] <= b' ' {
-                self.line += (self.buf[self.pos] == b'\n') as usize;
-                self.pos += 1;
-            }
-            if self.pos == self.end {
-                if self.eof {
-                    return Ok(None);
-                }
-                self.refill()?;
-                continue;
-            }
-            let mut i = self.pos;
-            while i < self.end && self.buf[i] > b' ' {
-                i += 1;
-            }
-            if i == self.end && !self.eof {
-                self.refill()?;
-                continue;
-            }
-            let start = self.pos;
-            self.pos = i;
-            return Ok(Some(&self.buf[start..i]));
-        }
-    }
-
-    /// The rest of the current line, its end consumed.
-    fn rest_of_line(&mut self) -> std::io::Result<&[u8]> {
-        loop {
-            let found = self.buf[self.pos..self.end].iter().position(|&b| b == b'\n');
-            if found.is_none() && !self.eof {
-                self.refill()?;
-                continue;
-            }
-            let start = self.pos;
-            let stop = found.map_or(self.end, |k| start + k);
-            self.pos = (stop + 1).min(self.end);
-            self.line += found.is_some() as usize;
-            return Ok(&self.buf[start..stop]);
-        }
-    }
 }
 
 /// A solid's triangles with coinciding vertices shared.

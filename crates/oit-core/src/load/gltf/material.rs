@@ -23,7 +23,7 @@ pub(super) enum Alpha {
 
 /// A glTF material as a primitive draws it.
 #[derive(Clone, Debug)]
-pub(super) struct Look {
+pub(super) struct DrawnMaterial {
     /// baseColorFactor: multiplies COLOR_0.
     pub factor: [f32; 4],
     pub alpha: Alpha,
@@ -40,7 +40,7 @@ pub(super) struct Looks<'a> {
     images: Vec<Obj<'a>>,
     samplers: Vec<Obj<'a>>,
     dir: &'a Path,
-    looks: Vec<Option<Look>>,
+    looks: Vec<Option<DrawnMaterial>>,
     decoded: Vec<Option<Arc<Texture>>>,
     texel_bytes: u64,
 }
@@ -69,9 +69,9 @@ impl<'a> Looks<'a> {
     }
 
     /// Material `index` (None: the specification's default, white, OPAQUE and single-sided).
-    pub fn look(&mut self, index: Option<usize>, store: &Store<'_>, notes: &mut Notes) -> Result<Look, LoadError> {
+    pub fn look(&mut self, index: Option<usize>, store: &Store<'_>, notes: &mut Notes) -> Result<DrawnMaterial, LoadError> {
         let Some(i) = index else {
-            return Ok(Look { factor: [1.0; 4], alpha: Alpha::Opaque, material: sides(false), uv_set: None });
+            return Ok(DrawnMaterial { factor: [1.0; 4], alpha: Alpha::Opaque, material: sides(false), uv_set: None });
         };
         if let Some(look) = &self.looks[i] {
             return Ok(look.clone());
@@ -81,7 +81,7 @@ impl<'a> Looks<'a> {
         Ok(look)
     }
 
-    fn read(&mut self, i: usize, store: &Store<'_>, notes: &mut Notes) -> Result<Look, LoadError> {
+    fn read(&mut self, i: usize, store: &Store<'_>, notes: &mut Notes) -> Result<DrawnMaterial, LoadError> {
         let m = self.materials[i].clone();
         let pbr = m.obj("pbrMetallicRoughness")?;
         let factor = match &pbr {
@@ -133,7 +133,7 @@ impl<'a> Looks<'a> {
         };
         material.texture = base.map(|(t, _)| t);
         material.emissive_texture = glow.map(|(t, _)| t);
-        Ok(Look { factor, alpha, material, uv_set })
+        Ok(DrawnMaterial { factor, alpha, material, uv_set })
     }
 
     /// A textureInfo: the shared image, its sampler and UV transform, and its TEXCOORD set;
