@@ -18,7 +18,7 @@ struct Drawn {
 //!if INSTANCED
 // A mesh's local triangles lo .. lo + triangles in the chunk, drawn once for each of its
 // instances from first_instance on, the chunk's drawn triangles from drawn_first on.
-// Mirrors `GpuSegment` in oit_core's upload.rs.
+// Mirrors `GpuSegment` in oit_core's gpu_types.rs.
 struct Segment {
     drawn_first: u32,
     lo: u32,

@@ -61,7 +61,7 @@ pub fn scene_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     ]
 }
 
-/// The texture atlas (upload.rs `Atlas`): every image of the scene's materials with its mips,
+/// The texture atlas (upload/atlas.rs `Atlas`): every image of the scene's materials with its mips,
 /// read texel by texel (shaders/common/shading.wgsl filters and decodes sRGB).
 fn atlas_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {

@@ -57,7 +57,7 @@ impl ShaderKey {
 /// A bind-group layout by its shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Layout {
-    /// Group 0: the scene's vertex-pulling buffers and the frame uniform (upload.rs).
+    /// Group 0: the scene's vertex-pulling buffers and the frame uniform (upload/).
     Scene,
     /// Group 1: the opaque depth and base color (targets.rs).
     Targets,
@@ -92,7 +92,7 @@ impl Layout {
     }
 
     /// The binding each of the layout's names is at; None for the shared layouts, which are
-    /// bound by their owners (upload.rs, targets.rs, scan.rs).
+    /// bound by their owners (upload/, targets.rs, scan.rs).
     pub fn named(self) -> Option<Vec<(&'static str, u32)>> {
         match self {
             Layout::Storage(names) => Some(names.iter().zip(0..).map(|(&n, b)| (n, b)).collect()),
@@ -342,7 +342,7 @@ pub const BLIT: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit", 
 pub const BLIT_SRGB: PipelineSpec = PipelineSpec::fullscreen("blit.wgsl", "fs_blit_srgb", BLIT_SOURCE);
 pub const SCAN_BLOCKS: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_scan_blocks", &[Layout::Scan]);
 pub const SCAN_ADD: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_add_blocks", &[Layout::Scan]);
-/// Strands and particles facing the eye, before a frame's geometry passes (upload.rs), an
+/// Strands and particles facing the eye, before a frame's geometry passes (upload/geometry.rs), an
 /// entry point a kind.
 pub const EXPAND_STRANDS: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand_strands", &[Layout::Expand]);
 pub const EXPAND_PARTICLES: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand_particles", &[Layout::Expand]);

@@ -35,6 +35,18 @@ use crate::upload::GpuScene;
 pub fn coverage_methods() -> Vec<&'static str> {
     method::methods().iter().filter(|m| m.antialias_modes.contains(&AntialiasMode::Coverage)).map(|m| m.name).collect()
 }
+/// How a frame is antialiased: `samples` a pixel, made the way `mode` says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Antialias {
+    pub samples: u32,
+    pub mode: AntialiasMode,
+}
+
+impl Antialias {
+    /// One sample a pixel.
+    pub const NONE: Self = Self { samples: 1, mode: AntialiasMode::Frames };
+}
+
 /// Samples a pixel of a coverage-mask frame: WebGPU guarantees multisampling at 4 (lavapipe
 /// offers no other count).
 pub const COVERAGE_SAMPLES: u32 = 4;
@@ -218,10 +230,10 @@ impl Renderer {
         params: &[(String, ParamValue)],
         background: [f32; 3],
     ) -> Result<Frame> {
-        self.render_antialiased(scene, camera, method_name, params, background, 1, AntialiasMode::Frames)
+        self.render_antialiased(scene, camera, method_name, params, background, Antialias::NONE)
     }
 
-    /// Renders `antialias` sample frames, each with the camera moved onto one position of the
+    /// Renders `antialias.samples` sample frames, each with the camera moved onto one position of the
     /// standard pattern (`antialias::sample_offsets`), and averages them: every method gets
     /// antialiasing with its own buffers reused from sample to sample (memory as at one
     /// sample, time about `antialias` times). The samples' stats merge by each key's rule
@@ -231,7 +243,6 @@ impl Renderer {
     /// `AntialiasMode::Coverage` instead rasterizes the transparent geometry once,
     /// multisampled, and stores one fragment per pixel with its sample mask (the methods of
     /// `coverage_methods()`, at COVERAGE_SAMPLES samples); docs/methods.md, "Antialiasing".
-    #[allow(clippy::too_many_arguments)]
     pub fn render_antialiased(
         &mut self,
         scene: &Scene,
@@ -239,8 +250,7 @@ impl Renderer {
         method_name: &str,
         params: &[(String, ParamValue)],
         background: [f32; 3],
-        antialias: u32,
-        mode: AntialiasMode,
+        Antialias { samples: antialias, mode }: Antialias,
     ) -> Result<Frame> {
         let start = Instant::now();
         let offsets = antialias::sample_offsets(antialias)?;

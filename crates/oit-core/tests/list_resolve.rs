@@ -7,7 +7,7 @@
 use oit_core::context::DeviceProfile;
 use oit_core::method::default_consts;
 use oit_core::shader::{compose, Const};
-use oit_core::{shared_context, AntialiasMode, Camera, GpuContext, Mesh, Renderer, Scene};
+use oit_core::{shared_context, Antialias, AntialiasMode, Camera, GpuContext, Mesh, Renderer, Scene};
 use std::sync::Arc;
 
 fn identity() -> Camera {
@@ -60,7 +60,16 @@ fn fingerprints_of_the_list_methods() {
             };
             out.push_str(&line);
         }
-        let f = r.render_antialiased(&scene, &identity(), "abuffer", &[], [0.2, 0.3, 0.4], 4, AntialiasMode::Coverage).unwrap();
+        let f = r
+            .render_antialiased(
+                &scene,
+                &identity(),
+                "abuffer",
+                &[],
+                [0.2, 0.3, 0.4],
+                Antialias { samples: 4, mode: AntialiasMode::Coverage },
+            )
+            .unwrap();
         out.push_str(&format!("{label} abuffer-coverage {:016x}\n", fingerprint(&f.image)));
     }
     std::fs::write(path, out).unwrap();
@@ -113,7 +122,16 @@ fn the_plain_resolve_gives_the_budgeted_ones_bits() {
             }
         }
         let coverage = |r: &mut Renderer| {
-            r.render_antialiased(&scene, &identity(), "abuffer", &[], [0.2, 0.3, 0.4], 4, AntialiasMode::Coverage).unwrap().image
+            r.render_antialiased(
+                &scene,
+                &identity(),
+                "abuffer",
+                &[],
+                [0.2, 0.3, 0.4],
+                Antialias { samples: 4, mode: AntialiasMode::Coverage },
+            )
+            .unwrap()
+            .image
         };
         let (ia, ib) = (coverage(&mut a), coverage(&mut b));
         assert!(ia.iter().zip(&ib).all(|(x, y)| x.to_bits() == y.to_bits()), "{label} abuffer coverage: the images differ");

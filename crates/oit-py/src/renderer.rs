@@ -8,7 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use oit_core::OitError;
+use oit_core::{Antialias, OitError};
 
 use crate::convert::{matrix, param_list, value_to_py};
 use crate::error::{Error, Res};
@@ -137,7 +137,7 @@ impl Renderer {
                 let mut r = self.inner.lock().unwrap_or_else(|p| p.into_inner());
                 r.set_shading_cost(shading_cost)?;
                 r.set_census(census);
-                r.render_antialiased(inner_scene, &camera, method, &plist, bg, antialias, mode)
+                r.render_antialiased(inner_scene, &camera, method, &plist, bg, Antialias { samples: antialias, mode })
             })
             .map_err(Error::from)?;
         let (h, w) = (frame.height as usize, frame.width as usize);

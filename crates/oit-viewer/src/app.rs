@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use eframe::egui::{self, ColorImage, Rect, TextureHandle, TextureId, TextureOptions};
-use oit_core::{AntialiasMode, Camera, Frame, GpuContext, ParamValue, Renderer, Scene};
+use oit_core::{Antialias, AntialiasMode, Camera, Frame, GpuContext, ParamValue, Renderer, Scene};
 
 use crate::gpu;
 use crate::heatmap::{self, ErrorMap};
@@ -222,7 +222,14 @@ impl ViewerApp {
         let (scene, native) = (&self.scene, &mut self.native);
         let mut run = |k: &RenderKey| match native.as_mut().filter(|_| k.direct) {
             Some(n) => n.render(renderer, scene, &camera, &k.method, &k.params, k.background),
-            None => renderer.render_antialiased(scene, &camera, &k.method, &k.params, k.background, k.antialias, k.mode),
+            None => renderer.render_antialiased(
+                scene,
+                &camera,
+                &k.method,
+                &k.params,
+                k.background,
+                Antialias { samples: k.antialias, mode: k.mode },
+            ),
         };
         if stale {
             self.key = Some(key.clone());

@@ -1,5 +1,5 @@
 //! The orbit camera: a pivot, a direction and a distance, turned into the same matrices as
-//! `oit.Camera.look_at` (python/oit/_api.py), at the view's aspect ratio.
+//! `oit.Camera.look_at` (python/oit/_camera.py), at the view's aspect ratio.
 
 use glam::{DMat4, DVec3, DVec4};
 
