@@ -45,7 +45,7 @@ def deep(n, regime):
 
 
 def loop_limited(renderer):
-    return "llvmpipe" in renderer.adapter_info["name"]
+    return renderer.adapter_info["loop_limit"] is not None
 
 
 # Methods that peel one layer a geometry pass cost n passes of n fragments: 4,000 layers take

@@ -23,6 +23,7 @@ class _AdapterInfo(TypedDict):
     float32_blendable: bool
     int64_atomic_min_max: bool
     max_storage_binding_bytes: int
+    loop_limit: int | None  # iterations one shader invocation may loop (the device profile's)
     features: list[str]
     methods: list[str]  # the methods this adapter's features allow
 

@@ -104,6 +104,9 @@ impl Renderer {
         d.set_item("float32_blendable", self.context.has(wgpu::Features::FLOAT32_BLENDABLE))?;
         d.set_item("int64_atomic_min_max", self.context.has(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX))?;
         d.set_item("max_storage_binding_bytes", self.context.max_binding_bytes())?;
+        // The device profile's loop limit (iterations one invocation may loop), None where loops
+        // run to their end (oit_core::context::DeviceProfile).
+        d.set_item("loop_limit", self.context.profile.loop_iterations())?;
         d.set_item("features", oit_core::method::feature_names(self.context.features))?;
         let works: Vec<&str> = oit_core::methods().iter().filter(|m| self.context.features.contains(m.features)).map(|m| m.name).collect();
         d.set_item("methods", works)?;
