@@ -109,6 +109,8 @@ pub struct GpuContext {
     pub device: wgpu::Device,
     /// The first validation or out-of-memory error wgpu reported since the last `wait`.
     errors: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+    /// Times the host has waited for this device (`wait`), for tests of how often a frame does.
+    waits: std::sync::atomic::AtomicU64,
     pub queue: wgpu::Queue,
     pub info: wgpu::AdapterInfo,
     pub features: wgpu::Features,
@@ -206,7 +208,7 @@ impl GpuContext {
         }));
         let adapter = DeviceProfile::for_adapter(&info);
         let profile = adapter.with_env().unwrap_or(adapter);
-        Self { device, errors, queue, info, features, limits, profile, cache: Default::default() }
+        Self { device, errors, waits: Default::default(), queue, info, features, limits, profile, cache: Default::default() }
     }
 
     pub fn has(&self, f: wgpu::Features) -> bool {
@@ -221,10 +223,16 @@ impl GpuContext {
     /// Blocks until the queue is idle; a device fault or an error wgpu reported since the
     /// last call becomes an error.
     pub fn wait(&self) -> Result<()> {
+        self.waits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         self.device
             .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
             .map_err(|e| OitError::Device(format!("waiting for the GPU failed: {e}")))?;
         self.take_error()
+    }
+
+    /// Times the host has waited for this device so far.
+    pub fn waits(&self) -> u64 {
+        self.waits.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Returns (and clears) the first error wgpu reported since the last check.

@@ -172,3 +172,30 @@ fn words_are_the_same_in_64_bit_atomics_and_32_bit_pairs() {
         assert_eq!(a.image, b.image, "adaptive, {nodes} nodes: the two node forms differ");
     }
 }
+
+/// The executor reads what a tile leaves (its pixels, its error bound, its pass times and the
+/// method's counters) after one wait: hybrid, ktab and hybrid64, which once waited for their
+/// counter, the pass times, the image and the bound apart, now wait once a frame; abuffer, which
+/// counts its fragments in its capture once a frame has sized its pool, waits for that count
+/// (it plans the resolve) and for the tile.
+#[test]
+fn a_frame_waits_for_the_gpu_once_where_its_method_allows() {
+    let ctx = std::sync::Arc::new(oit_core::GpuContext::new(None).expect("a GPU adapter (lavapipe in CI)"));
+    let mut scene = Scene::new();
+    for (z, c) in [(0.7, [1.0, 0.0, 0.0, 0.5]), (0.2, [0.0, 1.0, 0.0, 0.25]), (0.5, [0.0, 0.0, 1.0, 0.8])] {
+        scene.add_mesh(quad(z, c, false));
+    }
+    let mut r = Renderer::new(ctx.clone(), 8, 6).unwrap();
+    let mut waits = |name: &str| {
+        r.render(&scene, &identity(), name, &[], [1.0; 3]).unwrap(); // pipelines, pools
+        let before = ctx.waits();
+        r.render(&scene, &identity(), name, &[], [1.0; 3]).unwrap();
+        ctx.waits() - before
+    };
+    for name in ["hybrid", "ktab", "hybrid64", "wboit", "bucket_peeling"] {
+        if oit_core::method::lookup(name).is_ok_and(|m| ctx.features.contains(m.features)) {
+            assert_eq!(waits(name), 1, "{name}");
+        }
+    }
+    assert_eq!(waits("abuffer"), 2);
+}
