@@ -149,7 +149,7 @@ def run_cli(a: argparse.Namespace) -> int:
         ap = argparse.ArgumentParser(prog="python -m oit bench", exit_on_error=False)
         add_arguments(ap)
         a.out = "out/report" if a.out == "out/bench" else a.out
-        return run_report(a, ap)
+        return run_report(a, ap, run_cli)
     if a.gpu:
         return run_gpu(a.out, a.small)
     if a.load or a.fuzz_load:

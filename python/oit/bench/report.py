@@ -15,6 +15,7 @@ import os
 import re
 import shlex
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -79,8 +80,9 @@ def tables_without_source(text: str) -> list[int]:
     return missing
 
 
-def run_report(a: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
-    """Run (or with --list only print) every command of the doc; returns 1 if any failed."""
+def run_report(a: argparse.Namespace, parser: argparse.ArgumentParser, run: Callable[[argparse.Namespace], int]) -> int:
+    """Run (or with --list only print) every command of the doc, each parsed by `parser` and run
+    by `run` (the bench's `run_cli`); returns 1 if any failed."""
     doc = Path(a.doc) if a.doc else DOC if DOC.is_file() else Path("docs") / "results.md"
     if not doc.is_file():
         print(f"error: {doc} not found: pass --doc docs/results.md from the repository", file=sys.stderr)
@@ -90,8 +92,6 @@ def run_report(a: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         for c in cmds:
             print(f"{c.text}{' --quick' if a.quick else ''}")
         return 0
-    from .cli import run_cli
-
     failed = []
     for i, c in enumerate(cmds, 1):
         out = os.path.join(a.out, f"{i:02d}")
@@ -100,7 +100,7 @@ def run_report(a: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         try:
             ns = parser.parse_args(c.argv)
             ns.out, ns.quick = out, ns.quick or a.quick
-            rc = run_cli(ns)
+            rc = run(ns)
         except (Exception, SystemExit) as e:  # one command's failure does not stop the others
             print(f"error: {type(e).__name__}: {e}", file=sys.stderr)
             rc = 1

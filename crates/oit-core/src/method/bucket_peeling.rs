@@ -3,7 +3,7 @@
 //! kept, the others dropped and counted (shaders/bucket_peeling.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
+use super::info::{buffer_sizes, never, Buffer, ErrorBound, FRAMES, FrameBytes, Linear, Memory, MethodInfo, Order};
 use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -33,7 +33,12 @@ pub const INFO: MethodInfo = MethodInfo {
 
 /// Bytes bucket_peeling allocates: depth bounds, a 64-bit key and a color per bucket, and the
 /// dropped counter.
-const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(BUCKETS, 8 + 16, 8), fixed: 4 };
+const BUFFERS: &[Buffer] = &[
+    Buffer::per_pixel("bounds", Linear::bytes(8)),
+    Buffer::per_pixel("keys", Linear::per(BUCKETS, 8, 0)),
+    Buffer::per_pixel("bucket_colors", Linear::per(BUCKETS, 16, 0)),
+];
+const BYTES: FrameBytes = FrameBytes::of(BUFFERS, 4);
 
 const SHADER: &str = "bucket_peeling.wgsl";
 /// Group 2: bounds, keys, bucket colors, then the dropped counter.
@@ -57,7 +62,7 @@ impl Method for Buckets {
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("bucket_peeling with {buckets} buckets"), 16 * buckets as u64)?;
         let dropped = self.dropped.get_or_insert_with(|| Counter::new(cx.gpu, "bucket dropped"));
-        let sizes = [("bounds", pixels * 8), ("keys", pixels * buckets as u64 * 8), ("bucket_colors", pixels * buckets as u64 * 16)];
+        let sizes = buffer_sizes(BUFFERS, pixels, cx.params);
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("dropped", dropped)]);
         let consts = [BUCKETS.constant(cx.params)];
         let mut enc = cx.encoder();

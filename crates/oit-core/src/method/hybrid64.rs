@@ -5,7 +5,7 @@
 //! One geometry pass and one full-screen resolve (shaders/hybrid64.wgsl).
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
+use super::info::{buffer_sizes, never, Buffer, ErrorBound, FRAMES, FrameBytes, Linear, Memory, MethodInfo, Order};
 use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -43,7 +43,10 @@ const PIPELINES: &[PipelineSpec] =
 pub const ACCUM_WORDS: u64 = crate::consts::HYBRID_TAIL_WORDS as u64;
 
 /// Bytes hybrid64 allocates: k 64-bit words and the tail's words per pixel, a counter.
-const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(K, 8, 4 * ACCUM_WORDS), fixed: 4 };
+const BUFFERS: &[Buffer] =
+    &[Buffer::per_pixel("ktab", Linear::per(K, 8, 0)), Buffer::per_pixel("tail_words", Linear::bytes(4 * ACCUM_WORDS))];
+/// The buffers and the tail counter.
+const BYTES: FrameBytes = FrameBytes::of(BUFFERS, 4);
 
 struct Hybrid64 {
     buffers: Option<StorageGroup>,
@@ -56,7 +59,7 @@ impl Method for Hybrid64 {
         let pixels = cx.pixels();
         cx.check_per_pixel(&format!("hybrid64 with k = {k}"), (8 * k as u64).max(4 * ACCUM_WORDS))?;
         let tail = self.tail.get_or_insert_with(|| Counter::new(cx.gpu, "hybrid64 tail count"));
-        let sizes = [("ktab", pixels * k as u64 * 8), ("tail_words", pixels * ACCUM_WORDS * 4)];
+        let sizes = buffer_sizes(BUFFERS, pixels, cx.params);
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("overflow", tail)]);
         let consts = [K.constant(cx.params)];
         let insert = cx.capture_pipeline(spec(PIPELINES, "fs_insert"), &consts);

@@ -166,6 +166,62 @@ impl FrameBytes {
     }
 }
 
+impl FrameBytes {
+    /// The bytes of `buffers` together, and `fixed` more (counters, say): what a method
+    /// declares its memory as where it is its buffers (their parameters must agree).
+    pub const fn of(buffers: &[Buffer], fixed: u64) -> Self {
+        let mut out = FrameBytes { per_pixel: Linear::bytes(0), fixed };
+        let mut i = 0;
+        while i < buffers.len() {
+            let b = buffers[i].bytes;
+            let param = match (out.per_pixel.param, b.per_pixel.param) {
+                (Some(a), Some(c)) => {
+                    assert!(same(a, c), "buffers of one method grow with one parameter");
+                    Some(a)
+                }
+                (a, None) => a,
+                (None, c) => c,
+            };
+            out.per_pixel = Linear { base: out.per_pixel.base + b.per_pixel.base, per: out.per_pixel.per + b.per_pixel.per, param };
+            out.fixed += b.fixed;
+            i += 1;
+        }
+        out
+    }
+}
+
+/// Whether two names are the same (for `const` code).
+const fn same(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    let mut i = 0;
+    while i < a.len() && i < b.len() && a[i] == b[i] {
+        i += 1;
+    }
+    i == a.len() && i == b.len()
+}
+
+/// One buffer of a method's own storage group, declared once: its binding's name (as its WGSL
+/// declares it) and its bytes, from which the buffer is made (`buffer_sizes`) and the method's
+/// memory declared (`FrameBytes::of`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Buffer {
+    pub name: &'static str,
+    pub bytes: FrameBytes,
+}
+
+impl Buffer {
+    /// `per_pixel` bytes for each pixel of the tile.
+    pub const fn per_pixel(name: &'static str, per_pixel: Linear) -> Self {
+        Self { name, bytes: FrameBytes { per_pixel, fixed: 0 } }
+    }
+}
+
+/// Each of `buffers` with its bytes for a tile of `pixels` pixels and `params`: what
+/// `StorageGroup::ensure` makes.
+pub fn buffer_sizes(buffers: &[Buffer], pixels: u64, params: &Params) -> Vec<(&'static str, u64)> {
+    buffers.iter().map(|b| (b.name, b.bytes.at(pixels, params))).collect()
+}
+
 /// What a method stores that grows with the scene: bytes a pixel, a stored fragment (a node
 /// of its pool, spread over `lists::POOL_BINDINGS` bindings) and a transparent triangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

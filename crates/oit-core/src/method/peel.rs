@@ -4,7 +4,7 @@
 //! (shaders/peel.wgsl, docs/methods.md).
 
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
+use super::info::{buffer_sizes, never, Buffer, ErrorBound, FRAMES, FrameBytes, Linear, Memory, MethodInfo, Order};
 use super::params::IntParam;
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::error::Result;
@@ -58,7 +58,13 @@ pub const PEEL_WORDS: u64 = crate::consts::PEEL_WORDS as u64;
 
 /// Bytes either peeling method allocates: four 64-bit keys, two layer colors and the
 /// accumulators per pixel, and a counter.
-const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::bytes(4 * 8 + 2 * 16 + PEEL_WORDS * 4), fixed: 4 };
+const BUFFERS: &[Buffer] = &[
+    Buffer::per_pixel("keys", Linear::bytes(4 * 8)),
+    Buffer::per_pixel("layers", Linear::bytes(2 * 16)),
+    Buffer::per_pixel("acc", Linear::bytes(PEEL_WORDS * 4)),
+];
+/// The buffers and the peeled counter.
+const BYTES: FrameBytes = FrameBytes::of(BUFFERS, 4);
 const MEMORY: Memory = Memory::Frame(BYTES);
 
 struct Peel {
@@ -73,7 +79,7 @@ impl Method for Peel {
         let name = if self.dual { "dual_depth_peeling" } else { "depth_peeling" };
         cx.check_per_pixel(name, 4 * PEEL_WORDS.max(8))?;
         let peeled = self.peeled.get_or_insert_with(|| Counter::new(cx.gpu, "peeled count"));
-        let sizes = [("keys", pixels * 32), ("layers", pixels * 32), ("acc", pixels * PEEL_WORDS * 4)];
+        let sizes = buffer_sizes(BUFFERS, pixels, cx.params);
         let b = StorageGroup::ensure(&mut self.buffers, cx.gpu, OWN, &sizes, &[("peeled", peeled)]);
         let limit = LAYERS.of(cx.params) as u64;
         let n = cx.max_depth_complexity as u64;
