@@ -26,7 +26,7 @@ pub const INFO: MethodInfo = MethodInfo {
     order: Order::Bitwise,
     antialias_modes: &[AntialiasMode::Frames, AntialiasMode::Coverage],
     memory: Memory::Scene {
-        storage: SceneBytes { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: 24, per_triangle: 0 },
+        storage: SceneBytes { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: size_of::<PoolNode>() as u64, per_triangle: 0 },
         note: "(the node pool grows with the scene)",
     },
     error_bound: ErrorBound::Exact,

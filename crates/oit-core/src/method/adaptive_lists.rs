@@ -28,7 +28,7 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Submission,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { storage: SceneBytes { per_pixel: 4, per_fragment: 32, per_triangle: 0 }, note: "(grows with the scene)" },
+    memory: Memory::Scene { storage: SceneBytes { per_pixel: 4, per_fragment: size_of::<PrimNode>() as u64, per_triangle: 0 }, note: "(grows with the scene)" },
     error_bound: ErrorBound::None,
     census: true,
     census_when: never,

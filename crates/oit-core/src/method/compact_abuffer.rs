@@ -27,7 +27,7 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { storage: SceneBytes { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: 12, per_triangle: 176 }, note: "" },
+    memory: Memory::Scene { storage: SceneBytes { per_pixel: COUNTED_PIXEL_BYTES, per_fragment: size_of::<CompactNode>() as u64, per_triangle: size_of::<PrimShading>() as u64 }, note: "" },
     error_bound: ErrorBound::Exact,
     census: true,
     census_when: never,

@@ -28,7 +28,7 @@ pub const INFO: MethodInfo = MethodInfo {
     order: Order::Bitwise,
     antialias_modes: FRAMES,
     memory: Memory::Scene {
-        storage: SceneBytes { per_pixel: PIXEL_BYTES, per_fragment: 24, per_triangle: 16 },
+        storage: SceneBytes { per_pixel: PIXEL_BYTES, per_fragment: size_of::<PoolNode>() as u64, per_triangle: size_of::<PallBlock>() as u64 },
         note: "(a fragment's node for each pixel of its triangle's bounds)",
     },
     error_bound: ErrorBound::Exact,

@@ -27,7 +27,7 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::empty(),
     order: Order::Bitwise,
     antialias_modes: FRAMES,
-    memory: Memory::Scene { storage: SceneBytes { per_pixel: PIXEL_BYTES + 8, per_fragment: 24, per_triangle: 0 }, note: "+ scan sums" },
+    memory: Memory::Scene { storage: SceneBytes { per_pixel: PIXEL_BYTES + 8, per_fragment: size_of::<PoolNode>() as u64, per_triangle: 0 }, note: "+ scan sums" },
     error_bound: ErrorBound::Exact,
     census: true,
     census_when: never,
