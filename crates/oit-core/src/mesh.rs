@@ -11,6 +11,7 @@ use crate::shading::{self, Material, Shading};
 pub const PRIM_MESH: u32 = 0;
 pub const PRIM_STRANDS: u32 = 1;
 pub const PRIM_PARTICLES: u32 = 2;
+pub const PRIM_GAUSSIANS: u32 = 3;
 
 /// How a mesh's triangles come about.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -23,6 +24,10 @@ pub enum Primitive {
     Strands { counts: Vec<u32>, widths: Vec<f32> },
     /// A disc per position of radius `radii` (per point, world units): a quad, two triangles.
     Particles { radii: Vec<f32> },
+    /// A Gaussian splat per position (its mean): standard deviations `scales` along its axes,
+    /// rotated by `rotations` (wxyz quaternions), its opacity the color's alpha; drawn as its
+    /// 3-sigma screen ellipse's quad, two triangles (src/splat.rs).
+    Gaussians { scales: Vec<[f32; 3]>, rotations: Vec<[f32; 4]> },
 }
 
 impl Primitive {
@@ -32,6 +37,7 @@ impl Primitive {
             Self::Triangles => PRIM_MESH,
             Self::Strands { .. } => PRIM_STRANDS,
             Self::Particles { .. } => PRIM_PARTICLES,
+            Self::Gaussians { .. } => PRIM_GAUSSIANS,
         }
     }
 
@@ -40,6 +46,7 @@ impl Primitive {
             Self::Triangles => "triangles",
             Self::Strands { .. } => "strands",
             Self::Particles { .. } => "particles",
+            Self::Gaussians { .. } => "gaussians",
         }
     }
 }
@@ -130,7 +137,7 @@ impl Mesh {
         match &self.primitive {
             Primitive::Triangles => self.indices.len(),
             Primitive::Strands { counts, .. } => self.positions.len() - counts.len(),
-            Primitive::Particles { .. } => self.positions.len(),
+            Primitive::Particles { .. } | Primitive::Gaussians { .. } => self.positions.len(),
         }
     }
 

@@ -80,6 +80,19 @@ impl Scene {
         Ok(self.inner.add_mesh(primitives::particles(&centers, &radii, &colors, opaque, falloff, opacity)?))
     }
 
+    /// A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
+    /// colors (n, 3) float32, each with n rows or one.
+    fn add_gaussians(
+        &mut self,
+        means: PyReadonlyArray2<'_, f32>,
+        scales: PyReadonlyArray2<'_, f32>,
+        rotations: PyReadonlyArray2<'_, f32>,
+        opacities: PyReadonlyArray1<'_, f32>,
+        colors: PyReadonlyArray2<'_, f32>,
+    ) -> PyResult<usize> {
+        Ok(self.inner.add_mesh(primitives::gaussians(&means, &scales, &rotations, &opacities, &colors)?))
+    }
+
     /// Mesh `mesh` as the triangles it is drawn as under `view_proj`.
     fn to_triangles<'py>(
         &self,

@@ -130,6 +130,13 @@ fn mesh_dict<'py>(py: Python<'py>, m: &FileMesh) -> PyResult<Bound<'py, PyDict>>
             p.set_item("falloff", falloff.name())?;
             Some(p)
         }
+        FilePrimitive::Gaussians { scales, rotations } => {
+            let p = PyDict::new(py);
+            p.set_item("kind", "gaussians")?;
+            p.set_item("scales", array(py, scales))?;
+            p.set_item("rotations", array(py, rotations))?;
+            Some(p)
+        }
     };
     d.set_item("primitive", primitive)?;
     d.set_item("surface", m.surface.as_ref().map(|s| surface_dict(py, s)).transpose()?)?;

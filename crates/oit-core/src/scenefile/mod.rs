@@ -41,6 +41,11 @@ pub enum FilePrimitive {
         falloff: Falloff,
         radii: Vec<f32>,
     },
+    /// Gaussian splats: standard deviations and wxyz rotations (their opacity is the colors' alpha).
+    Gaussians {
+        scales: Vec<[f32; 3]>,
+        rotations: Vec<[f32; 4]>,
+    },
 }
 
 /// A base color texture as the file stores it: linear RGBA, row 0 first.
@@ -143,6 +148,11 @@ impl SceneFile {
                 FilePrimitive::Particles { falloff, radii } => {
                     w.u32s(&[2, falloff.code()]);
                     w.pod(radii);
+                }
+                FilePrimitive::Gaussians { scales, rotations } => {
+                    w.u32s(&[3, 0]);
+                    w.pod(scales);
+                    w.pod(rotations);
                 }
             }
             if let Some(s) = &m.surface {
@@ -248,7 +258,8 @@ fn read_primitive(r: &mut Reader<'_>, n: usize) -> Result<FilePrimitive> {
             };
             Ok(FilePrimitive::Particles { falloff, radii: r.array(n, "the radii")? })
         }
-        k => Err(invalid!("unknown primitive kind {k} (1: strands, 2: particles)")),
+        3 => Ok(FilePrimitive::Gaussians { scales: r.array(n, "the scales")?, rotations: r.array(n, "the rotations")? }),
+        k => Err(invalid!("unknown primitive kind {k} (1: strands, 2: particles, 3: gaussians)")),
     }
 }
 
@@ -294,6 +305,11 @@ impl FileMesh {
             FilePrimitive::Particles { falloff, radii } => {
                 Mesh::particles(self.positions.clone(), radii.clone(), self.colors.clone(), self.opaque, *falloff)
             }
+            FilePrimitive::Gaussians { scales, rotations } => {
+                let opacities = self.colors.iter().map(|c| c[3]).collect();
+                let rgb = self.colors.iter().map(|c| [c[0], c[1], c[2]]).collect();
+                Mesh::gaussians(self.positions.clone(), scales.clone(), rotations.clone(), opacities, rgb)
+            }
         }?;
         let Some(s) = &self.surface else { return Ok(mesh) };
         let texture = match &s.texture {
@@ -330,6 +346,7 @@ impl FileMesh {
             Primitive::Triangles => FilePrimitive::Triangles,
             Primitive::Strands { counts, widths } => FilePrimitive::Strands { counts: counts.clone(), widths: widths.clone() },
             Primitive::Particles { radii } => FilePrimitive::Particles { falloff: mat.falloff, radii: radii.clone() },
+            Primitive::Gaussians { scales, rotations } => FilePrimitive::Gaussians { scales: scales.clone(), rotations: rotations.clone() },
         };
         let surfaced = !mat.is_plain_surface() || !m.normals.is_empty() || !m.uvs.is_empty();
         let surface = surfaced.then(|| FileSurface {
