@@ -66,8 +66,11 @@ fn cs_expand_gaussians(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var ii = chunk.set_instance; ii < chunk.set_instance + chunk.drawn / chunk.triangles; ii++) {
         let base = expanded_base(ii);
         let c = gaussian_corners(unit, ii);
+        // The splat's RGB rides in its first three corners' w (read by corner_of).
+        let rgb = gaussian_color(unit, ii);
+        let w = vec4<f32>(rgb, 1.0);
         for (var j = 0u; j < 4u; j++) {
-            expanded[base + 4u * unit + j] = vec4<f32>(c[j], 1.0);
+            expanded[base + 4u * unit + j] = vec4<f32>(c[j], w[j]);
         }
     }
 }

@@ -114,6 +114,10 @@ def bad(**kw):
     (bad(opacities=[0.5, 1.5]), "\\[0, 1\\].*logits"),
     (bad(opacities=[0.5, 0.5, 0.5]), "one number or \\(2,\\)"),
     (bad(colors=[[0, 0, 2], [0, 0, 0]]), "\\[0, 1\\]"),
+    (bad(sh=np.zeros((2, 4, 3))), "colors or sh, not both"),
+    (bad(colors=None, sh=np.zeros((2, 5, 3))), "k = 1, 4, 9 or 16"),
+    (bad(colors=None, sh=np.zeros((1, 4, 3))), "must have shape \\(2, k, 3\\)"),
+    (bad(colors=None, sh=np.full((2, 4, 3), np.nan)), "NaN or Inf"),
 ])
 def test_bad_gaussians_are_refused_with_what_to_do(call, match):
     with pytest.raises(ValueError, match=match):
@@ -154,3 +158,40 @@ def test_a_3dgs_ply_loads_as_splats_with_every_field_as_written(tmp_path):
     b = oit.reference(by_hand, cam, 32, 32)
     assert np.abs(a - b).max() < 1e-6
     assert a[..., 3].max() > 0.05
+
+
+def sh_numpy(c: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """3DGS's eval_sh (its basis and signs) for coefficients c (k, 3) in unit direction d,
+    plus 0.5, clamped to [0, 1]."""
+    x, y, z = d
+    basis = [0.28209479177387814,
+             -0.4886025119029199 * y, 0.4886025119029199 * z, -0.4886025119029199 * x,
+             1.0925484305920792 * x * y, -1.0925484305920792 * y * z, 0.31539156525252005 * (2 * z * z - x * x - y * y),
+             -1.0925484305920792 * x * z, 0.5462742152960396 * (x * x - y * y),
+             -0.5900435899266435 * y * (3 * x * x - y * y), 2.890611442640554 * x * y * z,
+             -0.4570457994644658 * y * (4 * z * z - x * x - y * y), 0.3731763325901154 * z * (2 * z * z - 3 * x * x - 3 * y * y),
+             -0.4570457994644658 * x * (4 * z * z - x * x - y * y), 1.445305721320277 * z * (x * x - y * y),
+             -0.5900435899266435 * x * (x * x - 3 * y * y)]
+    return np.clip(0.5 + np.asarray(basis[:len(c)]) @ c, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("degree", [0, 1, 2, 3])
+def test_sh_colors_match_a_numpy_evaluation(renderer, degree):
+    k = (degree + 1) ** 2
+    rng = np.random.default_rng(degree)
+    eye, mean = np.array([0.7, 0.4, 3.0]), np.array([0.1, -0.2, 0.3])
+    cam = oit.Camera.look_at(eye=tuple(eye), target=tuple(mean), fov_y=40.0, near=0.5, far=10.0)
+    want = []
+    for _ in range(3):
+        sh = rng.uniform(-0.6, 0.6, (1, k, 3)).astype(np.float32)
+        s = oit.Scene()
+        s.add_gaussians(mean[None].astype(np.float32), [0.2, 0.1, 0.15], [1, 0, 0, 0], [1.0], sh=sh)
+        d = (mean - eye) / np.linalg.norm(mean - eye)
+        color = 0.99 * sh_numpy(sh[0].astype(np.float64), d)
+        # The mean projects onto the center of pixel (16, 16) of 33 x 33.
+        gpu = renderer(33, 33).render(s, cam, "abuffer", background=(0, 0, 0)).image[16, 16, :3]
+        ref = oit.reference(s, cam, 33, 33, background=(0, 0, 0))[16, 16, :3]
+        np.testing.assert_allclose(ref, color, atol=1e-6)
+        np.testing.assert_allclose(gpu, color, atol=2e-5)
+        want.append(color)
+    assert np.ptp(np.array(want)) > 0.05, "the colors differ from draw to draw"

@@ -1,7 +1,8 @@
 // Strands, particles and Gaussian splats (oit_core::primitive, whose float64 `expand` this
 // mirrors): a chunk of kind PRIM_STRANDS or PRIM_PARTICLES holds one set's points as four floats
 // each (x, y, z and half the width, or the radius) and their colors, a PRIM_GAUSSIANS chunk
-// twelve a splat (its mean, 0, its covariance's upper triangle, 0, 0); a strand chunk has a word a segment in
+// twelve a splat and 3 k more (its mean, its count k of spherical-harmonic coefficients, its
+// covariance's upper triangle, 0, 0, then the k RGB coefficients); a strand chunk has a word a segment in
 // `indices` (its first point, FIRST_SEGMENT, LAST_SEGMENT). Once a frame, before any geometry
 // pass, shaders/expand.wgsl builds the corners facing the eye into `expanded` (each point's two
 // ribbon corners and its tangent, or each particle's four quad corners, for each instance of
@@ -65,6 +66,11 @@ fn corner_of(vi: u32, ii: u32) -> Corner {
     var k: Corner;
     k.world = expanded[at].xyz;
     k.color = placed_color(i, ii);
+    if chunk.kind == PRIM_GAUSSIANS {
+        // The splat's RGB, evaluated by the expansion into its first three corners' w.
+        let first = base + 4u * unit;
+        k.color = vec4<f32>(expanded[first].w, expanded[first + 1u].w, expanded[first + 2u].w, k.color.a);
+    }
 //!if SHADED
     if strands {
         k.tangent = expanded[base + 2u * chunk.set_points + i].xyz;
@@ -113,7 +119,7 @@ fn particle_corners(q: u32, ii: u32) -> array<vec3<f32>, 4> {
 // and w (so the disc coordinates interpolate affinely on screen), back in world space. A mean
 // behind the eye gives four equal corners, no fragments.
 fn gaussian_corners(q: u32, ii: u32) -> array<vec3<f32>, 4> {
-    let b = 12u * q;
+    let b = splat_stride() * q;
     let mean = placed_at(vec3<f32>(positions[b], positions[b + 1u], positions[b + 2u]), ii).xyz;
     let local = mat3x3<f32>(
         vec3<f32>(positions[b + 4u], positions[b + 5u], positions[b + 6u]),
@@ -150,6 +156,57 @@ fn gaussian_corners(q: u32, ii: u32) -> array<vec3<f32>, 4> {
         out[j] = h.xyz / h.w;
     }
     return out;
+}
+
+// Floats a splat in `positions`: 12, and 3 a harmonic coefficient (the chunk's set has one
+// degree; its first splat says how many).
+fn splat_stride() -> u32 {
+    return 12u + 3u * u32(positions[3]);
+}
+
+// A splat's RGB under instance `ii`: its color, or its spherical harmonics evaluated in the
+// direction from the eye to its mean (oit_core::splat::sh_color and view_direction: 3DGS's
+// basis, 0.5 + Σ Y_lm(d) c_lm clamped to [0, 1]), times the instance's color.
+fn gaussian_color(q: u32, ii: u32) -> vec3<f32> {
+    let k = u32(positions[3]);
+    if k == 0u {
+        return placed_color(q, ii).rgb;
+    }
+    let b = splat_stride() * q;
+    let mean = placed_at(vec3<f32>(positions[b], positions[b + 1u], positions[b + 2u]), ii).xyz;
+    let e = frame.inv_view_proj[2];
+    var d = normalize(e.xyz);
+    if abs(e.w) > 1e-30 {
+        d = normalize(mean - e.xyz / e.w);
+    }
+    var c: array<vec3<f32>, 16>;
+    for (var j = 0u; j < k; j++) {
+        let at = b + 12u + 3u * j;
+        c[j] = vec3<f32>(positions[at], positions[at + 1u], positions[at + 2u]);
+    }
+    let x = d.x;
+    let y = d.y;
+    let z = d.z;
+    var r = SH_C0 * c[0];
+    if k > 1u {
+        r += -SH_C1 * y * c[1] + SH_C1 * z * c[2] - SH_C1 * x * c[3];
+    }
+    if k > 4u {
+        let xx = x * x;
+        let yy = y * y;
+        let zz = z * z;
+        r += 1.0925484305920792 * x * y * c[4] - 1.0925484305920792 * y * z * c[5]
+            + 0.31539156525252005 * (2.0 * zz - xx - yy) * c[6] - 1.0925484305920792 * x * z * c[7]
+            + 0.5462742152960396 * (xx - yy) * c[8];
+        if k > 9u {
+            r += -0.5900435899266435 * y * (3.0 * xx - yy) * c[9] + 2.890611442640554 * x * y * z * c[10]
+                - 0.4570457994644658 * y * (4.0 * zz - xx - yy) * c[11]
+                + 0.3731763325901154 * z * (2.0 * zz - 3.0 * xx - 3.0 * yy) * c[12]
+                - 0.4570457994644658 * x * (4.0 * zz - xx - yy) * c[13]
+                + 1.445305721320277 * z * (xx - yy) * c[14] - 0.5900435899266435 * x * (xx - 3.0 * yy) * c[15];
+        }
+    }
+    return clamp(r + vec3<f32>(0.5), vec3<f32>(0.0), vec3<f32>(1.0)) * placed_tint(ii).rgb;
 }
 
 // The vertex shader's output for corner `vi` of a strand or particle chunk.

@@ -203,6 +203,10 @@ fn placed_color(v: u32, ii: u32) -> vec4<f32> {
     return colors[v] * instances[ii].color;
 }
 
+fn placed_tint(ii: u32) -> vec4<f32> {
+    return instances[ii].color;
+}
+
 fn placed_linear(ii: u32) -> mat3x3<f32> {
     let m = instances[ii].model;
     return mat3x3<f32>(m[0].xyz, m[1].xyz, m[2].xyz);
@@ -231,6 +235,10 @@ fn placed_at(p: vec3<f32>, ii: u32) -> vec4<f32> {
 
 fn placed_color(v: u32, ii: u32) -> vec4<f32> {
     return colors[v];
+}
+
+fn placed_tint(ii: u32) -> vec4<f32> {
+    return vec4<f32>(1.0);
 }
 
 fn placed_linear(ii: u32) -> mat3x3<f32> {

@@ -103,6 +103,8 @@ pub const SHARED: &[Const] = &[
     Const::F32("SPLAT_ALPHA_MIN", crate::splat::ALPHA_MIN as f32),
     Const::F32("SPLAT_LOW_PASS", crate::splat::LOW_PASS as f32),
     Const::F32("SPLAT_SIGMAS", crate::splat::SIGMAS as f32),
+    Const::F32("SH_C0", crate::splat::SH_C0 as f32),
+    Const::F32("SH_C1", crate::splat::SH_C1 as f32),
     Const::U32("PRIM_MESH", crate::primitive::PRIM_MESH),
     Const::U32("PRIM_STRANDS", crate::primitive::PRIM_STRANDS),
     Const::U32("PRIM_PARTICLES", crate::primitive::PRIM_PARTICLES),

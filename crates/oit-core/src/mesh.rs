@@ -27,7 +27,10 @@ pub enum Primitive {
     /// A Gaussian splat per position (its mean): standard deviations `scales` along its axes,
     /// rotated by `rotations` (wxyz quaternions), its opacity the color's alpha; drawn as its
     /// 3-sigma screen ellipse's quad, two triangles (src/splat.rs).
-    Gaussians { scales: Vec<[f32; 3]>, rotations: Vec<[f32; 4]> },
+    /// Where `sh` is not empty, the color is its spherical harmonics of degree `degree`
+    /// evaluated in the view direction ((degree + 1)² RGB coefficients a splat, the DC first;
+    /// `splat::sh_color`), and the colors' RGB only their DC part.
+    Gaussians { scales: Vec<[f32; 3]>, rotations: Vec<[f32; 4]>, sh: Vec<[f32; 3]>, degree: u32 },
 }
 
 impl Primitive {

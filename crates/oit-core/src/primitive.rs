@@ -112,8 +112,41 @@ impl Mesh {
         }
         let rgba = colors.iter().zip(&opacities).map(|(c, &o)| [c[0], c[1], c[2], o]).collect();
         let mut mesh = Mesh::new(means, Vec::new(), rgba, false)?;
-        mesh.primitive = Primitive::Gaussians { scales, rotations };
+        mesh.primitive = Primitive::Gaussians { scales, rotations, sh: Vec::new(), degree: 0 };
         mesh.material.falloff = Falloff::Splat;
+        Ok(mesh)
+    }
+
+    /// Splats whose color is spherical harmonics of `degree` (0 to 3) in the view direction:
+    /// `sh` holds (degree + 1)² RGB coefficients a splat, splat after splat, the DC first, as
+    /// 3DGS stores them (color = 0.5 + Σ Y_lm(dir) c_lm clamped to [0, 1], `splat::sh_color`).
+    pub fn gaussians_sh(
+        means: Vec<[f32; 3]>,
+        scales: Vec<[f32; 3]>,
+        rotations: Vec<[f32; 4]>,
+        opacities: Vec<f32>,
+        sh: Vec<[f32; 3]>,
+        degree: u32,
+    ) -> Result<Self> {
+        if degree > 3 {
+            return Err(invalid!("sh degree {degree}: spherical harmonics of degree 0 to 3 (1, 4, 9 or 16 coefficients a splat)"));
+        }
+        let k = ((degree + 1) * (degree + 1)) as usize;
+        if sh.len() != k * means.len() {
+            return Err(invalid!(
+                "sh has {} coefficients for {} splats: pass {k} RGB coefficients a splat (degree {degree})",
+                sh.len(),
+                means.len()
+            ));
+        }
+        if let Some(i) = sh.iter().position(|c| c.iter().any(|x| !x.is_finite())) {
+            return Err(invalid!("sh coefficient {} of splat {} is not finite", i % k, i / k));
+        }
+        let dc = sh.chunks_exact(k).map(|c| c[0].map(|x| (0.5 + crate::splat::SH_C0 * x as f64).clamp(0.0, 1.0) as f32)).collect();
+        let mut mesh = Self::gaussians(means, scales, rotations, opacities, dc)?;
+        if let Primitive::Gaussians { sh: s, degree: d, .. } = &mut mesh.primitive {
+            (*s, *d) = (sh, degree);
+        }
         Ok(mesh)
     }
 
@@ -226,18 +259,24 @@ pub fn expand(m: &Mesh, inst: &Instance, camera: &Camera, size: DVec2) -> Vec<Co
                 }
             }
         }
-        Primitive::Gaussians { scales, rotations } => {
+        Primitive::Gaussians { scales, rotations, sh, degree } => {
             let inv = camera.view_proj.inverse();
+            let k = ((degree + 1) * (degree + 1)) as usize;
             let linear = glam::DMat3::from_mat4(inst.transform);
             for (i, (s, q)) in scales.iter().zip(rotations).enumerate() {
                 let mean = inst.apply(m.positions[i]);
                 let cov = linear * crate::splat::covariance(*s, *q) * linear.transpose();
                 let f = crate::splat::footprint(mean, &cov, &camera.view_proj, size);
+                let mut c = color(i);
+                if !sh.is_empty() {
+                    let rgb = crate::splat::sh_color(&sh[k * i..k * (i + 1)], crate::splat::view_direction(e, mean));
+                    c = (rgb * DVec4::from(inst.color.map(|x| x as f64)).truncate()).extend(c.w);
+                }
                 for (v, u) in CORNERS {
                     let uv = DVec2::new(u as f64, 2.0 * v as f64 - 1.0);
                     // Behind the eye: a point, no fragments (the GPU's too).
                     let position = f.map_or(mean, |f| crate::splat::corner(&f, uv, &inv, size));
-                    out.push(Corner { position, color: color(i), tangent: DVec3::ZERO, uv });
+                    out.push(Corner { position, color: c, tangent: DVec3::ZERO, uv });
                 }
             }
         }

@@ -17,6 +17,62 @@ pub const SIGMAS: f64 = 3.0;
 pub const ALPHA_MAX: f64 = 0.99;
 pub const ALPHA_MIN: f64 = 1.0 / 255.0;
 
+/// The spherical-harmonic basis constants of 3DGS (degree 0, 1, 2, 3).
+pub const SH_C0: f64 = 0.282_094_791_773_878_14;
+pub const SH_C1: f64 = 0.488_602_511_902_919_9;
+pub const SH_C2: [f64; 5] =
+    [1.092_548_430_592_079_2, -1.092_548_430_592_079_2, 0.315_391_565_252_520_05, -1.092_548_430_592_079_2, 0.546_274_215_296_039_6];
+pub const SH_C3: [f64; 7] = [
+    -0.590_043_589_926_643_5,
+    2.890_611_442_640_554,
+    -0.457_045_799_464_465_8,
+    0.373_176_332_590_115_4,
+    -0.457_045_799_464_465_8,
+    1.445_305_721_320_277,
+    -0.590_043_589_926_643_5,
+];
+
+/// The unit direction from the eye to `p`: from the homogeneous eye `e` (inv_view_proj times
+/// (0, 0, 1, 0), primitive.rs) its center e.xyz / e.w, or for an orthographic camera (e.w = 0)
+/// the view direction e.xyz.
+pub fn view_direction(e: DVec4, p: DVec3) -> DVec3 {
+    if e.w.abs() > 1e-300 {
+        (p - e.truncate() / e.w).normalize_or_zero()
+    } else {
+        e.truncate().normalize_or_zero()
+    }
+}
+
+/// 3DGS's color of spherical-harmonic coefficients `c` ((degree + 1)² RGB, the DC first) in
+/// the unit direction `d` from the eye: 0.5 + Σ Y_lm(d) c_lm with its basis and signs, clamped
+/// to [0, 1] (3DGS clamps at 0 alone; colors here are in [0, 1], as every vertex color is).
+pub fn sh_color(c: &[[f32; 3]], d: DVec3) -> DVec3 {
+    let c: Vec<DVec3> = c.iter().map(|v| DVec3::from(v.map(|x| x as f64))).collect();
+    let (x, y, z) = (d.x, d.y, d.z);
+    let mut r = SH_C0 * c[0];
+    if c.len() > 1 {
+        r += -SH_C1 * y * c[1] + SH_C1 * z * c[2] - SH_C1 * x * c[3];
+    }
+    if c.len() > 4 {
+        let (xx, yy, zz, xy, yz, xz) = (x * x, y * y, z * z, x * y, y * z, x * z);
+        r += SH_C2[0] * xy * c[4]
+            + SH_C2[1] * yz * c[5]
+            + SH_C2[2] * (2.0 * zz - xx - yy) * c[6]
+            + SH_C2[3] * xz * c[7]
+            + SH_C2[4] * (xx - yy) * c[8];
+        if c.len() > 9 {
+            r += SH_C3[0] * y * (3.0 * xx - yy) * c[9]
+                + SH_C3[1] * xy * z * c[10]
+                + SH_C3[2] * y * (4.0 * zz - xx - yy) * c[11]
+                + SH_C3[3] * z * (2.0 * zz - 3.0 * xx - 3.0 * yy) * c[12]
+                + SH_C3[4] * x * (4.0 * zz - xx - yy) * c[13]
+                + SH_C3[5] * z * (xx - yy) * c[14]
+                + SH_C3[6] * x * (xx - 3.0 * yy) * c[15];
+        }
+    }
+    (r + DVec3::splat(0.5)).clamp(DVec3::ZERO, DVec3::ONE)
+}
+
 /// The unit rotation of a wxyz quaternion (normalized; the caller refuses zero ones).
 pub fn rotation(q: [f32; 4]) -> DMat3 {
     let [w, x, y, z] = q.map(|c| c as f64);

@@ -24,9 +24,9 @@ fn unit(i: u32) -> f32 {
     (x >> 8) as f32 / (1u32 << 24) as f32
 }
 
-/// Splats of every size and orientation among a transparent triangle pair crossing them and
-/// an opaque floor behind.
-fn scene() -> Scene {
+/// Splats of every size and orientation among a transparent triangle crossing them and an
+/// opaque floor behind; their colors spherical harmonics of `sh` degree where given.
+fn scene(sh: Option<u32>) -> Scene {
     let mut scene = Scene::new();
     let floor = vec![[-3.0, -1.0, -3.0], [3.0, -1.0, -3.0], [3.0, -1.0, 2.0], [-3.0, -1.0, 2.0]];
     scene.add_mesh(Mesh::new(floor, vec![[0, 2, 1], [0, 3, 2]], vec![[0.3, 0.35, 0.4, 1.0]], true).unwrap());
@@ -42,7 +42,20 @@ fn scene() -> Scene {
         opacities.push(0.1 + 0.9 * r(10));
         colors.push([r(11), r(12), r(13)]);
     }
-    scene.add_gaussians(means, scales, rotations, opacities, colors).unwrap();
+    match sh {
+        None => _ = scene.add_gaussians(means, scales, rotations, opacities, colors).unwrap(),
+        Some(degree) => {
+            let k = ((degree + 1) * (degree + 1)) as usize;
+            let sh = (0..n as usize * k).map(|j| [0, 1, 2].map(|c| unit(9000 + 3 * j as u32 + c) - 0.5)).collect();
+            let m = Mesh::gaussians_sh(means, scales, rotations, opacities, sh, degree).unwrap();
+            // Twice: in place and rotated, scaled and tinted (the view direction and the tint
+            // go through the instance).
+            let turn = glam::DMat4::from_rotation_y(0.7) * glam::DMat4::from_scale(DVec3::new(1.0, 0.6, 1.2));
+            let rows = |m: glam::DMat4| m.transpose().to_cols_array_2d();
+            let instances = vec![oit_core::Instance::IDENTITY, oit_core::Instance::from_rows(rows(turn), [0.9, 0.7, 1.0, 0.8]).unwrap()];
+            scene.add_placed(m, instances);
+        }
+    }
     let sheet = vec![[-1.2, -0.9, 0.3], [1.1, -0.7, -0.6], [0.0, 1.0, 0.0]];
     scene.add_mesh(Mesh::new(sheet, vec![[0, 1, 2]], vec![[0.9, 0.2, 0.1, 0.45]], false).unwrap());
     scene
@@ -50,11 +63,21 @@ fn scene() -> Scene {
 
 #[test]
 fn abuffer_equals_the_reference_on_splats_mixed_with_meshes() {
-    let scene = scene();
+    check(&scene(None), "splats");
+}
+
+#[test]
+fn abuffer_equals_the_reference_on_instanced_splats_of_every_harmonic_degree() {
+    for degree in 0..=3 {
+        check(&scene(Some(degree)), &format!("degree {degree}"));
+    }
+}
+
+fn check(scene: &Scene, what: &str) {
     let ctx = shared_context(None).expect("a GPU adapter (lavapipe in CI)");
     let mut r = Renderer::new(ctx, SIZE, SIZE).unwrap();
-    let f = r.render(&scene, &camera(), "abuffer", &[], [1.0; 3]).unwrap();
-    let want = reference(&scene, &camera(), SIZE, SIZE, [1.0; 3]).unwrap();
+    let f = r.render(scene, &camera(), "abuffer", &[], [1.0; 3]).unwrap();
+    let want = reference(scene, &camera(), SIZE, SIZE, [1.0; 3]).unwrap();
     let mut errors: Vec<f64> = Vec::new();
     let mut ambiguous = 0;
     for p in 0..(SIZE * SIZE) as usize {
@@ -68,7 +91,7 @@ fn abuffer_equals_the_reference_on_splats_mixed_with_meshes() {
     errors.sort_by(f64::total_cmp);
     let max = *errors.last().unwrap();
     let p99 = errors[errors.len() * 99 / 100];
-    println!("splats: {} pixels compared, {ambiguous} ambiguous, max error {max:.2e}, p99 {p99:.2e}", errors.len());
+    println!("{what}: {} pixels compared, {ambiguous} ambiguous, max error {max:.2e}, p99 {p99:.2e}", errors.len());
     assert!(want.depth_complexity.iter().any(|&d| d >= 4), "the splats overlap");
     // Float rounding: float32 footprints, exp and blending over a few layers.
     assert!(max < 1e-4 && p99 < 3e-5, "max {max:.2e}, p99 {p99:.2e}");

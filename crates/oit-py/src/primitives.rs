@@ -42,18 +42,26 @@ pub(crate) fn particles(
     surfaced(mesh, &Look { shading: "unlit".into(), specular: 0.0, shininess: 32.0, opacity })
 }
 
+/// A splat set's spherical harmonics: (n k, 3) RGB coefficients, the DC first, and their degree.
+pub(crate) type Harmonics<'py> = (PyReadonlyArray2<'py, f32>, u32);
+
 /// A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
-/// colors (n, 3), each row count n or 1.
+/// colors (n, 3), each row count n or 1; its color from `sh` instead where given.
 pub(crate) fn gaussians(
     means: &PyReadonlyArray2<'_, f32>,
     scales: &PyReadonlyArray2<'_, f32>,
     rotations: &PyReadonlyArray2<'_, f32>,
     opacities: &PyReadonlyArray1<'_, f32>,
     colors: &PyReadonlyArray2<'_, f32>,
+    sh: Option<&Harmonics<'_>>,
 ) -> PyResult<oit_core::Mesh> {
-    let (means, scales, rotations, colors) =
-        (rows(means, "means")?, rows(scales, "scales")?, rows(rotations, "rotations")?, rows(colors, "colors")?);
-    Ok(oit_core::Mesh::gaussians(means, scales, rotations, opacities.as_array().to_vec(), colors).map_err(Error::from)?)
+    let (means, scales, rotations) = (rows(means, "means")?, rows(scales, "scales")?, rows(rotations, "rotations")?);
+    let opacities = opacities.as_array().to_vec();
+    let mesh = match sh {
+        None => oit_core::Mesh::gaussians(means, scales, rotations, opacities, rows(colors, "colors")?),
+        Some((sh, degree)) => oit_core::Mesh::gaussians_sh(means, scales, rotations, opacities, rows(sh, "sh")?, *degree),
+    };
+    Ok(mesh.map_err(Error::from)?)
 }
 
 /// Positions (n, 3), indices (m, 3), colors (n, 4), normals (n, 3) or None, uvs (n, 2) or None.

@@ -130,7 +130,7 @@ fn mesh_dict<'py>(py: Python<'py>, m: &FileMesh) -> PyResult<Bound<'py, PyDict>>
             p.set_item("falloff", falloff.name())?;
             Some(p)
         }
-        FilePrimitive::Gaussians { scales, rotations } => {
+        FilePrimitive::Gaussians { scales, rotations, .. } => {
             let p = PyDict::new(py);
             p.set_item("kind", "gaussians")?;
             p.set_item("scales", array(py, scales))?;

@@ -218,8 +218,11 @@ fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
         }
     }
     if let Some(s) = splats {
-        let mesh =
-            crate::scene::Mesh::gaussians(s.means, s.scales, s.rotations, s.opacities, s.colors).map_err(|e| format!("'{name}': {e}"))?;
+        let mesh = match s.sh.is_empty() {
+            true => crate::scene::Mesh::gaussians(s.means, s.scales, s.rotations, s.opacities, s.colors),
+            false => crate::scene::Mesh::gaussians_sh(s.means, s.scales, s.rotations, s.opacities, s.sh, s.degree),
+        };
+        let mesh = mesh.map_err(|e| format!("'{name}': {e}"))?;
         return Ok(super::NamedMesh::new(name, mesh));
     }
     let Some(mut v) = vertices else { return Err("no 'vertex' element".into()) };

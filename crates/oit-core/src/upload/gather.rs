@@ -37,6 +37,8 @@ pub(super) struct Gather {
     /// `expanded` holds its corners once an instance.
     pub set_instance: u32,
     pub set_instances: u32,
+    /// A splat set's spherical-harmonic coefficients a splat (0: none, its colors).
+    pub splat_sh: u32,
 }
 
 impl Gather {
@@ -57,6 +59,7 @@ impl Gather {
     pub fn next(&self, kind: u32, material: u32) -> Gather {
         let (set_instance, set_instances) = if kind == PRIM_MESH { (0, 0) } else { (self.set_instance, self.set_instances) };
         Gather {
+            splat_sh: if kind == PRIM_MESH { 0 } else { self.splat_sh },
             first_triangle: self.first_triangle + self.triangles(),
             shaded: self.shaded,
             kind,
@@ -80,7 +83,7 @@ impl Gather {
     /// Floats of `positions` a point: four, a splat's `SPLAT_FLOATS`.
     fn point_floats(&self) -> u64 {
         if self.kind == PRIM_GAUSSIANS {
-            SPLAT_FLOATS as u64
+            SPLAT_FLOATS as u64 + 3 * self.splat_sh as u64
         } else {
             4
         }
@@ -107,15 +110,19 @@ impl Gather {
         }
     }
 
-    /// Splats `range` of `m`: each mean, 0, and its covariance Σ = R S Sᵀ Rᵀ (src/splat.rs),
-    /// computed in f64, as xx xy xz yy yz zz, 0, 0.
-    fn push_splats(&mut self, m: &Mesh, scales: &[[f32; 3]], rotations: &[[f32; 4]], range: std::ops::Range<usize>) {
+    /// Splats `range` of `m`: each mean, its count of spherical-harmonic coefficients k,
+    /// its covariance Σ = R S Sᵀ Rᵀ (src/splat.rs, computed in f64) as xx xy xz yy yz zz, 0,
+    /// 0, then its k RGB coefficients.
+    fn push_splats(&mut self, m: &Mesh, range: std::ops::Range<usize>) {
+        let Primitive::Gaussians { scales, rotations, sh, .. } = &m.primitive else { return };
+        let k = self.splat_sh as usize;
         for v in range {
             self.positions.extend(m.positions[v]);
-            self.positions.push(0.0);
+            self.positions.push(k as f32);
             let cov = crate::splat::upper(&crate::splat::covariance(scales[v], rotations[v]));
             self.positions.extend(cov.map(|x| x as f32));
             self.positions.extend([0.0; 2]);
+            self.positions.extend(sh[k * v..k * (v + 1)].iter().flatten());
             self.colors.push(m.colors[v]);
         }
     }
@@ -164,6 +171,9 @@ pub(super) fn upload_set(
         Gather { kind, material, ..cur }
     };
     (cur.set_instance, cur.set_instances) = (set_instance, set_instances);
+    if let Primitive::Gaussians { sh, .. } = &m.primitive {
+        cur.splat_sh = (sh.len() / m.positions.len().max(1)) as u32;
+    }
     let start = |mine: &mut Vec<Segment>, done: &Vec<Gather>| mine.push(Segment { chunk: done.len(), lo: 0, hi: 0 });
     start(mine, done);
     let units: Vec<(usize, usize)> = match &m.primitive {
@@ -199,7 +209,7 @@ pub(super) fn upload_set(
                 cur.indices.extend(primitive::segment_words(&[points as u32], base));
             }
             Primitive::Particles { radii } => cur.push_points(m, radii, 1.0, first..first + points),
-            Primitive::Gaussians { scales, rotations } => cur.push_splats(m, scales, rotations, first..first + points),
+            Primitive::Gaussians { .. } => cur.push_splats(m, first..first + points),
             Primitive::Triangles => unreachable!("meshes are uploaded by upload"),
         }
         mine.last_mut().expect("started above").hi = cur.triangles();
