@@ -195,3 +195,29 @@ def test_sh_colors_match_a_numpy_evaluation(renderer, degree):
         np.testing.assert_allclose(gpu, color, atol=2e-5)
         want.append(color)
     assert np.ptp(np.array(want)) > 0.05, "the colors differ from draw to draw"
+
+
+@pytest.mark.parametrize("harmonics", [False, True])
+def test_scene_files_carry_splats(tmp_path, harmonics):
+    from oit import scenefile
+    from oit.scenes import MeshArrays
+
+    g = splats(12, 7)
+    n = len(g["means"])
+    colors = np.concatenate([g["colors"], g["opacities"][:, None]], 1).astype(np.float32)
+    primitive = {"kind": "gaussians", "scales": g["scales"], "rotations": g["rotations"]}
+    if harmonics:
+        primitive |= {"sh": np.random.default_rng(1).uniform(-0.5, 0.5, (n, 9, 3)), "degree": 2}
+    m = MeshArrays(g["means"], np.zeros((0, 3), np.uint32), colors, False, {}, primitive=primitive)
+    path = tmp_path / "splats.oitscene"
+    scenefile.save_scene([m], path, camera=PERSPECTIVE)
+    back, _, _ = scenefile.load_scene(path)
+    assert back[0].primitive["kind"] == "gaussians"
+    assert (back[0].primitive["sh"] is not None) == harmonics
+    original, again = oit.Scene(), scenefile.scene_of(back)
+    m.add_to(original)
+    assert again.primitives() == ["gaussians"]
+    a = oit.reference(original, PERSPECTIVE, 24, 24)
+    b = oit.reference(again, PERSPECTIVE, 24, 24)
+    np.testing.assert_array_equal(a, b)
+    assert a[..., 3].max() > 0.1

@@ -61,6 +61,14 @@ class MeshArrays:
             return scene.add_mesh(self.positions, self.indices, self.colors, opaque=self.opaque, **self.surface)
         if p["kind"] == "strands":
             return scene.add_strands(self.positions, p["counts"], p["widths"], self.colors, self.opaque, **self.surface)
+        if p["kind"] == "gaussians":
+            # The opacity is the colors' alpha; harmonics (n k, 3) replace their RGB where given.
+            col = np.broadcast_to(np.asarray(self.colors, np.float32).reshape(-1, 4), (len(self.positions), 4))
+            sh = p.get("sh")
+            if sh is not None:
+                sh = np.asarray(sh, np.float32).reshape(len(self.positions), -1, 3)
+            return scene.add_gaussians(self.positions, p["scales"], p["rotations"], col[:, 3],
+                                       None if sh is not None else col[:, :3], sh=sh)
         return scene.add_particles(self.positions, p["radii"], self.colors, self.opaque, falloff=p["falloff"], **self.surface)
 
     def triangles(self, camera: Camera) -> MeshArrays:
