@@ -6,6 +6,8 @@ a 3DGS PLY written here loads as splats with every field as written (docs/method
 from __future__ import annotations
 
 import struct
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -125,22 +127,41 @@ def test_bad_gaussians_are_refused_with_what_to_do(call, match):
 
 
 def test_one_row_stands_for_every_splat_and_colors_default_to_white():
+    from oit import cli
+
     s = oit.Scene()
     assert s.add_gaussians(np.zeros((3, 3)), [0.1, 0.1, 0.1], [1, 0, 0, 0], 0.5) == 0
     assert s.primitives() == ["gaussians"]
+    assert cli.describe_contents(s) == "3 splats"
+
+
+PLY_NAMES = ["x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2", "f_rest_0", "opacity",
+             "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"]
+PLY_ROWS = np.array([
+    [0.5, -1.0, 2.0, 0, 0, 1, 0.3, -0.2, 1.0, 9, 0.0, -1.0, -2.0, -3.0, 1.0, 0.0, 0.0, 0.0],
+    [1.0, 2.0, 3.0, 0, 1, 0, -5.0, 0.0, 0.5, 9, 2.0, 0.1, 0.2, 0.3, 0.5, 0.5, 0.5, 0.5],
+], np.float32)
+
+
+def write_ply(path):
+    """A 3DGS PLY of PLY_ROWS, binary little endian (one f_rest value, read past)."""
+    header = "ply\nformat binary_little_endian 1.0\nelement vertex 2\n"
+    header += "".join(f"property float {n}\n" for n in PLY_NAMES) + "end_header\n"
+    path.write_bytes(header.encode() + b"".join(struct.pack("<18f", *r) for r in PLY_ROWS))
+    return path
+
+
+def test_the_cli_renders_a_3dgs_ply(tmp_path):
+    out = tmp_path / "splats.png"
+    done = subprocess.run([sys.executable, "-m", "oit", "render", str(write_ply(tmp_path / "s.ply")), "-o", str(out),
+                           "--size", "32", "32"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "2 splats" in done.stdout and out.exists()
 
 
 def test_a_3dgs_ply_loads_as_splats_with_every_field_as_written(tmp_path):
-    names = ["x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2", "f_rest_0", "opacity",
-             "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"]
-    rows = np.array([
-        [0.5, -1.0, 2.0, 0, 0, 1, 0.3, -0.2, 1.0, 9, 0.0, -1.0, -2.0, -3.0, 1.0, 0.0, 0.0, 0.0],
-        [1.0, 2.0, 3.0, 0, 1, 0, -5.0, 0.0, 0.5, 9, 2.0, 0.1, 0.2, 0.3, 0.5, 0.5, 0.5, 0.5],
-    ], np.float32)
-    header = "ply\nformat binary_little_endian 1.0\nelement vertex 2\n"
-    header += "".join(f"property float {n}\n" for n in names) + "end_header\n"
-    path = tmp_path / "splats.ply"
-    path.write_bytes(header.encode() + b"".join(struct.pack("<18f", *r) for r in rows))
+    names, rows = PLY_NAMES, PLY_ROWS
+    path = write_ply(tmp_path / "splats.ply")
     scene = oit.Scene.from_file(path)
     assert scene.primitives() == ["gaussians"]
     # The loaded splats render as the same splats added by hand from the decoded fields.
