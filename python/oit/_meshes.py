@@ -51,7 +51,9 @@ class MeshArrays:
     # A strand or particle set instead of triangles (no indices; positions are its points):
     # {"kind": "strands", "counts": (strands,), "widths": (n,)} or {"kind": "particles",
     # "radii": (n,), "falloff": "hard" | "linear" | "gaussian"}; `surface` then holds
-    # add_strands' shading, specular, shininess and opacity, or add_particles' opacity.
+    # add_strands' shading, specular, shininess and opacity, or add_particles' opacity. Or a
+    # splat set: {"kind": "gaussians", "scales": (n, 3), "rotations": (n, 4), "sh": (n, k, 3)
+    # or None, "degree": int}, the opacities the colors' alpha (add_gaussians).
     primitive: dict[str, Any] | None = None
 
     def add_to(self, scene: Scene) -> int:
