@@ -1,4 +1,4 @@
-// Strands and particles facing the eye, once a frame before its geometry passes
+// Strands, particles and Gaussian splats facing the eye, once a frame before its geometry passes
 // (common/primitives.wgsl), an entry point a kind: one invocation a segment or particle of the
 // chunk, for each instance of its set, writes its corners into `expanded` (compiled with
 // EXPANDING, which makes it writable). A segment writes its first point's corners and tangent,
@@ -53,6 +53,24 @@ fn cs_expand_particles(@builtin(global_invocation_id) gid: vec3<u32>) {
         let c = particle_corners(unit, ii);
         for (var j = 0u; j < 4u; j++) {
             expanded[base + 4u * unit + j] = vec4<f32>(c[j], 1.0);
+        }
+    }
+}
+
+@compute @workgroup_size(EXPAND_GROUP)
+fn cs_expand_gaussians(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let unit = unit_of(gid);
+    if unit == OUTSIDE {
+        return;
+    }
+    for (var ii = chunk.set_instance; ii < chunk.set_instance + chunk.drawn / chunk.triangles; ii++) {
+        let base = expanded_base(ii);
+        let c = gaussian_corners(unit, ii);
+        // The splat's RGB rides in its first three corners' w (read by corner_of).
+        let rgb = gaussian_color(unit, ii);
+        let w = vec4<f32>(rgb, 1.0);
+        for (var j = 0u; j < 4u; j++) {
+            expanded[base + 4u * unit + j] = vec4<f32>(c[j], w[j]);
         }
     }
 }

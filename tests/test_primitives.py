@@ -239,7 +239,7 @@ def test_strands_upload_their_points_not_triangles(renderer):
     # built on the GPU each frame: two corners and a tangent a point (48 bytes).
     assert a.stats["expanded_bytes"] == 300 * 48 and b.stats["expanded_bytes"] == 0
     assert a.stats["scene_bytes"] - a.stats["expanded_bytes"] == 300 * 32 + 270 * 4
-    assert a.stats["scene_bytes_by_primitive"] == {"triangles": 0.0, "strands": a.stats["scene_bytes"], "particles": 0.0}
+    assert a.stats["scene_bytes_by_primitive"] == {"triangles": 0.0, "strands": a.stats["scene_bytes"], "particles": 0.0, "gaussians": 0.0}
     assert b.stats["scene_bytes"] >= 4 * (a.stats["scene_bytes"] - a.stats["expanded_bytes"])
     assert b.stats["scene_bytes"] > a.stats["scene_bytes"]
 

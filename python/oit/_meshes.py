@@ -51,7 +51,9 @@ class MeshArrays:
     # A strand or particle set instead of triangles (no indices; positions are its points):
     # {"kind": "strands", "counts": (strands,), "widths": (n,)} or {"kind": "particles",
     # "radii": (n,), "falloff": "hard" | "linear" | "gaussian"}; `surface` then holds
-    # add_strands' shading, specular, shininess and opacity, or add_particles' opacity.
+    # add_strands' shading, specular, shininess and opacity, or add_particles' opacity. Or a
+    # splat set: {"kind": "gaussians", "scales": (n, 3), "rotations": (n, 4), "sh": (n, k, 3)
+    # or None, "degree": int}, the opacities the colors' alpha (add_gaussians).
     primitive: dict[str, Any] | None = None
 
     def add_to(self, scene: Scene) -> int:
@@ -61,6 +63,14 @@ class MeshArrays:
             return scene.add_mesh(self.positions, self.indices, self.colors, opaque=self.opaque, **self.surface)
         if p["kind"] == "strands":
             return scene.add_strands(self.positions, p["counts"], p["widths"], self.colors, self.opaque, **self.surface)
+        if p["kind"] == "gaussians":
+            # The opacity is the colors' alpha; harmonics (n k, 3) replace their RGB where given.
+            col = np.broadcast_to(np.asarray(self.colors, np.float32).reshape(-1, 4), (len(self.positions), 4))
+            sh = p.get("sh")
+            if sh is not None:
+                sh = np.asarray(sh, np.float32).reshape(len(self.positions), -1, 3)
+            return scene.add_gaussians(self.positions, p["scales"], p["rotations"], col[:, 3],
+                                       None if sh is not None else col[:, :3], sh=sh)
         return scene.add_particles(self.positions, p["radii"], self.colors, self.opaque, falloff=p["falloff"], **self.surface)
 
     def triangles(self, camera: Camera) -> MeshArrays:

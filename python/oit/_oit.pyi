@@ -129,6 +129,18 @@ class Scene:
         opacity: float = 1.0,
     ) -> int:
         """A particle set: centers (n, 3), radii (n,) or (1,), colors (n, 4) or (1, 4) float32."""
+    def add_gaussians(
+        self,
+        means: npt.NDArray[np.float32],
+        scales: npt.NDArray[np.float32],
+        rotations: npt.NDArray[np.float32],
+        opacities: npt.NDArray[np.float32],
+        colors: npt.NDArray[np.float32],
+        sh: tuple[npt.NDArray[np.float32], int] | None = None,
+    ) -> int:
+        """A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
+        colors (n, 3) float32, each with n rows or one; or spherical harmonics `sh`, ((n k, 3)
+        coefficients, k = (degree + 1)², the DC first; degree), in place of the colors."""
     def to_triangles(
         self, mesh: int, view_proj: npt.NDArray[np.float64]
     ) -> tuple[

@@ -1,6 +1,7 @@
-"""Strands and particles on a Scene: polylines drawn as camera-facing ribbons and points drawn
-as camera-facing discs, both built on the GPU from the points (docs/methods.md, "Strands and
-particles"). Arguments are converted here; their values are checked in the core."""
+"""Strands, particles and Gaussian splats on a Scene: polylines drawn as camera-facing ribbons,
+points drawn as camera-facing discs and 3D Gaussians drawn as their projected ellipses, all built
+on the GPU from the points (docs/methods.md, "Strands and particles", "Gaussian splats").
+Arguments are converted here; their values are checked in the core."""
 
 from __future__ import annotations
 
@@ -65,8 +66,65 @@ class PrimitiveMethods:
         return self._native.add_particles(c, _sizes(radius, "radius"), _colors(colors, len(c), "particle"),
                                           _bool(opaque, "opaque"), falloff=falloff, opacity=float(opacity))
 
+    def add_gaussians(self, means: Any, scales: Any, rotations: Any, opacities: Any, colors: Any = None,
+                      sh: Any = None) -> int:
+        """Adds a set of 3D Gaussian splats (Kerbl et al. 2023) and returns its index (a mesh
+        index).
+
+        means: (n, 3) float; scales: (n, 3) standard deviations along each Gaussian's axes
+        (world units, > 0: not their logs, as a 3DGS file stores them); rotations: (n, 4) wxyz
+        quaternions (normalized here, nonzero); opacities: (n,) in [0, 1] (not logits);
+        colors: (n, 3) straight linear RGB in [0, 1], or (3,) for all, white when None; or
+        sh: (n, k, 3) spherical-harmonic coefficients of degree 0 to 3 (k = 1, 4, 9 or 16, the
+        DC first, 3DGS's basis) instead, the color 0.5 + sum Y_lm(d) c_lm in the direction d
+        from the eye to the mean, clamped to [0, 1]. Each row argument may also be one row for
+        all. A Gaussian is drawn as its EWA-projected
+        ellipse (a 0.3-pixel² low-pass added) on a 3-sigma quad built on the GPU, its alpha
+        opacity * exp(-d'Σ'⁻¹d / 2) at most 0.99 and 0 below 1/255 or past 3 sigma, at the depth
+        of its mean (docs/methods.md, "Gaussian splats").
+        """
+        m = _rows(_float_array(means, "means"), 3, "means")
+        n = len(m)
+
+        def per_splat(value: Any, cols: int, name: str, what: str) -> np.ndarray:
+            a = _float_array(value, name)
+            if a.shape == (cols,):
+                return a.reshape(1, cols)
+            if a.ndim != 2 or a.shape[1] != cols or len(a) not in (1, n):
+                raise ValueError(f"{name} must have shape ({n}, {cols}) (one {what} per splat) or ({cols},), got {a.shape}")
+            return a
+
+        s = per_splat(scales, 3, "scales", "standard deviation per axis")
+        if not (np.isfinite(s).all() and (s > 0).all()):
+            raise ValueError("scales must be finite and > 0 (standard deviations in world units); "
+                             "a 3DGS file stores their logs: pass np.exp(scales)")
+        q = per_splat(rotations, 4, "rotations", "wxyz quaternion")
+        if not np.isfinite(q).all() or (np.abs(q).sum(axis=1) == 0).any():
+            raise ValueError("rotations must be finite nonzero wxyz quaternions (they are normalized here)")
+        o = _float_array(opacities, "opacities").reshape(-1)
+        if len(o) not in (1, n):
+            raise ValueError(f"opacities must be one number or ({n},), got {len(o)} values")
+        if not ((o >= 0) & (o <= 1)).all():
+            raise ValueError("opacities must be in [0, 1]; a 3DGS file stores logits: pass 1 / (1 + np.exp(-opacity))")
+        c = per_splat(np.ones(3, dtype=np.float32) if colors is None else colors, 3, "colors", "RGB")
+        if not ((c >= 0) & (c <= 1)).all():
+            raise ValueError("colors must be straight linear RGB in [0, 1] (clip them: np.clip(colors, 0, 1))")
+        harmonics = None
+        if sh is not None:
+            if colors is not None:
+                raise ValueError("pass colors or sh, not both: sh's first coefficient is the color's (DC) part")
+            h = _float_array(sh, "sh")
+            degrees = {1: 0, 4: 1, 9: 2, 16: 3}
+            if h.ndim != 3 or h.shape[0] != n or h.shape[2] != 3 or h.shape[1] not in degrees:
+                raise ValueError(f"sh must have shape ({n}, k, 3) with k = 1, 4, 9 or 16 coefficients "
+                                 f"(degree 0 to 3), got {h.shape}")
+            if not np.isfinite(h).all():
+                raise ValueError("sh has NaN or Inf coefficients")
+            harmonics = (np.ascontiguousarray(h.reshape(-1, 3)), degrees[h.shape[1]])
+        return self._native.add_gaussians(m, s, q, np.ascontiguousarray(o), c, harmonics)
+
     def primitives(self) -> list[str]:
-        """What each mesh is: "triangles", "strands" or "particles"."""
+        """What each mesh is: "triangles", "strands", "particles" or "gaussians"."""
         return list(self._native.mesh_primitives())
 
     def to_triangles(self, mesh: int, camera: Any) -> dict[str, np.ndarray | None]:

@@ -32,7 +32,7 @@ class Stats(TypedDict, total=False):
     scene_bytes: int  # the scene's GPU buffers (one copy of each mesh, the instance table), apart from the frame's
     expanded_bytes: int  # the part of scene_bytes that strands and particles build on the GPU each frame, not uploaded
     texture_bytes: int  # the part of scene_bytes that textures take (each image once, with its mips, 4 bytes a texel)
-    scene_bytes_by_primitive: dict[str, float]  # scene_bytes as 'triangles' (meshes, materials, instances), 'strands' and 'particles'
+    scene_bytes_by_primitive: dict[str, float]  # scene_bytes by kind: 'triangles' (and instances), 'strands', 'particles', 'gaussians'
     gpu_time_ms: float | None  # the passes' GPU time; None where the adapter has no timestamp queries
     pass_times_ms: dict[str, float]  # GPU time per pass; a pass run more than once adds up
     overflow_fragments: int  # fragments a bounded structure could not hold

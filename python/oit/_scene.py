@@ -191,7 +191,8 @@ class Scene(PrimitiveMethods):
         (Kd, d or Tr, map_Kd, map_d), glTF/GLB (a mesh shared by nodes drawn as instances, every
         primitive, baseColorFactor and baseColorTexture, alphaMode and alphaCutoff, doubleSided:
         false culls back faces), PLY (vertex colors with alpha; a PLY of points only is a particle
-        set of hard discs of `point_radius`, by default 1/200 of its box's diagonal), STL, or a
+        set of hard discs of `point_radius`, by default 1/200 of its box's diagonal; one with 3D
+        Gaussian splatting's properties is a splat set, `add_gaussians`), STL, or a
         `.hair` strand model (oit.hairfile; shaded "hair", its thickness as the width). `alpha` makes every mesh
         transparent at it; `shading` ("smooth" with the file's normals, "flat" or "unlit") and
         `specular` style every surface. `scene.mesh_names` names the meshes, and

@@ -97,14 +97,14 @@ def _plural(n: int, one: str, many: str) -> str:
 
 def describe_contents(scene: Any) -> str:
     """What a scene draws, counted by primitive kind: "2 meshes (1200 triangles), 500 particles,
-    30 strands (600 points)": meshes as added, what they draw as many times as they are instanced."""
-    totals = {"triangles": [0, 0, 0], "particles": [0, 0, 0], "strands": [0, 0, 0]}
+    30 strands (600 points), 1000 splats": meshes as added, what they draw as many times as they are instanced."""
+    totals = {"triangles": [0, 0, 0], "particles": [0, 0, 0], "strands": [0, 0, 0], "gaussians": [0, 0, 0]}
     for i, (kind, (triangles, vertices, _)) in enumerate(zip(scene.primitives(), scene._native.mesh_summary())):
         n = max(1, len(scene._native.instances(i)[0]))
         t = totals[kind]
         # Particles: a quad (2 triangles) each; strands: 2 triangles a segment, one segment fewer than points.
         t[0] += 1
-        t[1] += n * (triangles if kind == "triangles" else vertices if kind == "particles" else vertices - triangles // 2)
+        t[1] += n * (triangles if kind == "triangles" else vertices - triangles // 2 if kind == "strands" else vertices)
         t[2] += n * vertices
     parts = []
     if totals["triangles"][0]:
@@ -113,6 +113,8 @@ def describe_contents(scene: Any) -> str:
         parts.append(_plural(totals["particles"][1], "particle", "particles"))
     if totals["strands"][0]:
         parts.append(_plural(totals["strands"][1], "strand", "strands") + f" ({_plural(totals['strands'][2], 'point', 'points')})")
+    if totals["gaussians"][0]:
+        parts.append(_plural(totals["gaussians"][1], "splat", "splats"))
     return ", ".join(parts) or "nothing to draw"
 
 

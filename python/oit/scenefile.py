@@ -92,11 +92,15 @@ def _record(i: int, m: MeshArrays, name: str) -> dict[str, Any]:
     primitive = None
     if m.primitive is not None:
         p, n = m.primitive, len(pos)
-        if p["kind"] not in ("strands", "particles"):
-            raise ValueError(f"primitive kind must be 'strands' or 'particles', got {p['kind']!r}")
-        size = p["widths"] if p["kind"] == "strands" else p["radii"]
-        primitive = {"kind": p["kind"], "counts": None, "falloff": p.get("falloff"),
-                     "sizes": np.ascontiguousarray(np.broadcast_to(np.asarray(size, np.float32).reshape(-1), (n,)))}
+        if p["kind"] not in ("strands", "particles", "gaussians"):
+            raise ValueError(f"primitive kind must be 'strands', 'particles' or 'gaussians', got {p['kind']!r}")
+        if p["kind"] == "gaussians":
+            primitive = _splat_record(p, n)
+        else:
+            size = p["widths"] if p["kind"] == "strands" else p["radii"]
+            primitive = {"kind": p["kind"], "counts": None, "falloff": p.get("falloff"),
+                         "sizes": np.ascontiguousarray(np.broadcast_to(np.asarray(size, np.float32).reshape(-1), (n,))),
+                         "scales": None, "rotations": None, "sh": None, "degree": None}
         if p["kind"] == "strands":
             primitive["counts"] = np.ascontiguousarray(p["counts"], dtype=np.uint32).reshape(-1)
     surface = None
@@ -107,6 +111,17 @@ def _record(i: int, m: MeshArrays, name: str) -> dict[str, Any]:
     return {"name": name, "opaque": bool(m.opaque), "positions": pos, "colors": col,
             "indices": np.ascontiguousarray(m.indices, dtype=np.uint32).reshape(-1, 3), "primitive": primitive,
             "surface": surface}
+
+
+def _splat_record(p: dict[str, Any], n: int) -> dict[str, Any]:
+    """A splat set's primitive record: scales (n, 3), rotations (n, 4), harmonics (n k, 3) or
+    None and their degree (the opacity is the colors' alpha)."""
+    rows = lambda a, k: np.ascontiguousarray(np.broadcast_to(np.asarray(a, np.float32).reshape(-1, k), (n, k)))  # noqa: E731
+    sh = p.get("sh")
+    if sh is not None:
+        sh = np.ascontiguousarray(np.asarray(sh, np.float32).reshape(-1, 3))
+    return {"kind": "gaussians", "counts": None, "falloff": None, "sizes": None, "scales": rows(p["scales"], 3),
+            "rotations": rows(p["rotations"], 4), "sh": sh, "degree": int(p.get("degree", 0))}
 
 
 def load_scene(path: str | os.PathLike) -> tuple[list, Any, tuple[int, int] | None]:

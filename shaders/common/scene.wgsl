@@ -36,8 +36,8 @@ struct Light {
 // Geometry is uploaded in chunks that each fit a binding: this chunk's first uploaded triangle
 // in the scene's order, its uploaded triangle count, its segments (common/setup.wgsl) and the
 // triangles drawn from it, instances included. Indices are local to the chunk.
-// A chunk holds meshes, or one strand or particle set (`kind`: PRIM_MESH, PRIM_STRANDS,
-// PRIM_PARTICLES; common/primitives.wgsl) whose material is the chunk's.
+// A chunk holds meshes, or one strand, particle or splat set (`kind`: PRIM_MESH, PRIM_STRANDS,
+// PRIM_PARTICLES, PRIM_GAUSSIANS; common/primitives.wgsl) whose material is the chunk's.
 struct Chunk {
     first_triangle: u32,
     triangles: u32,
@@ -203,6 +203,15 @@ fn placed_color(v: u32, ii: u32) -> vec4<f32> {
     return colors[v] * instances[ii].color;
 }
 
+fn placed_tint(ii: u32) -> vec4<f32> {
+    return instances[ii].color;
+}
+
+fn placed_linear(ii: u32) -> mat3x3<f32> {
+    let m = instances[ii].model;
+    return mat3x3<f32>(m[0].xyz, m[1].xyz, m[2].xyz);
+}
+
 fn placed_normal(n: vec3<f32>, ii: u32) -> vec3<f32> {
     let m = instances[ii].normal * n;
     return select(vec3<f32>(0.0), normalize(m), dot(m, m) > 0.0);
@@ -226,6 +235,14 @@ fn placed_at(p: vec3<f32>, ii: u32) -> vec4<f32> {
 
 fn placed_color(v: u32, ii: u32) -> vec4<f32> {
     return colors[v];
+}
+
+fn placed_tint(ii: u32) -> vec4<f32> {
+    return vec4<f32>(1.0);
+}
+
+fn placed_linear(ii: u32) -> mat3x3<f32> {
+    return mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
 }
 
 fn placed_normal(n: vec3<f32>, ii: u32) -> vec3<f32> {

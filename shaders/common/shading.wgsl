@@ -159,7 +159,12 @@ fn surface_base(in: VsOut, m0: vec4<f32>) -> vec4<f32> {
 //!endif
     base.a = base.a * m0.z;
 //!if FALLOFF
-    base.a = base.a * falloff((flags & FALLOFF_MASK) >> FALLOFF_SHIFT, in.uv);
+    let falloff_mode = (flags & FALLOFF_MASK) >> FALLOFF_SHIFT;
+    base.a = base.a * falloff(falloff_mode, in.uv);
+    if falloff_mode == FALLOFF_SPLAT {
+        // 3DGS's clamp (oit_core::splat::clamp_alpha).
+        base.a = select(min(base.a, SPLAT_ALPHA_MAX), 0.0, base.a < SPLAT_ALPHA_MIN);
+    }
 //!endif
 //!if ALPHA_TESTS
     if (flags & ALPHA_TEST) != 0u {

@@ -346,5 +346,17 @@ pub const SCAN_ADD: PipelineSpec = PipelineSpec::compute("scan.wgsl", "cs_add_bl
 /// entry point a kind.
 pub const EXPAND_STRANDS: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand_strands", &[Layout::Expand]);
 pub const EXPAND_PARTICLES: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand_particles", &[Layout::Expand]);
-pub const ENGINE_PIPELINES: &[PipelineSpec] =
-    &[OPAQUE, CENSUS_BLEND, CENSUS_ATOMIC, CENSUS_SAMPLES, BLIT, BLIT_SRGB, SCAN_BLOCKS, SCAN_ADD, EXPAND_STRANDS, EXPAND_PARTICLES];
+pub const EXPAND_GAUSSIANS: PipelineSpec = PipelineSpec::compute("expand.wgsl", "cs_expand_gaussians", &[Layout::Expand]);
+pub const ENGINE_PIPELINES: &[PipelineSpec] = &[
+    OPAQUE,
+    CENSUS_BLEND,
+    CENSUS_ATOMIC,
+    CENSUS_SAMPLES,
+    BLIT,
+    BLIT_SRGB,
+    SCAN_BLOCKS,
+    SCAN_ADD,
+    EXPAND_STRANDS,
+    EXPAND_PARTICLES,
+    EXPAND_GAUSSIANS,
+];

@@ -23,6 +23,7 @@ pub mod scene;
 pub mod scenefile;
 pub mod shader;
 pub mod shading;
+pub mod splat;
 pub mod stats;
 mod targets;
 pub mod tiles;

@@ -11,6 +11,7 @@ use crate::shading::{self, Material, Shading};
 pub const PRIM_MESH: u32 = 0;
 pub const PRIM_STRANDS: u32 = 1;
 pub const PRIM_PARTICLES: u32 = 2;
+pub const PRIM_GAUSSIANS: u32 = 3;
 
 /// How a mesh's triangles come about.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -23,6 +24,13 @@ pub enum Primitive {
     Strands { counts: Vec<u32>, widths: Vec<f32> },
     /// A disc per position of radius `radii` (per point, world units): a quad, two triangles.
     Particles { radii: Vec<f32> },
+    /// A Gaussian splat per position (its mean): standard deviations `scales` along its axes,
+    /// rotated by `rotations` (wxyz quaternions), its opacity the color's alpha; drawn as its
+    /// 3-sigma screen ellipse's quad, two triangles (src/splat.rs).
+    /// Where `sh` is not empty, the color is its spherical harmonics of degree `degree`
+    /// evaluated in the view direction ((degree + 1)² RGB coefficients a splat, the DC first;
+    /// `splat::sh_color`), and the colors' RGB only their DC part.
+    Gaussians { scales: Vec<[f32; 3]>, rotations: Vec<[f32; 4]>, sh: Vec<[f32; 3]>, degree: u32 },
 }
 
 impl Primitive {
@@ -32,6 +40,7 @@ impl Primitive {
             Self::Triangles => PRIM_MESH,
             Self::Strands { .. } => PRIM_STRANDS,
             Self::Particles { .. } => PRIM_PARTICLES,
+            Self::Gaussians { .. } => PRIM_GAUSSIANS,
         }
     }
 
@@ -40,6 +49,7 @@ impl Primitive {
             Self::Triangles => "triangles",
             Self::Strands { .. } => "strands",
             Self::Particles { .. } => "particles",
+            Self::Gaussians { .. } => "gaussians",
         }
     }
 }
@@ -130,7 +140,7 @@ impl Mesh {
         match &self.primitive {
             Primitive::Triangles => self.indices.len(),
             Primitive::Strands { counts, .. } => self.positions.len() - counts.len(),
-            Primitive::Particles { .. } => self.positions.len(),
+            Primitive::Particles { .. } | Primitive::Gaussians { .. } => self.positions.len(),
         }
     }
 

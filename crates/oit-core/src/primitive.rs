@@ -14,13 +14,22 @@ use crate::error::{invalid, Result};
 use crate::mesh::{Instance, Mesh};
 use crate::shading::{Falloff, Material, Shading};
 
-pub use crate::mesh::{Primitive, PRIM_MESH, PRIM_PARTICLES, PRIM_STRANDS};
+pub use crate::mesh::{Primitive, PRIM_GAUSSIANS, PRIM_MESH, PRIM_PARTICLES, PRIM_STRANDS};
 
 /// A strand segment's word: its first point within the chunk, and whether it is its strand's
 /// first segment (no point before it) or last (no point after it).
 pub const POINT_MASK: u32 = 0x3fff_ffff;
 pub const FIRST_SEGMENT: u32 = 0x4000_0000;
 pub const LAST_SEGMENT: u32 = 0x8000_0000;
+
+/// `values` with one entry expanded to `n`, or one per splat.
+fn one_each<T: Copy>(values: Vec<T>, n: usize, what: &str) -> Result<Vec<T>> {
+    match values.len() {
+        1 if n != 1 => Ok(vec![values[0]; n]),
+        k if k == n => Ok(values),
+        k => Err(invalid!("{what} has {k} rows for {n} splats: pass one per splat or a single one")),
+    }
+}
 
 /// `values` with one entry expanded to `n`, checked finite and > 0.
 fn per_point(mut values: Vec<f32>, n: usize, what: &str) -> Result<Vec<f32>> {
@@ -71,13 +80,83 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// A strand or particle set's surface: strands shade "unlit" or "hair" (from their tangent),
-    /// particles only "unlit". Opacity multiplies alpha.
+    /// A set of Gaussian splats (src/splat.rs): means, standard deviations along their axes
+    /// (`scales`, > 0), wxyz `rotations` (any nonzero length), `opacities` in [0, 1] and RGB
+    /// `colors` in [0, 1], each one per splat (or one for all).
+    pub fn gaussians(
+        means: Vec<[f32; 3]>,
+        scales: Vec<[f32; 3]>,
+        rotations: Vec<[f32; 4]>,
+        opacities: Vec<f32>,
+        colors: Vec<[f32; 3]>,
+    ) -> Result<Self> {
+        let n = means.len();
+        let scales = one_each(scales, n, "scales")?;
+        let rotations = one_each(rotations, n, "rotations")?;
+        let opacities = one_each(opacities, n, "opacities")?;
+        let colors = one_each(colors, n, "colors")?;
+        if let Some(i) = scales.iter().position(|s| s.iter().any(|x| !(x.is_finite() && *x > 0.0))) {
+            return Err(invalid!(
+                "scales[{i}] = {:?}: standard deviations must be finite and > 0 (world units; a 3DGS file stores their logs)",
+                scales[i]
+            ));
+        }
+        if let Some(i) = rotations.iter().position(|q| q.iter().any(|x| !x.is_finite()) || q.iter().all(|&x| x == 0.0)) {
+            return Err(invalid!("rotations[{i}] = {:?}: a rotation is a finite nonzero wxyz quaternion (normalized here)", rotations[i]));
+        }
+        if let Some(i) = opacities.iter().position(|o| !(0.0..=1.0).contains(o)) {
+            return Err(invalid!(
+                "opacities[{i}] = {} is outside [0, 1] (or NaN): a 3DGS file stores logits, pass their sigmoid",
+                opacities[i]
+            ));
+        }
+        let rgba = colors.iter().zip(&opacities).map(|(c, &o)| [c[0], c[1], c[2], o]).collect();
+        let mut mesh = Mesh::new(means, Vec::new(), rgba, false)?;
+        mesh.primitive = Primitive::Gaussians { scales, rotations, sh: Vec::new(), degree: 0 };
+        mesh.material.falloff = Falloff::Splat;
+        Ok(mesh)
+    }
+
+    /// Splats whose color is spherical harmonics of `degree` (0 to 3) in the view direction:
+    /// `sh` holds (degree + 1)² RGB coefficients a splat, splat after splat, the DC first, as
+    /// 3DGS stores them (color = 0.5 + Σ Y_lm(dir) c_lm clamped to [0, 1], `splat::sh_color`).
+    pub fn gaussians_sh(
+        means: Vec<[f32; 3]>,
+        scales: Vec<[f32; 3]>,
+        rotations: Vec<[f32; 4]>,
+        opacities: Vec<f32>,
+        sh: Vec<[f32; 3]>,
+        degree: u32,
+    ) -> Result<Self> {
+        if degree > 3 {
+            return Err(invalid!("sh degree {degree}: spherical harmonics of degree 0 to 3 (1, 4, 9 or 16 coefficients a splat)"));
+        }
+        let k = ((degree + 1) * (degree + 1)) as usize;
+        if sh.len() != k * means.len() {
+            return Err(invalid!(
+                "sh has {} coefficients for {} splats: pass {k} RGB coefficients a splat (degree {degree})",
+                sh.len(),
+                means.len()
+            ));
+        }
+        if let Some(i) = sh.iter().position(|c| c.iter().any(|x| !x.is_finite())) {
+            return Err(invalid!("sh coefficient {} of splat {} is not finite", i % k, i / k));
+        }
+        let dc = sh.chunks_exact(k).map(|c| c[0].map(|x| (0.5 + crate::splat::SH_C0 * x as f64).clamp(0.0, 1.0) as f32)).collect();
+        let mut mesh = Self::gaussians(means, scales, rotations, opacities, dc)?;
+        if let Primitive::Gaussians { sh: s, degree: d, .. } = &mut mesh.primitive {
+            (*s, *d) = (sh, degree);
+        }
+        Ok(mesh)
+    }
+
+    /// A strand, particle or splat set's surface: strands shade "unlit" or "hair" (from their
+    /// tangent), particles and splats only "unlit". Opacity multiplies alpha.
     pub fn with_primitive_surface(mut self, shading: Shading, specular: f32, shininess: f32, opacity: f32) -> Result<Self> {
         let allowed = match self.primitive {
             Primitive::Triangles => return Err(invalid!("with_primitive_surface is for strands and particles: use with_surface")),
             Primitive::Strands { .. } => matches!(shading, Shading::Unlit | Shading::Hair),
-            Primitive::Particles { .. } => shading == Shading::Unlit,
+            Primitive::Particles { .. } | Primitive::Gaussians { .. } => shading == Shading::Unlit,
         };
         if !allowed {
             let which = if matches!(self.primitive, Primitive::Strands { .. }) { "'unlit' or 'hair'" } else { "'unlit'" };
@@ -134,8 +213,9 @@ fn towards_eye(e: DVec4, p: DVec3) -> DVec3 {
 
 /// The triangles of a strand or particle set placed by `inst` under `camera`, three corners
 /// each in the drawn order (segment after segment, particle after particle; corners as
-/// `CORNERS`). A triangle mesh has none: its triangles are its own.
-pub fn expand(m: &Mesh, inst: &Instance, camera: &Camera) -> Vec<Corner> {
+/// `CORNERS`). A triangle mesh has none: its triangles are its own. Splats depend on the
+/// frame's `size` in pixels (their low-pass, src/splat.rs).
+pub fn expand(m: &Mesh, inst: &Instance, camera: &Camera, size: DVec2) -> Vec<Corner> {
     let e = eye(camera);
     let color = |i: usize| DVec4::from(m.colors[i].map(|x| x as f64)) * DVec4::from(inst.color.map(|x| x as f64));
     let mut out = Vec::new();
@@ -179,6 +259,27 @@ pub fn expand(m: &Mesh, inst: &Instance, camera: &Camera) -> Vec<Corner> {
                 }
             }
         }
+        Primitive::Gaussians { scales, rotations, sh, degree } => {
+            let inv = camera.view_proj.inverse();
+            let k = ((degree + 1) * (degree + 1)) as usize;
+            let linear = glam::DMat3::from_mat4(inst.transform);
+            for (i, (s, q)) in scales.iter().zip(rotations).enumerate() {
+                let mean = inst.apply(m.positions[i]);
+                let cov = linear * crate::splat::covariance(*s, *q) * linear.transpose();
+                let f = crate::splat::footprint(mean, &cov, &camera.view_proj, size);
+                let mut c = color(i);
+                if !sh.is_empty() {
+                    let rgb = crate::splat::sh_color(&sh[k * i..k * (i + 1)], crate::splat::view_direction(e, mean));
+                    c = (rgb * DVec4::from(inst.color.map(|x| x as f64)).truncate()).extend(c.w);
+                }
+                for (v, u) in CORNERS {
+                    let uv = DVec2::new(u as f64, 2.0 * v as f64 - 1.0);
+                    // Behind the eye: a point, no fragments (the GPU's too).
+                    let position = f.map_or(mean, |f| crate::splat::corner(&f, uv, &inv, size));
+                    out.push(Corner { position, color: c, tangent: DVec3::ZERO, uv });
+                }
+            }
+        }
     }
     out
 }
@@ -198,12 +299,13 @@ fn disc_axes(d: DVec3, up_hint: DVec3) -> (DVec3, DVec3) {
 /// A strand or particle set as a triangle mesh under `camera` (world space, its identity
 /// placement): each triangle with its own three corners, the tangents as normals (what
 /// `Shading::Hair` reads), the disc coordinates as UVs and the set's material, so that it
-/// renders as the set does. A triangle mesh is returned as it is.
-pub fn to_triangles(m: &Mesh, camera: &Camera) -> Mesh {
+/// renders as the set does, on a frame of `size` pixels (splats' low-pass). A triangle mesh is
+/// returned as it is.
+pub fn to_triangles(m: &Mesh, camera: &Camera, size: DVec2) -> Mesh {
     if m.primitive == Primitive::Triangles {
         return m.clone();
     }
-    let corners = expand(m, &Instance::IDENTITY, camera);
+    let corners = expand(m, &Instance::IDENTITY, camera, size);
     let f = |v: DVec3| v.as_vec3().to_array();
     Mesh {
         positions: corners.iter().map(|c| f(c.position)).collect(),
@@ -237,7 +339,7 @@ mod tests {
     #[test]
     fn ribbons_share_their_joint_corners_and_face_the_eye() {
         let m = Mesh::strands(vec![[-1.0, 0.0, 0.0], [0.0, 0.2, 0.0], [1.0, 0.0, 0.0]], vec![3], vec![0.1], vec![[1.0; 4]], false).unwrap();
-        let c = expand(&m, &Instance::IDENTITY, &camera());
+        let c = expand(&m, &Instance::IDENTITY, &camera(), DVec2::splat(100.0));
         assert_eq!(c.len(), 12);
         // Segment 0's far end (corners 2, 3, 5) is segment 1's near end (corners 6, 7, 10).
         assert_eq!(c[2].position, c[6].position);
@@ -255,7 +357,7 @@ mod tests {
     #[test]
     fn particles_are_discs_facing_the_eye() {
         let m = Mesh::particles(vec![[0.5, 0.0, 0.0]], vec![0.25], vec![[1.0; 4]], false, Falloff::Linear).unwrap();
-        let c = expand(&m, &Instance::IDENTITY, &camera());
+        let c = expand(&m, &Instance::IDENTITY, &camera(), DVec2::splat(100.0));
         let to_eye = (DVec3::new(0.0, 0.0, 3.0) - DVec3::new(0.5, 0.0, 0.0)).normalize();
         for k in &c {
             let off = k.position - DVec3::new(0.5, 0.0, 0.0);
@@ -271,5 +373,22 @@ mod tests {
         assert!(bad(Mesh::strands(vec![[0.0; 3]; 3], vec![2], vec![1.0], vec![[1.0; 4]], false)).contains("add up to 2"));
         assert!(bad(Mesh::strands(vec![[0.0; 3]; 2], vec![2], vec![0.0], vec![[1.0; 4]], false)).contains("> 0"));
         assert!(bad(Mesh::particles(vec![[0.0; 3]; 2], vec![1.0; 3], vec![[1.0; 4]], false, Falloff::Hard)).contains("3 entries"));
+    }
+
+    #[test]
+    fn bad_gaussians_are_refused_with_what_to_do() {
+        let g = |mean: [f32; 3], s: [f32; 3], q: [f32; 4], o: f32, n: usize| {
+            Mesh::gaussians(vec![mean; 2], vec![s; n], vec![q], vec![o], vec![[1.0; 3]]).unwrap_err().to_string()
+        };
+        let (ok_s, ok_q) = ([1.0; 3], [1.0, 0.0, 0.0, 0.0]);
+        assert!(g([f32::NAN, 0.0, 0.0], ok_s, ok_q, 0.5, 1).contains("not finite"));
+        assert!(g([0.0; 3], [1.0, 0.0, 1.0], ok_q, 0.5, 1).contains("> 0"));
+        assert!(g([0.0; 3], [1.0, f32::NAN, 1.0], ok_q, 0.5, 1).contains("> 0"));
+        assert!(g([0.0; 3], ok_s, [0.0; 4], 0.5, 1).contains("nonzero"));
+        assert!(g([0.0; 3], ok_s, ok_q, 1.5, 1).contains("[0, 1]"));
+        assert!(g([0.0; 3], ok_s, ok_q, f32::NAN, 1).contains("[0, 1]"));
+        assert!(g([0.0; 3], ok_s, ok_q, 0.5, 3).contains("3 rows for 2 splats"));
+        let m = Mesh::gaussians(vec![[0.0; 3]; 2], vec![[1.0; 3]], vec![[2.0, 0.0, 0.0, 0.0]], vec![0.5], vec![[1.0; 3]]).unwrap();
+        assert_eq!((m.triangle_count(), m.colors[1]), (4, [1.0, 1.0, 1.0, 0.5]));
     }
 }

@@ -156,7 +156,7 @@ pub fn reference_antialiased(
         for inst in instances {
             if m.primitive != crate::primitive::Primitive::Triangles {
                 // Strands and particles: the triangles the vertex stage builds, in float64.
-                for c in crate::primitive::expand(m, inst, camera).chunks_exact(3) {
+                for c in crate::primitive::expand(m, inst, camera, DVec2::new(width as f64, height as f64)).chunks_exact(3) {
                     let c = [c[0], c[1], c[2]];
                     let (v, c, n, uv) = (c.map(|k| k.position), c.map(|k| k.color), c.map(|k| k.tangent), c.map(|k| k.uv));
                     tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull: false, mirror: false, back: false });

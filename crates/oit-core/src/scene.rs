@@ -104,6 +104,18 @@ impl Scene {
     }
 
     /// Adds a mesh drawn once for each of `instances` (none: uploaded, not drawn).
+    /// A set of Gaussian splats (`Mesh::gaussians`, src/splat.rs), after the meshes so far.
+    pub fn add_gaussians(
+        &mut self,
+        means: Vec<[f32; 3]>,
+        scales: Vec<[f32; 3]>,
+        rotations: Vec<[f32; 4]>,
+        opacities: Vec<f32>,
+        colors: Vec<[f32; 3]>,
+    ) -> Result<usize> {
+        Ok(self.add_mesh(Mesh::gaussians(means, scales, rotations, opacities, colors)?))
+    }
+
     pub fn add_placed(&mut self, mesh: Mesh, instances: Vec<Instance>) -> usize {
         self.meshes.push(mesh);
         self.instances.push(instances);

@@ -42,6 +42,28 @@ pub(crate) fn particles(
     surfaced(mesh, &Look { shading: "unlit".into(), specular: 0.0, shininess: 32.0, opacity })
 }
 
+/// A splat set's spherical harmonics: (n k, 3) RGB coefficients, the DC first, and their degree.
+pub(crate) type Harmonics<'py> = (PyReadonlyArray2<'py, f32>, u32);
+
+/// A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
+/// colors (n, 3), each row count n or 1; its color from `sh` instead where given.
+pub(crate) fn gaussians(
+    means: &PyReadonlyArray2<'_, f32>,
+    scales: &PyReadonlyArray2<'_, f32>,
+    rotations: &PyReadonlyArray2<'_, f32>,
+    opacities: &PyReadonlyArray1<'_, f32>,
+    colors: &PyReadonlyArray2<'_, f32>,
+    sh: Option<&Harmonics<'_>>,
+) -> PyResult<oit_core::Mesh> {
+    let (means, scales, rotations) = (rows(means, "means")?, rows(scales, "scales")?, rows(rotations, "rotations")?);
+    let opacities = opacities.as_array().to_vec();
+    let mesh = match sh {
+        None => oit_core::Mesh::gaussians(means, scales, rotations, opacities, rows(colors, "colors")?),
+        Some((sh, degree)) => oit_core::Mesh::gaussians_sh(means, scales, rotations, opacities, rows(sh, "sh")?, *degree),
+    };
+    Ok(mesh.map_err(Error::from)?)
+}
+
 /// Positions (n, 3), indices (m, 3), colors (n, 4), normals (n, 3) or None, uvs (n, 2) or None.
 pub(crate) type TriangleArrays<'py> = (
     Bound<'py, numpy::PyArray2<f32>>,
@@ -58,7 +80,8 @@ pub(crate) fn to_triangles<'py>(
     view_proj: &PyReadonlyArray2<'_, f64>,
 ) -> PyResult<TriangleArrays<'py>> {
     let camera = oit_core::Camera::from_rows(matrix(view_proj, "camera matrix")?).map_err(Error::from)?;
-    let m = oit_core::primitive::to_triangles(mesh, &camera);
+    // Splats take their low-pass as on a 1024 x 1024 frame (the camera carries no size).
+    let m = oit_core::primitive::to_triangles(mesh, &camera, glam::DVec2::splat(1024.0));
     let optional = |v: Bound<'py, numpy::PyArray2<f32>>, empty: bool| (!empty).then_some(v);
     Ok((
         array(py, &m.positions),

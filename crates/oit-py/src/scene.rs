@@ -80,6 +80,22 @@ impl Scene {
         Ok(self.inner.add_mesh(primitives::particles(&centers, &radii, &colors, opaque, falloff, opacity)?))
     }
 
+    /// A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
+    /// colors (n, 3) float32, each with n rows or one; or spherical harmonics `sh`, ((n k, 3)
+    /// coefficients, k = (degree + 1)², the DC first; degree), in place of the colors.
+    #[pyo3(signature = (means, scales, rotations, opacities, colors, sh=None))]
+    fn add_gaussians(
+        &mut self,
+        means: PyReadonlyArray2<'_, f32>,
+        scales: PyReadonlyArray2<'_, f32>,
+        rotations: PyReadonlyArray2<'_, f32>,
+        opacities: PyReadonlyArray1<'_, f32>,
+        colors: PyReadonlyArray2<'_, f32>,
+        sh: Option<primitives::Harmonics<'_>>,
+    ) -> PyResult<usize> {
+        Ok(self.inner.add_mesh(primitives::gaussians(&means, &scales, &rotations, &opacities, &colors, sh.as_ref())?))
+    }
+
     /// Mesh `mesh` as the triangles it is drawn as under `view_proj`.
     fn to_triangles<'py>(
         &self,

@@ -28,15 +28,20 @@ pub(crate) struct MeshRecord<'py> {
     surface: Option<Surface<'py>>,
 }
 
-/// A strand set ("strands": counts, and widths as `sizes`) or a particle set ("particles":
-/// falloff, and radii as `sizes`); one size a point.
+/// A strand set ("strands": counts, and widths as `sizes`), a particle set ("particles":
+/// falloff, and radii as `sizes`; one size a point) or a splat set ("gaussians": scales,
+/// rotations, and harmonics `sh` (n k, 3) of `degree` or none).
 #[derive(FromPyObject)]
 #[pyo3(from_item_all)]
 struct PrimitiveRecord<'py> {
     kind: String,
     counts: Option<PyReadonlyArray1<'py, u32>>,
     falloff: Option<String>,
-    sizes: PyReadonlyArray1<'py, f32>,
+    sizes: Option<PyReadonlyArray1<'py, f32>>,
+    scales: Option<PyReadonlyArray2<'py, f32>>,
+    rotations: Option<PyReadonlyArray2<'py, f32>>,
+    sh: Option<PyReadonlyArray2<'py, f32>>,
+    degree: Option<u32>,
 }
 
 /// A camera as the file has it: 1 and the 16 values of a row-major view-projection, or 2 and
@@ -51,14 +56,27 @@ fn mesh_record(m: MeshRecord<'_>) -> PyResult<FileMesh> {
     let n = positions.len();
     let primitive = match m.primitive {
         None => FilePrimitive::Triangles,
+        Some(PrimitiveRecord { kind, scales: Some(scales), rotations: Some(rotations), sh, degree, .. }) if kind == "gaussians" => {
+            let sh = sh.map(|s| rows(&s, "sh")).transpose()?.unwrap_or_default();
+            FilePrimitive::Gaussians {
+                scales: rows(&scales, "scales")?,
+                rotations: rows(&rotations, "rotations")?,
+                sh,
+                degree: degree.unwrap_or(0),
+            }
+        }
         Some(p) => {
-            let sizes = p.sizes.as_array().to_vec();
+            let sizes = p.sizes.map(|s| s.as_array().to_vec()).unwrap_or_default();
             match (p.kind.as_str(), p.counts, p.falloff) {
                 ("strands", Some(counts), _) => FilePrimitive::Strands { counts: counts.as_array().to_vec(), widths: sizes },
                 ("particles", _, Some(falloff)) => {
                     FilePrimitive::Particles { falloff: Falloff::from_name(&falloff).map_err(Error::from)?, radii: sizes }
                 }
-                (kind, ..) => return Err(PyValueError::new_err(format!("primitive kind must be 'strands' or 'particles', got '{kind}'"))),
+                (kind, ..) => {
+                    return Err(PyValueError::new_err(format!(
+                        "primitive kind must be 'strands', 'particles' or 'gaussians' (with scales and rotations), got '{kind}'"
+                    )))
+                }
             }
         }
     };
@@ -128,6 +146,15 @@ fn mesh_dict<'py>(py: Python<'py>, m: &FileMesh) -> PyResult<Bound<'py, PyDict>>
             p.set_item("kind", "particles")?;
             p.set_item("radii", radii.clone().into_pyarray(py))?;
             p.set_item("falloff", falloff.name())?;
+            Some(p)
+        }
+        FilePrimitive::Gaussians { scales, rotations, sh, degree } => {
+            let p = PyDict::new(py);
+            p.set_item("kind", "gaussians")?;
+            p.set_item("scales", array(py, scales))?;
+            p.set_item("rotations", array(py, rotations))?;
+            p.set_item("sh", (!sh.is_empty()).then(|| array(py, sh)))?;
+            p.set_item("degree", *degree)?;
             Some(p)
         }
     };

@@ -141,7 +141,8 @@ pub fn load_file(path: &Path, surface: Surface) -> Result<LoadedFile> {
         "gltf" | "glb" => gltf::load_with(path, surface.point_radius).map_err(fail)?,
         _ => return Err(invalid!("{}: unknown file type '.{ext}': oit reads {FORMATS}", path.display())),
     };
-    if ext == "ply" && file.meshes.iter().all(|m| m.mesh.indices.is_empty() && !m.mesh.positions.is_empty()) {
+    let points = |m: &Mesh| m.indices.is_empty() && !m.positions.is_empty() && m.primitive == crate::primitive::Primitive::Triangles;
+    if ext == "ply" && file.meshes.iter().all(|m| points(&m.mesh)) {
         // A point cloud: hard discs facing the eye, one a point.
         for m in &mut file.meshes {
             m.mesh = points_as_particles(std::mem::take(&mut m.mesh), surface.point_radius).map_err(|e| fail(e.to_string().into()))?;

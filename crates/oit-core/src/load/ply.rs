@@ -3,9 +3,10 @@
 //! file has before anything is allocated for it. Vertex and face colors with alpha (integer
 //! ones are sRGB, float ones linear; a face's color wins over its vertices', and vertices
 //! shared by faces of different colors are split), vertex normals; polygons fanned into
-//! triangles. A PLY of points only becomes particles in `load_file`. The header is
-//! ply/header.rs.
+//! triangles. A PLY of points only becomes particles in `load_file`; one with the 3DGS
+//! properties becomes Gaussian splats (ply/gaussians.rs). The header is ply/header.rs.
 
+mod gaussians;
 mod header;
 
 use std::io::Read;
@@ -141,6 +142,7 @@ fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
         return Err(format!("{vertex_count} vertices are more than a mesh holds ({})", u32::MAX - 1).into());
     }
     let mut vertices = None;
+    let mut splats: Option<gaussians::Splats> = None;
     let mut indices: Vec<[u32; 3]> = Vec::new();
     // The color of each triangle, where faces have colors.
     let mut face_colors: Vec<[f32; 4]> = Vec::new();
@@ -156,7 +158,15 @@ fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
             (has_rgb || (alpha.is_some() && e.name == "vertex")).then_some((rgb, alpha))
         };
         values.resize(props.len(), 0.0);
-        if e.name == "vertex" && vertices.is_none() {
+        let layout = (e.name == "vertex" && splats.is_none()).then(|| gaussians::SplatLayout::find(e)).flatten();
+        if let Some(layout) = layout {
+            let mut out = gaussians::Splats::default();
+            for i in 0..e.count {
+                read_item(&mut input, e, format, &mut values, &mut list).map_err(|m| at(&input, "vertex", i, m))?;
+                layout.push(&values, &mut out);
+            }
+            splats = Some(out);
+        } else if e.name == "vertex" && vertices.is_none() {
             let xyz = ["x", "y", "z"].map(|n| e.find(&[n]));
             let [Some(x), Some(y), Some(z)] = xyz else { return Err("vertices need x, y and z".into()) };
             let normal = ["nx", "ny", "nz"].map(|n| e.find(&[n]));
@@ -206,6 +216,14 @@ fn parse(r: impl Read, len: u64, name: String) -> Result<NamedMesh, LoadError> {
                 read_item(&mut input, e, format, &mut values, &mut list).map_err(|m| at(&input, &e.name, i, m))?;
             }
         }
+    }
+    if let Some(s) = splats {
+        let mesh = match s.sh.is_empty() {
+            true => crate::scene::Mesh::gaussians(s.means, s.scales, s.rotations, s.opacities, s.colors),
+            false => crate::scene::Mesh::gaussians_sh(s.means, s.scales, s.rotations, s.opacities, s.sh, s.degree),
+        };
+        let mesh = mesh.map_err(|e| format!("'{name}': {e}"))?;
+        return Ok(super::NamedMesh::new(name, mesh));
     }
     let Some(mut v) = vertices else { return Err("no 'vertex' element".into()) };
     if !face_colors.is_empty() {

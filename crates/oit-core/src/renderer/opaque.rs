@@ -7,7 +7,7 @@ use super::execute::Job;
 use super::Renderer;
 use crate::antialias;
 use crate::bindings::COLOR_FORMAT;
-use crate::cache::{Draw, EXPAND_PARTICLES, EXPAND_STRANDS, OPAQUE};
+use crate::cache::{Draw, EXPAND_GAUSSIANS, EXPAND_PARTICLES, EXPAND_STRANDS, OPAQUE};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::gpu_types::{FrameUniform, GpuLight};
@@ -38,15 +38,19 @@ impl Renderer {
         let Some((_, scene)) = self.scene.as_ref().filter(|(_, s)| s.primitives) else { return Ok(None) };
         // The corners depend on the uploaded scene and on the two matrices the uniform carries;
         // a scene that changes is uploaded again (GpuScene::new, which forgets the view).
-        let view = expansion_view(camera);
+        let view = expansion_view(camera, (w, h));
         if scene.expanded_view.get() == Some(view) {
             return Ok(None);
         }
         self.set_uniform(camera, scene, bg, Tile::frame(w, h));
         let consts = self.variant(scene).consts();
         // Compiled for the kinds the scene has (the cache keeps them).
-        let pipeline = |strands: bool| {
-            let spec = if strands { &EXPAND_STRANDS } else { &EXPAND_PARTICLES };
+        let pipeline = |kind: u32| {
+            let spec = match kind {
+                crate::primitive::PRIM_STRANDS => &EXPAND_STRANDS,
+                crate::primitive::PRIM_GAUSSIANS => &EXPAND_GAUSSIANS,
+                _ => &EXPAND_PARTICLES,
+            };
             self.gpu.cache.compute(&self.gpu.device, &spec.compute_desc(&consts))
         };
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
@@ -162,8 +166,10 @@ impl Renderer {
 
 /// What the expansion reads of the camera, as the frame uniform carries it: the view-projection
 /// and its inverse, float32 bits (their equality is the corners').
-fn expansion_view(camera: &Camera) -> [u32; 32] {
-    let mut bits = [0u32; 32];
+fn expansion_view(camera: &Camera, size: (u32, u32)) -> [u32; 34] {
+    let mut bits = [0u32; 34];
+    // Splats' footprints depend on the frame's size too (their low-pass is in pixels).
+    (bits[32], bits[33]) = size;
     let a = camera.matrix_f32().to_cols_array();
     let b = camera.view_proj.inverse().as_mat4().to_cols_array();
     for (o, v) in bits.iter_mut().zip(a.iter().chain(&b)) {

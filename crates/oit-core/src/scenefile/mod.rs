@@ -41,6 +41,14 @@ pub enum FilePrimitive {
         falloff: Falloff,
         radii: Vec<f32>,
     },
+    /// Gaussian splats: standard deviations and wxyz rotations (their opacity is the colors' alpha).
+    /// Spherical harmonics of `degree` where `sh` is not empty ((degree + 1)² a splat).
+    Gaussians {
+        scales: Vec<[f32; 3]>,
+        rotations: Vec<[f32; 4]>,
+        sh: Vec<[f32; 3]>,
+        degree: u32,
+    },
 }
 
 /// A base color texture as the file stores it: linear RGBA, row 0 first.
@@ -143,6 +151,13 @@ impl SceneFile {
                 FilePrimitive::Particles { falloff, radii } => {
                     w.u32s(&[2, falloff.code()]);
                     w.pod(radii);
+                }
+                FilePrimitive::Gaussians { scales, rotations, sh, degree } => {
+                    // The block's value: 0 without harmonics, else their degree + 1.
+                    w.u32s(&[3, if sh.is_empty() { 0 } else { degree + 1 }]);
+                    w.pod(scales);
+                    w.pod(rotations);
+                    w.pod(sh);
                 }
             }
             if let Some(s) = &m.surface {
@@ -248,7 +263,20 @@ fn read_primitive(r: &mut Reader<'_>, n: usize) -> Result<FilePrimitive> {
             };
             Ok(FilePrimitive::Particles { falloff, radii: r.array(n, "the radii")? })
         }
-        k => Err(invalid!("unknown primitive kind {k} (1: strands, 2: particles)")),
+        3 => {
+            let (scales, rotations) = (r.array(n, "the scales")?, r.array(n, "the rotations")?);
+            if value > 4 {
+                return Err(invalid!("spherical harmonics of degree {}: 0 to 3 are read", value - 1));
+            }
+            let k = if value == 0 { 0 } else { (value * value) as usize };
+            Ok(FilePrimitive::Gaussians {
+                scales,
+                rotations,
+                sh: r.array(n.saturating_mul(k), "the harmonics")?,
+                degree: value.saturating_sub(1),
+            })
+        }
+        k => Err(invalid!("unknown primitive kind {k} (1: strands, 2: particles, 3: gaussians)")),
     }
 }
 
@@ -294,6 +322,15 @@ impl FileMesh {
             FilePrimitive::Particles { falloff, radii } => {
                 Mesh::particles(self.positions.clone(), radii.clone(), self.colors.clone(), self.opaque, *falloff)
             }
+            FilePrimitive::Gaussians { scales, rotations, sh, degree } => {
+                let opacities = self.colors.iter().map(|c| c[3]).collect();
+                let rgb = self.colors.iter().map(|c| [c[0], c[1], c[2]]).collect();
+                let (p, s, q) = (self.positions.clone(), scales.clone(), rotations.clone());
+                match sh.is_empty() {
+                    true => Mesh::gaussians(p, s, q, opacities, rgb),
+                    false => Mesh::gaussians_sh(p, s, q, opacities, sh.clone(), *degree),
+                }
+            }
         }?;
         let Some(s) = &self.surface else { return Ok(mesh) };
         let texture = match &s.texture {
@@ -330,6 +367,9 @@ impl FileMesh {
             Primitive::Triangles => FilePrimitive::Triangles,
             Primitive::Strands { counts, widths } => FilePrimitive::Strands { counts: counts.clone(), widths: widths.clone() },
             Primitive::Particles { radii } => FilePrimitive::Particles { falloff: mat.falloff, radii: radii.clone() },
+            Primitive::Gaussians { scales, rotations, sh, degree } => {
+                FilePrimitive::Gaussians { scales: scales.clone(), rotations: rotations.clone(), sh: sh.clone(), degree: *degree }
+            }
         };
         let surfaced = !mat.is_plain_surface() || !m.normals.is_empty() || !m.uvs.is_empty();
         let surface = surfaced.then(|| FileSurface {

@@ -28,11 +28,11 @@ pub const CULL_BACK: u32 = 0x400;
 /// The material has an emissive texture (multiplying its emissive color).
 pub const EMISSIVE_TEXTURED: u32 = 0x800;
 /// The material's alpha is tested against its cutoff (glTF's MASK).
-pub const ALPHA_TEST: u32 = 0x4000;
-/// A particle's falloff (`Falloff::code`) in bits 12 and 13: its alpha times a function of the
-/// distance from its center (uv, the disc coordinates); 0 for every other surface.
+pub const ALPHA_TEST: u32 = 0x8000;
+/// A particle's or splat's falloff (`Falloff::code`) in bits 12 to 14: its alpha times a
+/// function of the distance from its center (uv, the disc coordinates); 0 for every other surface.
 pub const FALLOFF_SHIFT: u32 = 12;
-pub const FALLOFF_MASK: u32 = 0x3000;
+pub const FALLOFF_MASK: u32 = 0x7000;
 
 /// How a mesh's normal is found; `Unlit` keeps the vertex color (times texture and opacity).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -98,6 +98,9 @@ pub enum Falloff {
     Linear,
     /// exp(-r² / (2σ²)) with σ = 1/3 (the rim at 3σ, where it is 0.011), cut at the rim.
     Gaussian,
+    /// A Gaussian splat's (src/splat.rs): `Gaussian`'s factor, then the alpha it gives
+    /// clamped as 3DGS does (`splat::clamp_alpha`). Set by `Mesh::gaussians` alone.
+    Splat,
 }
 
 impl Falloff {
@@ -116,6 +119,7 @@ impl Falloff {
             Self::Hard => "hard",
             Self::Linear => "linear",
             Self::Gaussian => "gaussian",
+            Self::Splat => "splat",
         }
     }
 
@@ -132,7 +136,7 @@ impl Falloff {
             Self::None => (1.0, false),
             Self::Hard => (if inside { 1.0 } else { 0.0 }, (r2 - 1.0).abs() < 1e-5),
             Self::Linear => (if inside { 1.0 - r2.sqrt() } else { 0.0 }, false),
-            Self::Gaussian => (if inside { (-4.5 * r2).exp() } else { 0.0 }, (r2 - 1.0).abs() < 1e-5),
+            Self::Gaussian | Self::Splat => (if inside { (-4.5 * r2).exp() } else { 0.0 }, (r2 - 1.0).abs() < 1e-5),
         }
     }
 }

@@ -79,6 +79,10 @@ pub fn shade(s: &SurfacePoint<'_>, lighting: &Lighting) -> (DVec4, bool) {
     let (falloff, rim) = m.falloff.factor(s.uv);
     ambiguous |= rim;
     base.w *= falloff;
+    if m.falloff == super::Falloff::Splat {
+        let (alpha, cut) = crate::splat::clamp_alpha(base.w);
+        (base.w, ambiguous) = (alpha, ambiguous | cut);
+    }
     if let Some(cutoff) = m.alpha_cutoff {
         // float32 (and its UVs, a fraction of a pixel off) may land on the other side of the
         // cutoff: an ambiguous pixel.

@@ -150,9 +150,9 @@ stats_table! {
         texture_bytes: u64, "int", First, plain,
             "the part of scene_bytes that textures take (each image once, with its mips, 4 bytes a texel)";
         /// By what uploaded them: meshes (with materials, textures and instance tables), strand
-        /// sets, particle sets.
-        scene_bytes_by_primitive: [u64; 3], "dict[str, float]", First, by_primitive,
-            "scene_bytes as 'triangles' (meshes, materials, instances), 'strands' and 'particles'";
+        /// sets, particle sets, splat sets.
+        scene_bytes_by_primitive: [u64; 4], "dict[str, float]", First, by_primitive,
+            "scene_bytes by kind: 'triangles' (and instances), 'strands', 'particles', 'gaussians'";
         gpu_time_ms: Option<f64>, "float | None", Sum, plain,
             "the passes' GPU time; None where the adapter has no timestamp queries";
         pass_times_ms: Vec<(&'static str, f64)>, "dict[str, float]", Sum, summed,

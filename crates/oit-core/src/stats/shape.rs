@@ -20,8 +20,9 @@ pub(super) fn if_some(_: &Stats, v: &Option<f64>) -> Option<StatValue<'static>> 
 }
 
 /// Bytes by primitive kind as named numbers.
-pub(super) fn by_primitive(_: &Stats, b: &[u64; 3]) -> Option<StatValue<'static>> {
-    Some(StatValue::Numbers(vec![("triangles", b[0] as f64), ("strands", b[1] as f64), ("particles", b[2] as f64)]))
+pub(super) fn by_primitive(_: &Stats, b: &[u64; 4]) -> Option<StatValue<'static>> {
+    let names = ["triangles", "strands", "particles", "gaussians"];
+    Some(StatValue::Numbers(names.iter().zip(b).map(|(&n, &v)| (n, v as f64)).collect()))
 }
 
 /// Named numbers with repeats added up, in the order of first appearance (a pass that ran

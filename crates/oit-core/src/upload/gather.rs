@@ -3,8 +3,11 @@
 //! where a mesh's triangles went.
 
 use crate::error::{OitError, Result};
-use crate::primitive::{self, Primitive, PRIM_MESH, PRIM_PARTICLES, PRIM_STRANDS};
+use crate::primitive::{self, Primitive, PRIM_GAUSSIANS, PRIM_MESH, PRIM_PARTICLES, PRIM_STRANDS};
 use crate::scene::Mesh;
+
+/// Floats of `positions` a splat (shaders/common/primitives.wgsl reads them).
+pub const SPLAT_FLOATS: u32 = 12;
 
 /// A mesh's triangles within one chunk: local triangles `lo .. hi`.
 #[derive(Clone, Copy, Debug)]
@@ -15,7 +18,8 @@ pub struct Segment {
 }
 
 /// Chunk contents on the host while they are gathered. A chunk of strands or particles
-/// (`kind`) holds one set's points (x, y, z and half the width or the radius), their colors,
+/// (`kind`) holds one set's points (x, y, z and half the width or the radius; a splat's mean,
+/// 0, then its covariance's upper triangle and two zeros: `SPLAT_FLOATS`), their colors,
 /// and for strands a word a segment (`primitive::segment_words`) where a mesh chunk has its
 /// indices; the set's material is the chunk's.
 #[derive(Default)]
@@ -33,6 +37,8 @@ pub(super) struct Gather {
     /// `expanded` holds its corners once an instance.
     pub set_instance: u32,
     pub set_instances: u32,
+    /// A splat set's spherical-harmonic coefficients a splat (0: none, its colors).
+    pub splat_sh: u32,
 }
 
 impl Gather {
@@ -43,7 +49,7 @@ impl Gather {
     pub fn triangles(&self) -> u32 {
         match self.kind {
             PRIM_STRANDS => 2 * self.indices.len() as u32,
-            PRIM_PARTICLES => 2 * self.colors.len() as u32,
+            PRIM_PARTICLES | PRIM_GAUSSIANS => 2 * self.colors.len() as u32,
             _ => (self.indices.len() / 3) as u32,
         }
     }
@@ -53,6 +59,7 @@ impl Gather {
     pub fn next(&self, kind: u32, material: u32) -> Gather {
         let (set_instance, set_instances) = if kind == PRIM_MESH { (0, 0) } else { (self.set_instance, self.set_instances) };
         Gather {
+            splat_sh: if kind == PRIM_MESH { 0 } else { self.splat_sh },
             first_triangle: self.first_triangle + self.triangles(),
             shaded: self.shaded,
             kind,
@@ -68,8 +75,17 @@ impl Gather {
     pub fn expanded_per_point(&self) -> u64 {
         match self.kind {
             PRIM_STRANDS => 3,
-            PRIM_PARTICLES => 4,
+            PRIM_PARTICLES | PRIM_GAUSSIANS => 4,
             _ => 0,
+        }
+    }
+
+    /// Floats of `positions` a point: four, a splat's `SPLAT_FLOATS`.
+    fn point_floats(&self) -> u64 {
+        if self.kind == PRIM_GAUSSIANS {
+            SPLAT_FLOATS as u64 + 3 * self.splat_sh as u64
+        } else {
+            4
         }
     }
 
@@ -78,7 +94,7 @@ impl Gather {
     pub fn room_points(&self, points: u64, segments: u64, max: u64) -> bool {
         let v = self.vertices() + points;
         let units = if self.kind == PRIM_STRANDS { self.indices.len() as u64 + segments } else { v };
-        v * 16 <= max
+        v * self.point_floats() * 4 <= max
             && units * 4 <= max
             && v * self.expanded_per_point() * 16 * self.set_instances.max(1) as u64 <= max
             && units <= 65_535 * 64 * 65_535
@@ -90,6 +106,23 @@ impl Gather {
         for v in range {
             self.positions.extend(m.positions[v]);
             self.positions.push(sizes[v] * scale);
+            self.colors.push(m.colors[v]);
+        }
+    }
+
+    /// Splats `range` of `m`: each mean, its count of spherical-harmonic coefficients k,
+    /// its covariance Σ = R S Sᵀ Rᵀ (src/splat.rs, computed in f64) as xx xy xz yy yz zz, 0,
+    /// 0, then its k RGB coefficients.
+    fn push_splats(&mut self, m: &Mesh, range: std::ops::Range<usize>) {
+        let Primitive::Gaussians { scales, rotations, sh, .. } = &m.primitive else { return };
+        let k = self.splat_sh as usize;
+        for v in range {
+            self.positions.extend(m.positions[v]);
+            self.positions.push(k as f32);
+            let cov = crate::splat::upper(&crate::splat::covariance(scales[v], rotations[v]));
+            self.positions.extend(cov.map(|x| x as f32));
+            self.positions.extend([0.0; 2]);
+            self.positions.extend(sh[k * v..k * (v + 1)].iter().flatten());
             self.colors.push(m.colors[v]);
         }
     }
@@ -138,6 +171,9 @@ pub(super) fn upload_set(
         Gather { kind, material, ..cur }
     };
     (cur.set_instance, cur.set_instances) = (set_instance, set_instances);
+    if let Primitive::Gaussians { sh, .. } = &m.primitive {
+        cur.splat_sh = (sh.len() / m.positions.len().max(1)) as u32;
+    }
     let start = |mine: &mut Vec<Segment>, done: &Vec<Gather>| mine.push(Segment { chunk: done.len(), lo: 0, hi: 0 });
     start(mine, done);
     let units: Vec<(usize, usize)> = match &m.primitive {
@@ -173,6 +209,7 @@ pub(super) fn upload_set(
                 cur.indices.extend(primitive::segment_words(&[points as u32], base));
             }
             Primitive::Particles { radii } => cur.push_points(m, radii, 1.0, first..first + points),
+            Primitive::Gaussians { .. } => cur.push_splats(m, first..first + points),
             Primitive::Triangles => unreachable!("meshes are uploaded by upload"),
         }
         mine.last_mut().expect("started above").hi = cur.triangles();

@@ -6,7 +6,7 @@ use glam::Vec3;
 use crate::context::GpuContext;
 use crate::error::{OitError, Result};
 use crate::gpu_types::{GpuInstance, GpuSegment};
-use crate::primitive::{Primitive, PRIM_MESH, PRIM_STRANDS};
+use crate::primitive::{Primitive, PRIM_MESH};
 use crate::scene::{Instance, Mesh};
 use crate::shading::Shading;
 use crate::targets::storage_buffer;
@@ -35,7 +35,7 @@ pub struct Chunk {
     pub drawn: u32,
     /// A strand or particle chunk's group 0 for the expansion pass (`Layout::Expand`), and
     /// whether it holds strands (else particles: each kind has its own entry point).
-    pub expand: Option<(wgpu::BindGroup, bool)>,
+    pub expand: Option<(wgpu::BindGroup, u32)>,
 }
 
 /// The transparent or the opaque meshes, concatenated in submission order and split into
@@ -54,7 +54,7 @@ pub struct Geometry {
     pub instanced: bool,
     /// Bytes uploaded by what uploaded them (indexed by chunk kind: meshes with the instance
     /// and segment tables, strands, particles).
-    pub bytes: [u64; 3],
+    pub bytes: [u64; 4],
     /// The part of `bytes` that the expansion pass writes on the GPU (not uploaded).
     pub expanded_bytes: u64,
 }
@@ -89,10 +89,10 @@ impl Geometry {
 
     /// Builds the corners of every strand and particle chunk under the frame uniform's camera
     /// (shaders/expand.wgsl), before the passes that draw them.
-    pub fn expand(&self, pass: &mut wgpu::ComputePass<'_>, pipeline: impl Fn(bool) -> wgpu::ComputePipeline) {
+    pub fn expand(&self, pass: &mut wgpu::ComputePass<'_>, pipeline: impl Fn(u32) -> wgpu::ComputePipeline) {
         for c in &self.chunks {
-            if let Some((group, strands)) = &c.expand {
-                pass.set_pipeline(&pipeline(*strands));
+            if let Some((group, kind)) = &c.expand {
+                pass.set_pipeline(&pipeline(*kind));
                 pass.set_bind_group(0, group, &[]);
                 let groups = (c.triangles / 2).div_ceil(256);
                 pass.dispatch_workgroups(groups.min(65_535), groups.div_ceil(65_535), 1);
@@ -262,7 +262,7 @@ pub(super) fn upload<'a>(
         )));
     }
     let instance_table = make("instances", bytemuck::cast_slice(&table));
-    let mut bytes = [table_bytes, 0, 0];
+    let mut bytes = [table_bytes, 0, 0, 0];
     let mut expanded_bytes = 0;
     let chunks = kept
         .iter()
@@ -318,7 +318,7 @@ pub(super) fn upload<'a>(
                 gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
             };
             let group = bind(bindings.layout, label, None, &[(10, &bindings.atlas.view)]);
-            let expand = (corners > 0).then(|| (bind(bindings.expand_layout, "expand", Some(8), &[]), g.kind == PRIM_STRANDS));
+            let expand = (corners > 0).then(|| (bind(bindings.expand_layout, "expand", Some(8), &[]), g.kind));
             Chunk { group, triangles: g.triangles(), drawn: chunk_drawn[k], expand }
         })
         .collect();

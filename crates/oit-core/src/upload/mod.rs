@@ -46,13 +46,13 @@ pub struct GpuScene {
     pub texture_bytes: u64,
     /// The matrices (`execute::expansion_view`) the corners in `expanded` were last built
     /// under; None until the first expansion.
-    pub expanded_view: std::cell::Cell<Option<[u32; 32]>>,
+    pub expanded_view: std::cell::Cell<Option<[u32; 34]>>,
 }
 
 impl GpuScene {
     /// The scene's buffers by what uploaded them: meshes (with materials, textures and the
     /// instance tables), strands, particles.
-    pub fn bytes(&self) -> [u64; 3] {
+    pub fn bytes(&self) -> [u64; 4] {
         std::array::from_fn(|k| self.transparent.bytes[k] + self.opaque.bytes[k])
     }
 

@@ -260,7 +260,7 @@ fn size_points_and_lines(out: &mut LoadedFile, point_radius: Option<f32>) {
         match &mut m.mesh.primitive {
             Primitive::Strands { widths, .. } => widths.fill(size(LINE_WIDTH)),
             Primitive::Particles { radii } => radii.fill(point_radius.unwrap_or_else(|| size(POINT_RADIUS))),
-            Primitive::Triangles => {}
+            Primitive::Triangles | Primitive::Gaussians { .. } => {}
         }
     }
 }
