@@ -1,0 +1,261 @@
+// Moment-based OIT (Münstermann, Krumpen, Klein, Peters 2018), power moments at 32 bits:
+//   fs_moments4/fs_moments  pass 1: additive blending of b0 = sum of the optical depths
+//                           -ln(1 - alpha) and b_k = sum of optical depth times warped depth^k,
+//                           k = 1 .. MOMENTS (paper Sec. 3.1);
+//   fs_shade4/fs_shade      pass 2: each fragment's transmittance from the biased, normalized
+//                           moments (Sec. 3.3, Algorithm 1: the Hankel solve, the kernel
+//                           polynomial's roots, the interpolating polynomial through them with
+//                           the overestimation at the fragment), adds (C alpha T, alpha T) and,
+//                           in the companion target, its optical depth (b0 again);
+//   fs_resolve              the weighted average of the colors times 1 - exp(-b0), the opaque
+//                           base times exp(-b0) (Sec. 3.4).
+// The warp is the window depth to [-1, 1]. MOMENTS, MBOIT_BIAS and MBOIT_OVERESTIMATION are
+// injected; the bias vectors are shared constants (crates/oit-core/src/consts.rs). Model:
+// python/oit/models.py `mboit`; docs/methods.md ("mboit").
+//!include common/scene.wgsl
+//!include common/targets.wgsl
+//!include common/fullscreen.wgsl
+
+@group(2) @binding(0) var b0_tex: texture_2d<f32>;
+@group(2) @binding(1) var low_tex: texture_2d<f32>;
+@group(2) @binding(2) var high_tex: texture_2d<f32>;
+
+//!include common/accum_targets.wgsl
+
+// Half the moment count: the Hankel matrix is (N + 1) x (N + 1), the kernel polynomial of degree N.
+const N: u32 = MOMENTS / 2u;
+
+fn optical_depth(a: f32) -> f32 {
+    // Alpha 1 would be infinite: capped at -ln(MBOIT_MIN_TRANSMITTANCE).
+    return -log(max(1.0 - a, MBOIT_MIN_TRANSMITTANCE));
+}
+
+fn warp(z: f32) -> f32 {
+    return 2.0 * z - 1.0;
+}
+
+// z, z^2, ..., z^8 by repeated products.
+fn powers(z: f32) -> array<f32, 8> {
+    var p: array<f32, 8>;
+    p[0] = z;
+    for (var k = 1u; k < 8u; k++) {
+        p[k] = p[k - 1u] * z;
+    }
+    return p;
+}
+
+struct Moments4 {
+    @location(0) b0: vec4<f32>,
+    @location(1) low: vec4<f32>,
+}
+
+struct Moments {
+    @location(0) b0: vec4<f32>,
+    @location(1) low: vec4<f32>,
+    @location(2) high: vec4<f32>,
+}
+
+@fragment
+fn fs_moments4(raw: VsOut) -> Moments4 {
+    let in = shaded_alpha(raw);
+    if in.color.a <= 0.0 { discard; }
+    let od = optical_depth(in.color.a);
+    let p = powers(warp(in.clip.z));
+    return Moments4(vec4<f32>(od, 0.0, 0.0, 0.0), vec4<f32>(p[0], p[1], p[2], p[3]) * od);
+}
+
+@fragment
+fn fs_moments(raw: VsOut) -> Moments {
+    let in = shaded_alpha(raw);
+    if in.color.a <= 0.0 { discard; }
+    let od = optical_depth(in.color.a);
+    let p = powers(warp(in.clip.z));
+    return Moments(vec4<f32>(od, 0.0, 0.0, 0.0), vec4<f32>(p[0], p[1], p[2], p[3]) * od, vec4<f32>(p[4], p[5], p[6], p[7]) * od);
+}
+
+// The even moments of the bias vector b* for MOMENTS (its odd ones are 0).
+fn bias_vector(k: u32) -> f32 {
+    if k % 2u == 1u {
+        return 0.0;
+    }
+    var star: array<f32, 4>;
+    if MOMENTS == 4u {
+        star = array<f32, 4>(MBOIT_STAR4_2, MBOIT_STAR4_4, 0.0, 0.0);
+    } else if MOMENTS == 6u {
+        star = array<f32, 4>(MBOIT_STAR6_2, MBOIT_STAR6_4, MBOIT_STAR6_6, 0.0);
+    } else {
+        star = array<f32, 4>(MBOIT_STAR8_2, MBOIT_STAR8_4, MBOIT_STAR8_6, MBOIT_STAR8_8);
+    }
+    return star[k / 2u - 1u];
+}
+
+// p(x), p'(x), p''(x) of the polynomial c[0] + c[1] x + ... + c[deg] x^deg (Horner).
+fn horner(coefs: array<f32, 5>, deg: u32, x: f32) -> vec3<f32> {
+    var c = coefs;
+    var v = vec3<f32>(c[deg], 0.0, 0.0);
+    for (var k = i32(deg) - 1; k >= 0; k--) {
+        v = vec3<f32>(v.x * x + c[k], v.y * x + v.x, v.z * x + 2.0 * v.y);
+    }
+    return v;
+}
+
+// The largest root of the polynomial c (degree N, all its roots real) that is not one of the
+// `count` roots in `found`: Laguerre's method on c divided by (x - found[j]), the division
+// implicit in the logarithmic derivatives (an explicit one loses the small roots to rounding
+// after a large one), from above every root (Cauchy's bound), where it converges
+// monotonically, cubically near the root.
+fn largest_root(coefs: array<f32, 5>, given: array<f32, 5>, count: u32) -> f32 {
+    var c = coefs;
+    var found = given;
+    var bound = 0.0;
+    for (var k = 0u; k < N; k++) {
+        bound = max(bound, abs(c[k] / c[N]));
+    }
+    var x = 1.0 + bound;
+    let n = f32(N - count);
+    for (var it = 0u; it < 40u; it++) {
+        let v = horner(coefs, N, x);
+        if v.x == 0.0 {
+            break;
+        }
+        var g = v.y / v.x;
+        var h = g * g - v.z / v.x;
+        for (var j = 0u; j < count; j++) {
+            let q = 1.0 / (x - found[j]);
+            g -= q;
+            h -= q * q;
+        }
+        let s = sqrt(max((n - 1.0) * (n * h - g * g), 0.0));
+        let den = select(g - s, g + s, g >= 0.0);
+        if den == 0.0 {
+            break;
+        }
+        let step = n / den;
+        x -= step;
+        if abs(step) <= 1e-7 * abs(x) {
+            break;
+        }
+    }
+    return x;
+}
+
+// Transmittance in front of warped depth z from b = (b0, b1, .., b8) (paper Algorithm 1).
+fn transmittance(given: array<f32, 9>, z: f32) -> f32 {
+    var b = given;
+    // Normalized and biased toward b*: m = (1 - beta) b / b0 + beta b*.
+    var m: array<f32, 9>;
+    m[0] = 1.0;
+    for (var k = 1u; k <= 2u * N; k++) {
+        m[k] = mix(b[k] / b[0], bias_vector(k), MBOIT_BIAS);
+    }
+    // Hankel matrix H[i][j] = m[i + j] = L D L^T.
+    var l: array<array<f32, 5>, 5>;
+    var d: array<f32, 5>;
+    for (var i = 0u; i <= N; i++) {
+        for (var j = 0u; j < i; j++) {
+            var s = m[i + j];
+            for (var k = 0u; k < j; k++) {
+                s -= l[i][k] * l[j][k] * d[k];
+            }
+            l[i][j] = s / d[j];
+        }
+        var e = m[2u * i];
+        for (var k = 0u; k < i; k++) {
+            e -= l[i][k] * l[i][k] * d[k];
+        }
+        d[i] = e;
+    }
+    // H c = (1, z, .., z^N): the kernel polynomial's coefficients.
+    var c: array<f32, 5>;
+    var zk = 1.0;
+    for (var i = 0u; i <= N; i++) {
+        var s = zk;
+        for (var k = 0u; k < i; k++) {
+            s -= l[i][k] * c[k];
+        }
+        c[i] = s;
+        zk *= z;
+    }
+    for (var i = 0u; i <= N; i++) {
+        c[i] /= d[i];
+    }
+    for (var i = i32(N); i >= 0; i--) {
+        var s = c[i];
+        for (var k = u32(i) + 1u; k <= N; k++) {
+            s -= l[k][i] * c[k];
+        }
+        c[i] = s;
+    }
+    // Nodes: z (value: the overestimation), then the kernel polynomial's N roots (value 1 in
+    // front of z, 0 behind it), largest first.
+    var x: array<f32, 5>;
+    var f: array<f32, 5>;
+    x[0] = z;
+    f[0] = MBOIT_OVERESTIMATION;
+    var roots: array<f32, 5>;
+    for (var r = 0u; r < N; r++) {
+        roots[r] = largest_root(c, roots, r);
+        x[r + 1u] = roots[r];
+        f[r + 1u] = select(0.0, 1.0, roots[r] < z);
+    }
+    // The interpolating polynomial through (x, f): Newton's divided differences, then its
+    // monomial coefficients; the absorbance is its integral against the biased moments.
+    for (var j = 1u; j <= N; j++) {
+        for (var i = N; i >= j; i--) {
+            f[i] = (f[i] - f[i - 1u]) / (x[i] - x[i - j]);
+        }
+    }
+    var p: array<f32, 5>;
+    p[0] = f[N];
+    for (var j = i32(N) - 1; j >= 0; j--) {
+        for (var k = N - u32(j); k >= 1u; k--) {
+            p[k] = p[k - 1u] - x[j] * p[k];
+        }
+        p[0] = f[j] - x[j] * p[0];
+    }
+    var absorbance = 0.0;
+    for (var k = 0u; k <= N; k++) {
+        absorbance += p[k] * m[k];
+    }
+    return clamp(exp(-b[0] * absorbance), MBOIT_MIN_WEIGHT, 1.0);
+}
+
+fn shade_with(raw: VsOut, b: array<f32, 9>) -> Accum {
+    let in = shaded(raw);
+    let a = in.color.a;
+    if a <= 0.0 { discard; }
+    let t = a * transmittance(b, warp(in.clip.z));
+    return Accum(vec4<f32>(in.color.rgb * t, t), vec4<f32>(optical_depth(a), 0.0, 0.0, 0.0));
+}
+
+@fragment
+fn fs_shade4(raw: VsOut) -> Accum {
+    let p = vec2<i32>(raw.clip.xy);
+    let lo = textureLoad(low_tex, p, 0);
+    let b = array<f32, 9>(textureLoad(b0_tex, p, 0).r, lo.x, lo.y, lo.z, lo.w, 0.0, 0.0, 0.0, 0.0);
+    return shade_with(raw, b);
+}
+
+@fragment
+fn fs_shade(raw: VsOut) -> Accum {
+    let p = vec2<i32>(raw.clip.xy);
+    let lo = textureLoad(low_tex, p, 0);
+    let hi = textureLoad(high_tex, p, 0);
+    let b = array<f32, 9>(textureLoad(b0_tex, p, 0).r, lo.x, lo.y, lo.z, lo.w, hi.x, hi.y, hi.z, hi.w);
+    return shade_with(raw, b);
+}
+
+@group(2) @binding(3) var accum_tex: texture_2d<f32>;
+@group(2) @binding(4) var aux_tex: texture_2d<f32>;
+
+@fragment
+fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let base = base_at(pos);
+    let p = vec2<i32>(pos.xy);
+    let acc = textureLoad(accum_tex, p, 0);
+    let t = exp(-textureLoad(aux_tex, p, 0).r);
+    if acc.a <= 0.0 {
+        return vec4<f32>(base.rgb * t, 1.0 - t * (1.0 - base.a));
+    }
+    return vec4<f32>(acc.rgb / acc.a * (1.0 - t) + base.rgb * t, 1.0 - t * (1.0 - base.a));
+}
