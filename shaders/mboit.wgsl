@@ -9,7 +9,7 @@
 //                           in the companion target, its optical depth (b0 again);
 //   fs_resolve              the weighted average of the colors times 1 - exp(-b0), the opaque
 //                           base times exp(-b0) (Sec. 3.4).
-// The warp is the window depth to [-1, 1]. MOMENTS, MBOIT_BIAS and MBOIT_OVERESTIMATION are
+// The warp: `warp`. MOMENTS, MBOIT_BIAS and MBOIT_OVERESTIMATION are
 // injected; the bias vectors are shared constants (crates/oit-core/src/consts.rs). Model:
 // python/oit/models.py `mboit`; docs/methods.md ("mboit").
 //!include common/scene.wgsl
@@ -30,8 +30,17 @@ fn optical_depth(a: f32) -> f32 {
     return -log(max(1.0 - a, MBOIT_MIN_TRANSMITTANCE));
 }
 
-fn warp(z: f32) -> f32 {
-    return 2.0 * z - 1.0;
+// The depth warp to [-1, 1] (paper Sec. 3.2): under a perspective camera the logarithm of the
+// view depth w between the near and far planes (where window depth 0 and 1 are, found through the
+// inverse projection: there w = 1 / h.w); under an orthographic one (w the same at both planes)
+// the window depth, linear in the view depth already.
+fn warp(clip: vec4<f32>, view_w: f32) -> f32 {
+    let near = 1.0 / (frame.inv_view_proj * vec4<f32>(0.0, 0.0, 0.0, 1.0)).w;
+    let far = 1.0 / (frame.inv_view_proj * vec4<f32>(0.0, 0.0, 1.0, 1.0)).w;
+    if !(abs(far - near) > 1e-6 * abs(near)) || near <= 0.0 || view_w <= 0.0 {
+        return 2.0 * clip.z - 1.0;
+    }
+    return clamp(2.0 * log(view_w / near) / log(far / near) - 1.0, -1.0, 1.0);
 }
 
 // z, z^2, ..., z^8 by repeated products.
@@ -60,7 +69,7 @@ fn fs_moments4(raw: VsOut) -> Moments4 {
     let in = shaded_alpha(raw);
     if in.color.a <= 0.0 { discard; }
     let od = optical_depth(in.color.a);
-    let p = powers(warp(in.clip.z));
+    let p = powers(warp(in.clip, in.view_w));
     return Moments4(vec4<f32>(od, 0.0, 0.0, 0.0), vec4<f32>(p[0], p[1], p[2], p[3]) * od);
 }
 
@@ -69,7 +78,7 @@ fn fs_moments(raw: VsOut) -> Moments {
     let in = shaded_alpha(raw);
     if in.color.a <= 0.0 { discard; }
     let od = optical_depth(in.color.a);
-    let p = powers(warp(in.clip.z));
+    let p = powers(warp(in.clip, in.view_w));
     return Moments(vec4<f32>(od, 0.0, 0.0, 0.0), vec4<f32>(p[0], p[1], p[2], p[3]) * od, vec4<f32>(p[4], p[5], p[6], p[7]) * od);
 }
 
@@ -224,7 +233,7 @@ fn shade_with(raw: VsOut, b: array<f32, 9>) -> Accum {
     let in = shaded(raw);
     let a = in.color.a;
     if a <= 0.0 { discard; }
-    let t = a * transmittance(b, warp(in.clip.z));
+    let t = a * transmittance(b, warp(in.clip, in.view_w));
     return Accum(vec4<f32>(in.color.rgb * t, t), vec4<f32>(optical_depth(a), 0.0, 0.0, 0.0));
 }
 

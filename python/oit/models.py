@@ -368,7 +368,8 @@ MBOIT_BIAS = {m: float(np.float32(_SHARED[f"MBOIT_BIAS_{m}"])) for m in (4, 6, 8
 
 def mboit_moments(z, alpha, moments=6) -> np.ndarray:
     """(b0, b1, .., b_moments): the sums of the optical depths -ln(1 - alpha) (1 - alpha at least
-    MBOIT_MIN_TRANSMITTANCE) and of the optical depths times the warped depth 2 z - 1 to the k."""
+    MBOIT_MIN_TRANSMITTANCE) and of the optical depths times the warped depth 2 z - 1 to the k
+    (the shader's warp under an orthographic camera, the identity included)."""
     od = -np.log(np.maximum(1.0 - np.asarray(alpha, np.float64), MBOIT_MIN_TRANSMITTANCE))
     w = 2.0 * np.asarray(z, np.float64) - 1.0
     return np.array([np.sum(od * w ** k) for k in range(moments + 1)])
