@@ -1,7 +1,9 @@
-// Moment-based OIT (Münstermann, Krumpen, Klein, Peters 2018), power moments at 32 bits:
+// Moment-based OIT (Münstermann, Krumpen, Klein, Peters 2018), power or trigonometric
+// moments (MBOIT_BASIS 0 or 1) at 32 bits:
 //   fs_moments4/fs_moments  pass 1: additive blending of b0 = sum of the optical depths
 //                           -ln(1 - alpha) and b_k = sum of optical depth times warped depth^k,
-//                           k = 1 .. MOMENTS (paper Sec. 3.1);
+//                           k = 1 .. MOMENTS (paper Sec. 3.1), or times cos and sin of j times
+//                           its angle, j = 1 .. MOMENTS (Sec. 3.6);
 //   fs_shade4/fs_shade      pass 2: each fragment's transmittance from the biased, normalized
 //                           moments (Sec. 3.3, Algorithm 1: the Hankel solve, the kernel
 //                           polynomial's roots, the interpolating polynomial through them with
@@ -64,12 +66,34 @@ struct Moments {
     @location(2) high: vec4<f32>,
 }
 
+// What a fragment adds per unit of optical depth: the warped depth's powers z, .., z^8, or
+// the trigonometric basis' cos(j phi), sin(j phi), j = 1 .. 4, at phi = angle(z).
+fn basis(z: f32) -> array<f32, 8> {
+    if MBOIT_BASIS == 0u {
+        return powers(z);
+    }
+    var p: array<f32, 8>;
+    let phi = angle(z);
+    for (var j = 0u; j < 4u; j++) {
+        p[2u * j] = cos(f32(j + 1u) * phi);
+        p[2u * j + 1u] = sin(f32(j + 1u) * phi);
+    }
+    return p;
+}
+
+// The trigonometric basis' angle of a warped depth: [-1, 1] to [0, 2 pi - MBOIT_WRAP], the
+// rest of the circle a wrapping zone between the farthest and the nearest depths (Sec. 3.6).
+fn angle(z: f32) -> f32 {
+    let half = 3.14159265 - 0.5 * MBOIT_WRAP;
+    return z * half + half;
+}
+
 @fragment
 fn fs_moments4(raw: VsOut) -> Moments4 {
     let in = shaded_alpha(raw);
     if in.color.a <= 0.0 { discard; }
     let od = optical_depth(in.color.a);
-    let p = powers(warp(in.clip, in.view_w));
+    let p = basis(warp(in.clip, in.view_w));
     return Moments4(vec4<f32>(od, 0.0, 0.0, 0.0), vec4<f32>(p[0], p[1], p[2], p[3]) * od);
 }
 
@@ -78,7 +102,7 @@ fn fs_moments(raw: VsOut) -> Moments {
     let in = shaded_alpha(raw);
     if in.color.a <= 0.0 { discard; }
     let od = optical_depth(in.color.a);
-    let p = powers(warp(in.clip, in.view_w));
+    let p = basis(warp(in.clip, in.view_w));
     return Moments(vec4<f32>(od, 0.0, 0.0, 0.0), vec4<f32>(p[0], p[1], p[2], p[3]) * od, vec4<f32>(p[4], p[5], p[6], p[7]) * od);
 }
 
@@ -229,11 +253,149 @@ fn transmittance(given: array<f32, 9>, z: f32) -> f32 {
     return clamp(exp(-b[0] * absorbance), MBOIT_MIN_WEIGHT, 1.0);
 }
 
+// ---- trigonometric moments (Sec. 3.6): complex numbers as vec2 (re, im).
+
+// The trigonometric moment count (the power basis compiles this code at its own count too).
+const TRIG_N: u32 = min(MOMENTS, 4u);
+
+fn cmul(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
+}
+
+fn cdiv(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return cmul(a, vec2<f32>(b.x, -b.y)) / dot(b, b);
+}
+
+fn conj(a: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(a.x, -a.y);
+}
+
+// The Hermitian Toeplitz matrix of the moments, T[k][l] = m[k - l] (m[-j] = conj(m[j])),
+// factored as L D L^H; `christoffel` and `kernel` solve with it.
+struct Toeplitz {
+    l: array<array<vec2<f32>, 5>, 5>,
+    d: array<f32, 5>,
+}
+
+fn toeplitz(m: array<vec2<f32>, 5>) -> Toeplitz {
+    var mm = m;
+    var t: Toeplitz;
+    for (var i = 0u; i <= TRIG_N; i++) {
+        for (var j = 0u; j < i; j++) {
+            var s = mm[i - j];
+            for (var k = 0u; k < j; k++) {
+                s -= cmul(t.l[i][k], conj(t.l[j][k])) * t.d[k];
+            }
+            t.l[i][j] = s / t.d[j];
+        }
+        var e = 1.0;
+        for (var k = 0u; k < i; k++) {
+            e -= dot(t.l[i][k], t.l[i][k]) * t.d[k];
+        }
+        t.d[i] = e;
+    }
+    return t;
+}
+
+// L^-1 (1, e^(i theta), .., e^(i TRIG_N theta)).
+fn forward(t: Toeplitz, theta: f32) -> array<vec2<f32>, 5> {
+    var tt = t;
+    var y: array<vec2<f32>, 5>;
+    for (var i = 0u; i <= TRIG_N; i++) {
+        var s = vec2<f32>(cos(f32(i) * theta), sin(f32(i) * theta));
+        for (var k = 0u; k < i; k++) {
+            s -= cmul(tt.l[i][k], y[k]);
+        }
+        y[i] = s;
+    }
+    return y;
+}
+
+// The Christoffel function 1 / (e^H T^-1 e) at angle theta: the weight of a node there.
+fn christoffel(t: Toeplitz, theta: f32) -> f32 {
+    var tt = t;
+    var y = forward(t, theta);
+    var k = 0.0;
+    for (var i = 0u; i <= TRIG_N; i++) {
+        k += dot(y[i], y[i]) / tt.d[i];
+    }
+    return 1.0 / k;
+}
+
+// The transmittance in front of angle phi from b = (b0, Re b1, Im b1, ..): the nodes of the
+// canonical representation through phi are the kernel polynomial's roots on the unit circle
+// (Durand-Kerner); each weighs its Christoffel number, counted in front of phi (1), behind it
+// (0), or in the wrapping zone rising from 0 at its far end to 1 at its near one.
+fn trig_transmittance(given: array<f32, 9>, phi: f32) -> f32 {
+    var b = given;
+    var m: array<vec2<f32>, 5>;
+    m[0] = vec2<f32>(1.0, 0.0);
+    for (var j = 1u; j <= TRIG_N; j++) {
+        m[j] = (1.0 - MBOIT_BIAS) * vec2<f32>(b[2u * j - 1u], b[2u * j]) / b[0];
+    }
+    var t = toeplitz(m);
+    // q = T^-1 e(phi); the kernel polynomial sum conj(q[k]) z^k.
+    var q = forward(t, phi);
+    for (var i = 0u; i <= TRIG_N; i++) {
+        q[i] /= t.d[i];
+    }
+    for (var i = i32(TRIG_N); i >= 0; i--) {
+        var s = q[i];
+        for (var k = u32(i) + 1u; k <= TRIG_N; k++) {
+            s -= cmul(conj(t.l[k][i]), q[k]);
+        }
+        q[i] = s;
+    }
+    var c: array<vec2<f32>, 5>;
+    for (var i = 0u; i <= TRIG_N; i++) {
+        c[i] = cdiv(conj(q[i]), conj(q[TRIG_N])); // monic
+    }
+    var r: array<vec2<f32>, 4>;
+    var start = vec2<f32>(1.0, 0.0);
+    for (var j = 0u; j < TRIG_N; j++) {
+        r[j] = start;
+        start = cmul(start, vec2<f32>(0.4, 0.9));
+    }
+    for (var it = 0u; it < 64u; it++) {
+        for (var j = 0u; j < TRIG_N; j++) {
+            var v = c[TRIG_N];
+            for (var k = i32(TRIG_N) - 1; k >= 0; k--) {
+                v = cmul(v, r[j]) + c[k];
+            }
+            var den = vec2<f32>(1.0, 0.0);
+            for (var k = 0u; k < TRIG_N; k++) {
+                if k != j {
+                    den = cmul(den, r[j] - r[k]);
+                }
+            }
+            r[j] -= cdiv(v, den);
+        }
+    }
+    let zone = 6.28318531 - MBOIT_WRAP;
+    var absorbance = MBOIT_OVERESTIMATION * christoffel(t, phi);
+    for (var j = 0u; j < TRIG_N; j++) {
+        var theta = atan2(r[j].y, r[j].x);
+        theta = select(theta, theta + 6.28318531, theta < 0.0);
+        var f = select(0.0, 1.0, theta < phi);
+        if theta > zone {
+            f = (theta - zone) / MBOIT_WRAP;
+        }
+        absorbance += f * christoffel(t, theta);
+    }
+    return clamp(exp(-b[0] * absorbance), MBOIT_MIN_WEIGHT, 1.0);
+}
+
 fn shade_with(raw: VsOut, b: array<f32, 9>) -> Accum {
     let in = shaded(raw);
     let a = in.color.a;
     if a <= 0.0 { discard; }
-    let t = a * transmittance(b, warp(in.clip, in.view_w));
+    let z = warp(in.clip, in.view_w);
+    var t = a;
+    if MBOIT_BASIS == 0u {
+        t *= transmittance(b, z);
+    } else {
+        t *= trig_transmittance(b, angle(z));
+    }
     return Accum(vec4<f32>(in.color.rgb * t, t), vec4<f32>(optical_depth(a), 0.0, 0.0, 0.0));
 }
 

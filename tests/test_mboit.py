@@ -1,4 +1,4 @@
-"""mboit (moment-based OIT): one layer is exact, the error against the exact composite falls as
+"""mboit (moment-based OIT), power and trigonometric moments: one layer is exact, the error against the exact composite falls as
 the moment count grows, the GPU agrees with its float64 model (oit.models.mboit) within
 numerics.tolerance, and bad parameters are refused naming what to use."""
 
@@ -11,39 +11,42 @@ from numerics import BG, EXACT, expected_image, full_screen_layers, layer_arrays
 from oit import models
 from scenes import IDENTITY
 
-COUNTS = (4, 6, 8)
+COUNTS = {"power": (4, 6, 8), "trigonometric": (2, 3, 4)}
+CASES = [(basis, m) for basis, counts in COUNTS.items() for m in counts]
 
 
-@pytest.mark.parametrize("moments", COUNTS)
+@pytest.mark.parametrize("basis,moments", CASES)
 @pytest.mark.parametrize("alpha", [1e-4, 0.3, 0.9, 1 - 1e-6])
-def test_one_layer_is_exact(renderer, moments, alpha):
+def test_one_layer_is_exact(renderer, basis, moments, alpha):
     # One fragment: its color is the weighted average alone and 1 - exp(-b0) = alpha, whatever
     # its reconstructed transmittance: alpha C + (1 - alpha) background to float32.
     ls = [(0.4, (0.9, 0.5, 0.25, alpha))]
-    frame = renderer(4, 4).render(full_screen_layers(ls), IDENTITY, "mboit", background=tuple(BG), moments=moments)
+    frame = renderer(4, 4).render(full_screen_layers(ls), IDENTITY, "mboit", background=tuple(BG), moments=moments, basis=basis)
     want = expected_image(EXACT[0], 4, 4, *layer_arrays(ls), BG)
-    assert np.abs(frame.image - want).max() <= tolerance("mboit", 1, mass=alpha, moments=moments)
+    assert np.abs(frame.image - want).max() <= tolerance("mboit", 1, mass=alpha)
 
 
-def _errors(moments: int, seed: int = 3, layers: int = 12) -> np.ndarray:
+def _errors(basis: str, moments: int, seed: int = 3, layers: int = 12) -> np.ndarray:
     s = stacks(1, 200, layers, seed=seed)
-    err = [np.abs(models.mboit(z, c, a, BG, moments=moments) - models.exact(z, c, a, BG))[:3].max()
+    err = [np.abs(models.mboit(z, c, a, BG, moments=moments, basis=basis) - models.exact(z, c, a, BG))[:3].max()
            for z, c, a in zip(s.z, s.rgb, s.alpha)]
     return np.array(err)
 
 
-def test_error_falls_as_moments_grow():
+@pytest.mark.parametrize("basis", list(COUNTS))
+def test_error_falls_as_moments_grow(basis):
     # On random stacks of 12 layers (the model; the GPU is held to it below): the mean error
-    # against the exact composite falls from 4 to 6 to 8 moments.
-    means = [_errors(m).mean() for m in COUNTS]
+    # against the exact composite falls with each count of the basis (measured: power 0.067,
+    # 0.045, 0.029; trigonometric 0.136, 0.108, 0.083).
+    means = [_errors(basis, m).mean() for m in COUNTS[basis]]
     assert means[0] > means[1] > means[2], means
-    assert means[2] < 0.05, means
+    assert means[2] < 0.7 * means[0], means
 
 
-@pytest.mark.parametrize("moments", COUNTS)
-def test_gpu_agrees_with_the_model(renderer, moments):
+@pytest.mark.parametrize("basis,moments", CASES)
+def test_gpu_agrees_with_the_model(renderer, basis, moments):
     s = stacks(8, 6, 10, seed=moments)
-    params = params_for("mboit", moments=moments)
+    params = params_for("mboit", moments=moments, basis=basis)
     frame = renderer(8, 6).render(s.scene, IDENTITY, "mboit", background=tuple(BG), **params)
     want = s.expect("mboit", **params)
     mass = max(a.sum() for a in s.alpha)
@@ -51,12 +54,24 @@ def test_gpu_agrees_with_the_model(renderer, moments):
     assert err <= tolerance("mboit", 10, mass=mass, **params), err
 
 
+@pytest.mark.parametrize("basis,moments", CASES)
+@pytest.mark.parametrize("alphas", [(1.0, 1.0, 1.0, 1.0), (1 - 1e-6, 1e-4, 0.0, 1.0), (1e-4,) * 4, (0.5, 0.25, 0.75, 0.6)])
+def test_gpu_agrees_with_the_model_at_alpha_extremes(renderer, basis, moments, alphas):
+    ls = [(z, (*c, a)) for z, c, a in zip((0.7, 0.4, 0.1, 0.55), ((0, 1, 0), (0.3, 0.2, 0.1), (0, 0, 1), (0.9, 0.5, 0.25)), alphas)]
+    params = params_for("mboit", moments=moments, basis=basis)
+    frame = renderer(4, 4).render(full_screen_layers(ls), IDENTITY, "mboit", background=tuple(BG), **params)
+    want = expected_image("mboit", 4, 4, *layer_arrays(ls), BG, **params)
+    assert np.abs(frame.image - want).max() <= tolerance("mboit", 4, mass=sum(alphas), **params)
+
+
 @pytest.mark.parametrize(
     "params,message",
     [
-        ({"moments": 5}, "use 4, 6 or 8"),
+        ({"moments": 5}, "not a count of the power basis; use 4, 6 or 8"),
+        ({"moments": 6, "basis": "trigonometric"}, "not a count of the trigonometric basis; use 2, 3 or 4"),
         ({"moments": 10}, "moments = 10 is out of range"),
-        ({"basis": "wavelet"}, "is not one of: power"),
+        ({"basis": "wavelet"}, "is not one of: power, trigonometric"),
+        ({"precision": "16"}, "is not one of: 32"),
         ({"bias": -1.0}, "bias = -1"),
         ({"overestimation": 2.0}, "overestimation = 2"),
     ],

@@ -364,6 +364,48 @@ MBOIT_MIN_TRANSMITTANCE = float(np.float32(_SHARED["MBOIT_MIN_TRANSMITTANCE"]))
 MBOIT_MIN_WEIGHT = float(np.float32(_SHARED["MBOIT_MIN_WEIGHT"]))
 MBOIT_STAR = {m: [float(np.float32(_SHARED[f"MBOIT_STAR{m}_{k}"])) for k in range(2, m + 1, 2)] for m in (4, 6, 8)}
 MBOIT_BIAS = {m: float(np.float32(_SHARED[f"MBOIT_BIAS_{m}"])) for m in (4, 6, 8)}
+MBOIT_TRIG_BIAS = {m: float(np.float32(_SHARED[f"MBOIT_TRIG_BIAS_{m}"])) for m in (2, 3, 4)}
+MBOIT_WRAP = float(np.float32(_SHARED["MBOIT_WRAP"]))
+
+
+def mboit_angle(z) -> np.ndarray:
+    """The trigonometric basis' angle of window depth z: [0, 2 pi - MBOIT_WRAP]."""
+    half = np.pi - 0.5 * MBOIT_WRAP
+    return (2.0 * np.asarray(z, np.float64) - 1.0) * half + half
+
+
+def mboit_trig_moments(z, alpha, moments=3) -> np.ndarray:
+    """(b0, b1, .., b_moments) complex: the optical depths' sum and their sums times
+    exp(i j angle(z))."""
+    od = -np.log(np.maximum(1.0 - np.asarray(alpha, np.float64), MBOIT_MIN_TRANSMITTANCE))
+    phi = mboit_angle(z)
+    return np.array([np.sum(od * np.exp(1j * j * phi)) for j in range(moments + 1)])
+
+
+def mboit_trig_transmittance(b, z, bias, overestimation=0.25) -> float:
+    """The transmittance in front of window depth z that mboit reconstructs from trigonometric
+    moments b (mboit_trig_moments), as shaders/mboit.wgsl: the normalized moments biased toward
+    0, the Hermitian Toeplitz matrix T, the nodes of the canonical representation through the
+    fragment's angle (the kernel polynomial's roots on the unit circle) weighted by their
+    Christoffel numbers 1 / (e^H T^-1 e), counted 1 in front, 0 behind, rising from 0 to 1
+    across the wrapping zone, the fragment's own by the overestimation."""
+    n = len(b) - 1
+    m = np.concatenate([[1.0], (1.0 - bias) * np.asarray(b[1:]) / b[0].real])
+    toeplitz = np.array([[m[k - j] if k >= j else np.conj(m[j - k]) for j in range(n + 1)] for k in range(n + 1)])
+
+    def e(theta):
+        return np.exp(1j * np.arange(n + 1) * theta)
+
+    def christoffel(theta):
+        return 1.0 / np.real(np.conj(e(theta)) @ np.linalg.solve(toeplitz, e(theta)))
+
+    phi = float(mboit_angle(z))
+    q = np.linalg.solve(toeplitz, e(phi))
+    theta = np.mod(np.angle(np.roots(np.conj(q)[::-1])), 2.0 * np.pi)
+    zone = 2.0 * np.pi - MBOIT_WRAP
+    f = np.where(theta > zone, (theta - zone) / MBOIT_WRAP, (theta < phi).astype(np.float64))
+    absorbance = overestimation * christoffel(phi) + sum(fi * christoffel(t) for fi, t in zip(f, theta))
+    return float(np.clip(np.exp(-b[0].real * absorbance), MBOIT_MIN_WEIGHT, 1.0))
 
 
 def mboit_moments(z, alpha, moments=6) -> np.ndarray:
@@ -406,16 +448,21 @@ def mboit_transmittance(b, z, bias, overestimation=0.25) -> float:
 
 
 def mboit(z, rgb, alpha, bg, bg_a=0.0, moments=6, basis="power", precision="32", bias=0.0, overestimation=0.25):
-    """Moment-based OIT (Münstermann et al. 2018), power moments at 32 bits: each fragment's
-    color weighted by alpha and its reconstructed transmittance, averaged, times 1 - exp(-b0);
-    the color behind times exp(-b0). `bias` 0 is the paper's for the count (MBOIT_BIAS)."""
-    if basis != "power" or str(precision) != "32" or moments not in MBOIT_BIAS:
+    """Moment-based OIT (Münstermann et al. 2018) at 32 bits: each fragment's color weighted by
+    alpha and its reconstructed transmittance, averaged, times 1 - exp(-b0); the color behind
+    times exp(-b0). `bias` 0 is the paper's for the basis and count (MBOIT_BIAS, MBOIT_TRIG_BIAS)."""
+    defaults = {"power": MBOIT_BIAS, "trigonometric": MBOIT_TRIG_BIAS}.get(basis, {})
+    if str(precision) != "32" or moments not in defaults:
         raise ValueError(f"mboit model: no model of basis={basis!r}, precision={precision!r}, moments={moments}")
     z, rgb, alpha = _visible(z, rgb, alpha)
-    b = mboit_moments(z, alpha, moments)
-    beta = bias if bias > 0 else MBOIT_BIAS[moments]
-    w = np.array([a * mboit_transmittance(b, zi, beta, overestimation) for zi, a in zip(z, alpha)])
-    t = float(np.exp(-b[0]))
+    beta = bias if bias > 0 else defaults[moments]
+    if basis == "power":
+        b = mboit_moments(z, alpha, moments)
+        w = np.array([a * mboit_transmittance(b, zi, beta, overestimation) for zi, a in zip(z, alpha)])
+    else:
+        b = mboit_trig_moments(z, alpha, moments)
+        w = np.array([a * mboit_trig_transmittance(b, zi, beta, overestimation) for zi, a in zip(z, alpha)])
+    t = float(np.exp(-b[0].real))
     if len(w) == 0 or w.sum() <= 0:
         return _out(np.zeros(3), t, bg, bg_a)
     return _out((rgb * w[:, None]).sum(0) / w.sum() * (1.0 - t), t, bg, bg_a)

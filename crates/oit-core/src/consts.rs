@@ -77,6 +77,11 @@ pub const MBOIT_STAR6: [f32; 3] = [0.48, 0.451, 0.45];
 pub const MBOIT_STAR8: [f32; 4] = [0.75, 0.676_666_7, 0.63, 0.600_303];
 /// mboit's default moment bias for 4, 6 and 8 power moments at 32 bits (the paper's, Sec. 3.5).
 pub const MBOIT_BIAS: [f32; 3] = [5e-7, 5e-6, 5e-5];
+/// mboit's default moment bias for 2, 3 and 4 trigonometric moments at 32 bits (toward 0, the
+/// moments of the uniform angle).
+pub const MBOIT_TRIG_BIAS: [f32; 3] = [4e-7, 3.8e-7, 8e-7];
+/// The angle of the trigonometric basis' wrapping zone, 0.1 pi (the paper's code's default).
+pub const MBOIT_WRAP: f32 = 0.314_159_27;
 
 /// Every shared constant, in the order they are prepended (float64 ones as the float32 the
 /// shaders compute with).
@@ -138,4 +143,8 @@ pub const SHARED: &[Const] = &[
     Const::F32("MBOIT_BIAS_4", MBOIT_BIAS[0]),
     Const::F32("MBOIT_BIAS_6", MBOIT_BIAS[1]),
     Const::F32("MBOIT_BIAS_8", MBOIT_BIAS[2]),
+    Const::F32("MBOIT_TRIG_BIAS_2", MBOIT_TRIG_BIAS[0]),
+    Const::F32("MBOIT_TRIG_BIAS_3", MBOIT_TRIG_BIAS[1]),
+    Const::F32("MBOIT_TRIG_BIAS_4", MBOIT_TRIG_BIAS[2]),
+    Const::F32("MBOIT_WRAP", MBOIT_WRAP),
 ];

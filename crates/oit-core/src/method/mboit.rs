@@ -1,33 +1,54 @@
-//! `mboit`: moment-based OIT (Münstermann, Krumpen, Klein, Peters 2018) with power moments at
-//! 32 bits: a blended pass of the optical depth's moments, a blended pass of each fragment's
+//! `mboit`: moment-based OIT (Münstermann, Krumpen, Klein, Peters 2018) with power or
+//! trigonometric moments at 32 bits: a blended pass of the optical depth's moments, a blended pass of each fragment's
 //! color weighted by the transmittance reconstructed from them, and a resolve that composites
 //! with the total transmittance exp(-b0) (shaders/mboit.wgsl, docs/methods.md "mboit").
 
 use super::accum::{accumulation_targets, blended, Companion, FloatTargets, ADD, AUX_FORMAT};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
-use super::params::{ChoiceParam, FloatParam, IntParam};
+use super::info::{never, ErrorBound, Memory, MethodInfo, Order, FRAMES};
+use super::params::{ChoiceParam, FloatParam, IntParam, Params};
 use crate::cache::{spec, Layout, PipelineSpec};
-use crate::consts::MBOIT_BIAS;
+use crate::consts::{MBOIT_BIAS, MBOIT_TRIG_BIAS};
 use crate::error::{invalid, Result};
 use crate::pipeline;
 use crate::shader::Const;
 
-const MOMENTS: IntParam =
-    IntParam::new("moments", (4, 8, 6), "power moments of the optical depth: 4, 6 or 8 (more: closer to the exact composite)")
-        .compiled_as("MOMENTS");
-const BASIS: ChoiceParam<u32> = ChoiceParam::new("basis", &["power"], &[0], 0, "moment basis: powers of the warped depth");
+const MOMENTS: IntParam = IntParam::new(
+    "moments",
+    (2, 8, 6),
+    "moments of the optical depth: 4, 6 or 8 power moments, 2, 3 or 4 trigonometric (more: closer to the exact composite)",
+)
+.compiled_as("MOMENTS");
+const BASIS: ChoiceParam<u32> = ChoiceParam::new(
+    "basis",
+    &["power", "trigonometric"],
+    &[0, 1],
+    0,
+    "moment basis: powers of the warped depth, or cos and sin of multiples of its angle",
+)
+.compiled_as("MBOIT_BASIS");
 const PRECISION: ChoiceParam<u32> = ChoiceParam::new("precision", &["32"], &[32], 0, "bits a stored moment: 32 (float targets)");
 const BIAS: FloatParam = FloatParam::new(
     "bias",
     (0.0, 0.5, 0.0),
-    "moment bias toward the paper's bias vector; 0: the paper's for the count (5e-7, 5e-6, 5e-5 for 4, 6, 8)",
+    "moment bias toward the paper's bias vector; 0: the paper's for the basis and count (consts.rs MBOIT_BIAS, MBOIT_TRIG_BIAS)",
 );
 const OVERESTIMATION: FloatParam =
     FloatParam::new("overestimation", (0.0, 1.0, 0.25), "share of the fragment's own depth's mass counted in front of it");
 
-/// The moment counts of the power basis.
-const COUNTS: [u32; 3] = [4, 6, 8];
+/// The moment counts of the power and the trigonometric basis.
+const COUNTS: [[u32; 3]; 2] = [[4, 6, 8], [2, 3, 4]];
+
+/// Floats a pixel's moments take besides b0: a power moment is one, a trigonometric one two.
+fn floats(params: &Params) -> u64 {
+    MOMENTS.of(params) as u64 * if BASIS.of(params) == 0 { 1 } else { 2 }
+}
+
+/// b0 (R32F), the moments (4 floats a texel: RGBA32F, then RG32F or RGBA32F), and the shade
+/// pass's accumulation targets (RGBA32F color, R32F optical depth).
+fn bytes(pixels: u64, params: &Params) -> u64 {
+    pixels * (4 + 4 * floats(params) + super::accum::TARGET_BYTES)
+}
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "mboit",
@@ -39,7 +60,7 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Rounding,
     antialias_modes: FRAMES,
-    memory: Memory::Frame(BYTES),
+    memory: Memory::Computed { formula: "W·H·(4·moments + 24) (power), W·H·(8·moments + 24) (trigonometric)", bytes },
     error_bound: ErrorBound::None,
     census: false,
     census_when: never,
@@ -48,10 +69,6 @@ pub const INFO: MethodInfo = MethodInfo {
     constants: &[Const::F32("MBOIT_BIAS", MBOIT_BIAS[1]), Const::F32("MBOIT_OVERESTIMATION", 0.25)],
     create: |_, _| Box::new(Mboit { moments: None, accum: None }),
 };
-
-/// b0 (R32F), the moments (4 a texel: RGBA32F, then RG32F or RGBA32F), and the shade pass's
-/// accumulation targets (RGBA32F color, R32F optical depth).
-const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(MOMENTS, 4, 4 + super::accum::TARGET_BYTES), fixed: 0 };
 
 const SHADER: &str = "mboit.wgsl";
 /// The moment targets as the shade pass reads them (group 2): 4 moments, or 6 and 8.
@@ -74,21 +91,24 @@ struct Mboit {
 
 impl Method for Mboit {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
-        let m = MOMENTS.of(cx.params);
-        let Some(at) = COUNTS.iter().position(|&c| c == m) else {
-            return Err(invalid!("mboit: moments = {m} is not a count of the power basis; use 4, 6 or 8"));
+        let (m, basis) = (MOMENTS.of(cx.params), BASIS.of(cx.params) as usize);
+        let Some(at) = COUNTS[basis].iter().position(|&c| c == m) else {
+            let [a, b, c] = COUNTS[basis];
+            let name = ["power", "trigonometric"][basis];
+            return Err(invalid!("mboit: moments = {m} is not a count of the {name} basis; use {a}, {b} or {c}"));
         };
         let bias = match BIAS.of(cx.params) {
             b if b > 0.0 => b as f32,
-            _ => MBOIT_BIAS[at],
+            _ => [MBOIT_BIAS, MBOIT_TRIG_BIAS][basis][at],
         };
         let consts = [
             MOMENTS.constant(cx.params),
+            BASIS.constant_or(cx.params, 0),
             Const::F32("MBOIT_BIAS", bias),
             Const::F32("MBOIT_OVERESTIMATION", OVERESTIMATION.of(cx.params) as f32),
         ];
         let f32x4 = wgpu::TextureFormat::Rgba32Float;
-        let (formats, bindings, moments_fs, shade_fs) = match m {
+        let (formats, bindings, moments_fs, shade_fs) = match floats(cx.params) {
             4 => (vec![AUX_FORMAT, f32x4], MOMENTS4, "fs_moments4", "fs_shade4"),
             6 => (vec![AUX_FORMAT, f32x4, wgpu::TextureFormat::Rg32Float], MOMENTS8, "fs_moments", "fs_shade"),
             _ => (vec![AUX_FORMAT, f32x4, f32x4], MOMENTS8, "fs_moments", "fs_shade"),
@@ -104,6 +124,6 @@ impl Method for Mboit {
         accum.blend("shade", cx, &mut enc, &[wgpu::Color::TRANSPARENT; 2], &shade, &[cx.targets_group(), &moments.group]);
         cx.resolve(&mut enc, "resolve", &resolve, &accum.group, false);
         cx.submit(enc);
-        Ok(Outcome::Done(MethodReport { memory_bytes: BYTES.at(cx.pixels(), cx.params), ..Default::default() }))
+        Ok(Outcome::Done(MethodReport { memory_bytes: bytes(cx.pixels(), cx.params), ..Default::default() }))
     }
 }
