@@ -8,9 +8,10 @@
 //                           moments (Sec. 3.3, Algorithm 1: the Hankel solve, the kernel
 //                           polynomial's roots, the interpolating polynomial through them with
 //                           the overestimation at the fragment), adds (C alpha T, alpha T) and,
-//                           in the companion target, its optical depth (b0 again);
+//                           in the companion target, its optical depth (b0 again), its share
+//                           of the error bound and a count;
 //   fs_resolve              the weighted average of the colors times 1 - exp(-b0), the opaque
-//                           base times exp(-b0) (Sec. 3.4).
+//                           base times exp(-b0) (Sec. 3.4), and the per-pixel error bound.
 // The warp: `warp`. MOMENTS, MBOIT_BIAS and MBOIT_OVERESTIMATION are
 // injected; the bias vectors are shared constants (crates/oit-core/src/consts.rs). Model:
 // python/oit/models.py `mboit`; docs/methods.md ("mboit").
@@ -172,8 +173,36 @@ fn largest_root(coefs: array<f32, 5>, given: array<f32, 5>, count: u32) -> f32 {
     return x;
 }
 
-// Transmittance in front of warped depth z from b = (b0, b1, .., b8) (paper Algorithm 1).
-fn transmittance(given: array<f32, 9>, z: f32) -> f32 {
+// The integral against m of the polynomial through (x[i], f[i]), i = 0 .. N: Newton's divided
+// differences, then its monomial coefficients.
+fn integral(nodes: array<f32, 5>, values: array<f32, 5>, moments: array<f32, 9>) -> f32 {
+    var x = nodes;
+    var f = values;
+    var m = moments;
+    for (var j = 1u; j <= N; j++) {
+        for (var i = N; i >= j; i--) {
+            f[i] = (f[i] - f[i - 1u]) / (x[i] - x[i - j]);
+        }
+    }
+    var p: array<f32, 5>;
+    p[0] = f[N];
+    for (var j = i32(N) - 1; j >= 0; j--) {
+        for (var k = N - u32(j); k >= 1u; k--) {
+            p[k] = p[k - 1u] - x[j] * p[k];
+        }
+        p[0] = f[j] - x[j] * p[0];
+    }
+    var sum = 0.0;
+    for (var k = 0u; k <= N; k++) {
+        sum += p[k] * m[k];
+    }
+    return sum;
+}
+
+// The normalized absorbance in front of warped depth z from b = (b0, b1, .., b8) (paper
+// Algorithm 1), with the biased measure's mass in front of z and up to it (the moment
+// problem's lower and upper bounds: the reconstruction with 0 and with 1 at z).
+fn transmittance(given: array<f32, 9>, z: f32) -> vec3<f32> {
     var b = given;
     // Normalized and biased toward b*: m = (1 - beta) b / b0 + beta b*.
     var m: array<f32, 9>;
@@ -231,26 +260,12 @@ fn transmittance(given: array<f32, 9>, z: f32) -> f32 {
         x[r + 1u] = roots[r];
         f[r + 1u] = select(0.0, 1.0, roots[r] < z);
     }
-    // The interpolating polynomial through (x, f): Newton's divided differences, then its
-    // monomial coefficients; the absorbance is its integral against the biased moments.
-    for (var j = 1u; j <= N; j++) {
-        for (var i = N; i >= j; i--) {
-            f[i] = (f[i] - f[i - 1u]) / (x[i] - x[i - j]);
-        }
-    }
-    var p: array<f32, 5>;
-    p[0] = f[N];
-    for (var j = i32(N) - 1; j >= 0; j--) {
-        for (var k = N - u32(j); k >= 1u; k--) {
-            p[k] = p[k - 1u] - x[j] * p[k];
-        }
-        p[0] = f[j] - x[j] * p[0];
-    }
-    var absorbance = 0.0;
-    for (var k = 0u; k <= N; k++) {
-        absorbance += p[k] * m[k];
-    }
-    return clamp(exp(-b[0] * absorbance), MBOIT_MIN_WEIGHT, 1.0);
+    // The interpolating polynomial through (x, f), integrated against the biased moments.
+    let estimate = integral(x, f, m);
+    f[0] = 0.0;
+    let lower = integral(x, f, m);
+    f[0] = 1.0;
+    return vec3<f32>(estimate, lower, integral(x, f, m));
 }
 
 // ---- trigonometric moments (Sec. 3.6): complex numbers as vec2 (re, im).
@@ -326,7 +341,7 @@ fn christoffel(t: Toeplitz, theta: f32) -> f32 {
 // canonical representation through phi are the kernel polynomial's roots on the unit circle
 // (Durand-Kerner); each weighs its Christoffel number, counted in front of phi (1), behind it
 // (0), or in the wrapping zone rising from 0 at its far end to 1 at its near one.
-fn trig_transmittance(given: array<f32, 9>, phi: f32) -> f32 {
+fn trig_transmittance(given: array<f32, 9>, phi: f32) -> vec3<f32> {
     var b = given;
     var m: array<vec2<f32>, 5>;
     m[0] = vec2<f32>(1.0, 0.0);
@@ -372,31 +387,48 @@ fn trig_transmittance(given: array<f32, 9>, phi: f32) -> f32 {
         }
     }
     let zone = 6.28318531 - MBOIT_WRAP;
-    var absorbance = MBOIT_OVERESTIMATION * christoffel(t, phi);
+    let own = christoffel(t, phi);
+    var front = 0.0;
+    var zone_part = 0.0;
+    var zone_mass = 0.0;
     for (var j = 0u; j < TRIG_N; j++) {
         var theta = atan2(r[j].y, r[j].x);
         theta = select(theta, theta + 6.28318531, theta < 0.0);
-        var f = select(0.0, 1.0, theta < phi);
+        let w = christoffel(t, theta);
         if theta > zone {
-            f = (theta - zone) / MBOIT_WRAP;
+            zone_part += (theta - zone) / MBOIT_WRAP * w;
+            zone_mass += w;
+        } else if theta < phi {
+            front += w;
         }
-        absorbance += f * christoffel(t, theta);
     }
-    return clamp(exp(-b[0] * absorbance), MBOIT_MIN_WEIGHT, 1.0);
+    // The bounds count the wrapping zone's nodes out, then in (the zone holds no depth).
+    return vec3<f32>(front + zone_part + MBOIT_OVERESTIMATION * own, front, front + own + zone_mass);
 }
 
+// A fragment's color weighted by alpha T (T from the estimate of the absorbance in front of
+// it), its optical depth, and its share of the error bound: alpha max(C) times how far T can
+// be from the transmittance of every measure with these moments (docs/methods.md, "mboit").
 fn shade_with(raw: VsOut, b: array<f32, 9>) -> Accum {
     let in = shaded(raw);
     let a = in.color.a;
     if a <= 0.0 { discard; }
     let z = warp(in.clip, in.view_w);
-    var t = a;
+    var masses: vec3<f32>;
     if MBOIT_BASIS == 0u {
-        t *= transmittance(b, z);
+        masses = transmittance(b, z);
     } else {
-        t *= trig_transmittance(b, angle(z));
+        masses = trig_transmittance(b, angle(z));
     }
-    return Accum(vec4<f32>(in.color.rgb * t, t), vec4<f32>(optical_depth(a), 0.0, 0.0, 0.0));
+    let t = clamp(exp(-b[0] * masses.x), MBOIT_MIN_WEIGHT, 1.0);
+    // The bias mixed beta of another measure in: the true mass in front is within
+    // [(lower - beta) / (1 - beta), upper / (1 - beta)].
+    let lower = max(masses.y - MBOIT_BIAS, 0.0) / (1.0 - MBOIT_BIAS);
+    let upper = min(masses.z / (1.0 - MBOIT_BIAS), 1.0);
+    let dev = max(max(t - exp(-b[0] * upper), exp(-b[0] * lower) - t), 0.0) + MBOIT_MIN_TRANSMITTANCE;
+    let w = a * t;
+    let c = in.color.rgb;
+    return Accum(vec4<f32>(c * w, w), vec4<f32>(optical_depth(a), a * max(max(c.r, c.g), c.b) * dev, 1.0, 0.0));
 }
 
 @fragment
@@ -419,14 +451,21 @@ fn fs_shade(raw: VsOut) -> Accum {
 @group(2) @binding(3) var accum_tex: texture_2d<f32>;
 @group(2) @binding(4) var aux_tex: texture_2d<f32>;
 
+// C = sum(C alpha T) / sum(alpha T) (1 - exp(-b0)) + exp(-b0) C_bg. Its bound: with s the
+// factor the average scales the sums by, |s - 1| max(sum C alpha T) + sum alpha max(C) dev,
+// and a rounding term a fragment (docs/methods.md, "mboit").
 @fragment
-fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
     let base = base_at(pos);
     let p = vec2<i32>(pos.xy);
     let acc = textureLoad(accum_tex, p, 0);
-    let t = exp(-textureLoad(aux_tex, p, 0).r);
+    let aux = textureLoad(aux_tex, p, 0);
+    let t = exp(-aux.r);
+    let rounding = (aux.b + 2.0) * ROUNDING_TERM;
     if acc.a <= 0.0 {
-        return vec4<f32>(base.rgb * t, 1.0 - t * (1.0 - base.a));
+        return Final(vec4<f32>(base.rgb * t, 1.0 - t * (1.0 - base.a)), aux.g + (1.0 - t) + rounding);
     }
-    return vec4<f32>(acc.rgb / acc.a * (1.0 - t) + base.rgb * t, 1.0 - t * (1.0 - base.a));
+    let s = (1.0 - t) / acc.a;
+    let bound = abs(s - 1.0) * max(max(acc.r, acc.g), acc.b) + aux.g + rounding;
+    return Final(vec4<f32>(acc.rgb / acc.a * (1.0 - t) + base.rgb * t, 1.0 - t * (1.0 - base.a)), bound);
 }

@@ -7,7 +7,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from numerics import BG, EXACT, expected_image, full_screen_layers, layer_arrays, params_for, stacks, tolerance
+from numerics import (
+    BG,
+    EXACT,
+    assert_within_error_bound,
+    expected_image,
+    full_screen_layers,
+    layer_arrays,
+    params_for,
+    stacks,
+    tolerance,
+)
 from oit import models
 from scenes import IDENTITY
 
@@ -62,6 +72,20 @@ def test_gpu_agrees_with_the_model_at_alpha_extremes(renderer, basis, moments, a
     frame = renderer(4, 4).render(full_screen_layers(ls), IDENTITY, "mboit", background=tuple(BG), **params)
     want = expected_image("mboit", 4, 4, *layer_arrays(ls), BG, **params)
     assert np.abs(frame.image - want).max() <= tolerance("mboit", 4, mass=sum(alphas), **params)
+
+
+@pytest.mark.parametrize("basis,moments", CASES)
+@pytest.mark.parametrize("layers,alpha", [(10, None), (300, lambda r, n: r.uniform(1e-4, 2e-3, n)),
+                                          (300, lambda r, n: r.uniform(0.5, 1.0, n)),
+                                          (40, lambda r, n: np.where(r.uniform(0, 1, n) < 0.5, 1e-4, 1 - 1e-6))])
+def test_error_bound_holds(renderer, basis, moments, layers, alpha):
+    # frame.error_bound (the moment problem's bounds on each fragment's transmittance, the
+    # bias's share and the average's scale: docs/methods.md, "mboit") holds against the exact
+    # composite on random stacks, faint and dense deep ones, and alphas at both extremes.
+    s = stacks(4, 3, layers, seed=layers + moments, alpha=alpha)
+    frame = renderer(4, 3).render(s.scene, IDENTITY, "mboit", background=tuple(BG), moments=moments, basis=basis)
+    assert frame.error_bound is not None
+    assert_within_error_bound(frame, s.expect(EXACT[0]))
 
 
 @pytest.mark.parametrize(

@@ -3,7 +3,7 @@
 //! color weighted by the transmittance reconstructed from them, and a resolve that composites
 //! with the total transmittance exp(-b0) (shaders/mboit.wgsl, docs/methods.md "mboit").
 
-use super::accum::{accumulation_targets, blended, Companion, FloatTargets, ADD, AUX_FORMAT};
+use super::accum::{blended, FloatTargets, ADD, AUX_FORMAT};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, FRAMES};
 use super::params::{ChoiceParam, FloatParam, IntParam, Params};
@@ -44,10 +44,14 @@ fn floats(params: &Params) -> u64 {
     MOMENTS.of(params) as u64 * if BASIS.of(params) == 0 { 1 } else { 2 }
 }
 
+/// The shade pass's two RGBA32F targets: the weighted color, and the optical depth, the error
+/// bound's sum and the fragment count.
+const SHADE_FORMATS: [wgpu::TextureFormat; 2] = [wgpu::TextureFormat::Rgba32Float; 2];
+
 /// b0 (R32F), the moments (4 floats a texel: RGBA32F, then RG32F or RGBA32F), and the shade
-/// pass's accumulation targets (RGBA32F color, R32F optical depth).
+/// pass's targets.
 fn bytes(pixels: u64, params: &Params) -> u64 {
-    pixels * (4 + 4 * floats(params) + super::accum::TARGET_BYTES)
+    pixels * (4 + 4 * floats(params) + 32)
 }
 
 pub const INFO: MethodInfo = MethodInfo {
@@ -60,8 +64,8 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Rounding,
     antialias_modes: FRAMES,
-    memory: Memory::Computed { formula: "W·H·(4·moments + 24) (power), W·H·(8·moments + 24) (trigonometric)", bytes },
-    error_bound: ErrorBound::None,
+    memory: Memory::Computed { formula: "W·H·(4·moments + 36) (power), W·H·(8·moments + 36) (trigonometric)", bytes },
+    error_bound: ErrorBound::PerPixel,
     census: false,
     census_when: never,
     main: Some("moments"),
@@ -115,15 +119,16 @@ impl Method for Mboit {
         };
         let targets: Vec<_> = formats.iter().map(|&f| blended(f, ADD)).collect();
         let gather = cx.draw_pipeline(spec(PIPELINES, moments_fs), &consts, targets, pipeline::depth_test_only());
-        let shade = cx.draw_pipeline(spec(PIPELINES, shade_fs), &consts, accumulation_targets(Companion::Sum), pipeline::depth_test_only());
-        let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, false);
+        let shade_targets = SHADE_FORMATS.iter().map(|&f| blended(f, ADD)).collect();
+        let shade = cx.draw_pipeline(spec(PIPELINES, shade_fs), &consts, shade_targets, pipeline::depth_test_only());
+        let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, true);
         let moments = FloatTargets::ensure(&mut self.moments, cx, &formats, bindings);
-        let accum = FloatTargets::accumulation(&mut self.accum, cx, TEXTURES);
+        let accum = FloatTargets::ensure(&mut self.accum, cx, &SHADE_FORMATS, TEXTURES);
         let mut enc = cx.encoder();
         moments.blend("moments", cx, &mut enc, &vec![wgpu::Color::TRANSPARENT; formats.len()], &gather, &[]);
         accum.blend("shade", cx, &mut enc, &[wgpu::Color::TRANSPARENT; 2], &shade, &[cx.targets_group(), &moments.group]);
-        cx.resolve(&mut enc, "resolve", &resolve, &accum.group, false);
+        cx.resolve(&mut enc, "resolve", &resolve, &accum.group, true);
         cx.submit(enc);
-        Ok(Outcome::Done(MethodReport { memory_bytes: bytes(cx.pixels(), cx.params), ..Default::default() }))
+        Ok(Outcome::Done(MethodReport { memory_bytes: bytes(cx.pixels(), cx.params), error_bound: true, ..Default::default() }))
     }
 }
