@@ -3,7 +3,7 @@
 //   fs_moments4/fs_moments  pass 1: additive blending of b0 = sum of the optical depths
 //                           -ln(1 - alpha) and b_k = sum of optical depth times warped depth^k,
 //                           k = 1 .. MOMENTS (paper Sec. 3.1), or times cos and sin of j times
-//                           its angle, j = 1 .. MOMENTS (Sec. 3.6);
+//                           its angle, j = 1 .. MOMENTS / 2 (Sec. 3.6);
 //   fs_shade4/fs_shade      pass 2: each fragment's transmittance from the biased, normalized
 //                           moments (Sec. 3.3, Algorithm 1: the Hankel solve, the kernel
 //                           polynomial's roots, the interpolating polynomial through them with
@@ -270,8 +270,8 @@ fn transmittance(given: array<f32, 9>, z: f32) -> vec3<f32> {
 
 // ---- trigonometric moments (Sec. 3.6): complex numbers as vec2 (re, im).
 
-// The trigonometric moment count (the power basis compiles this code at its own count too).
-const TRIG_N: u32 = min(MOMENTS, 4u);
+// The trigonometric moments: MOMENTS real values, MOMENTS / 2 complex moments.
+const TRIG_N: u32 = MOMENTS / 2u;
 
 fn cmul(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);

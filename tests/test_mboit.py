@@ -21,7 +21,7 @@ from numerics import (
 from oit import models
 from scenes import IDENTITY
 
-COUNTS = {"power": (4, 6, 8), "trigonometric": (2, 3, 4)}
+COUNTS = {"power": (4, 6, 8), "trigonometric": (4, 6, 8)}  # real values: 2, 3, 4 complex trigonometric
 CASES = [(basis, m) for basis, counts in COUNTS.items() for m in counts]
 
 
@@ -91,8 +91,8 @@ def test_error_bound_holds(renderer, basis, moments, layers, alpha):
 @pytest.mark.parametrize(
     "params,message",
     [
-        ({"moments": 5}, "not a count of the power basis; use 4, 6 or 8"),
-        ({"moments": 6, "basis": "trigonometric"}, "not a count of the trigonometric basis; use 2, 3 or 4"),
+        ({"moments": 5}, "not a moment count; use 4, 6 or 8"),
+        ({"moments": 7, "basis": "trigonometric"}, r"use 4, 6 or 8 \(2, 3 or 4 complex trigonometric moments\)"),
         ({"moments": 10}, "moments = 10 is out of range"),
         ({"basis": "wavelet"}, "is not one of: power, trigonometric"),
         ({"precision": "16"}, "is not one of: 32"),

@@ -364,7 +364,8 @@ MBOIT_MIN_TRANSMITTANCE = float(np.float32(_SHARED["MBOIT_MIN_TRANSMITTANCE"]))
 MBOIT_MIN_WEIGHT = float(np.float32(_SHARED["MBOIT_MIN_WEIGHT"]))
 MBOIT_STAR = {m: [float(np.float32(_SHARED[f"MBOIT_STAR{m}_{k}"])) for k in range(2, m + 1, 2)] for m in (4, 6, 8)}
 MBOIT_BIAS = {m: float(np.float32(_SHARED[f"MBOIT_BIAS_{m}"])) for m in (4, 6, 8)}
-MBOIT_TRIG_BIAS = {m: float(np.float32(_SHARED[f"MBOIT_TRIG_BIAS_{m}"])) for m in (2, 3, 4)}
+# Trigonometric biases by real moment count (2, 3, 4 complex moments).
+MBOIT_TRIG_BIAS = {2 * m: float(np.float32(_SHARED[f"MBOIT_TRIG_BIAS_{m}"])) for m in (2, 3, 4)}
 MBOIT_WRAP = float(np.float32(_SHARED["MBOIT_WRAP"]))
 
 
@@ -375,8 +376,8 @@ def mboit_angle(z) -> np.ndarray:
 
 
 def mboit_trig_moments(z, alpha, moments=3) -> np.ndarray:
-    """(b0, b1, .., b_moments) complex: the optical depths' sum and their sums times
-    exp(i j angle(z))."""
+    """(b0, b1, .., b_moments) complex (`moments` complex ones: twice as many reals): the
+    optical depths' sum and their sums times exp(i j angle(z))."""
     od = -np.log(np.maximum(1.0 - np.asarray(alpha, np.float64), MBOIT_MIN_TRANSMITTANCE))
     phi = mboit_angle(z)
     return np.array([np.sum(od * np.exp(1j * j * phi)) for j in range(moments + 1)])
@@ -450,7 +451,8 @@ def mboit_transmittance(b, z, bias, overestimation=0.25) -> float:
 def mboit(z, rgb, alpha, bg, bg_a=0.0, moments=6, basis="power", precision="32", bias=0.0, overestimation=0.25):
     """Moment-based OIT (Münstermann et al. 2018) at 32 bits: each fragment's color weighted by
     alpha and its reconstructed transmittance, averaged, times 1 - exp(-b0); the color behind
-    times exp(-b0). `bias` 0 is the paper's for the basis and count (MBOIT_BIAS, MBOIT_TRIG_BIAS)."""
+    times exp(-b0). `moments` counts reals (a complex trigonometric moment is two); `bias` 0 is
+    the paper's for the basis and count (MBOIT_BIAS, MBOIT_TRIG_BIAS)."""
     defaults = {"power": MBOIT_BIAS, "trigonometric": MBOIT_TRIG_BIAS}.get(basis, {})
     if str(precision) != "32" or moments not in defaults:
         raise ValueError(f"mboit model: no model of basis={basis!r}, precision={precision!r}, moments={moments}")
@@ -460,7 +462,7 @@ def mboit(z, rgb, alpha, bg, bg_a=0.0, moments=6, basis="power", precision="32",
         b = mboit_moments(z, alpha, moments)
         w = np.array([a * mboit_transmittance(b, zi, beta, overestimation) for zi, a in zip(z, alpha)])
     else:
-        b = mboit_trig_moments(z, alpha, moments)
+        b = mboit_trig_moments(z, alpha, moments // 2)
         w = np.array([a * mboit_trig_transmittance(b, zi, beta, overestimation) for zi, a in zip(z, alpha)])
     t = float(np.exp(-b[0].real))
     if len(w) == 0 or w.sum() <= 0:

@@ -77,8 +77,8 @@ pub const MBOIT_STAR6: [f32; 3] = [0.48, 0.451, 0.45];
 pub const MBOIT_STAR8: [f32; 4] = [0.75, 0.676_666_7, 0.63, 0.600_303];
 /// mboit's default moment bias for 4, 6 and 8 power moments at 32 bits (the paper's, Sec. 3.5).
 pub const MBOIT_BIAS: [f32; 3] = [5e-7, 5e-6, 5e-5];
-/// mboit's default moment bias for 2, 3 and 4 trigonometric moments at 32 bits (toward 0, the
-/// moments of the uniform angle).
+/// mboit's default moment bias for 2, 3 and 4 complex trigonometric moments (4, 6, 8 real) at
+/// 32 bits (toward 0, the moments of the uniform angle).
 pub const MBOIT_TRIG_BIAS: [f32; 3] = [4e-7, 3.8e-7, 8e-7];
 /// The angle of the trigonometric basis' wrapping zone, 0.1 pi (the paper's code's default).
 pub const MBOIT_WRAP: f32 = 0.314_159_27;

@@ -5,8 +5,8 @@
 
 use super::accum::{blended, FloatTargets, ADD, AUX_FORMAT};
 use super::frame::{FrameCtx, Method, MethodReport, Outcome};
-use super::info::{never, ErrorBound, Memory, MethodInfo, Order, FRAMES};
-use super::params::{ChoiceParam, FloatParam, IntParam, Params};
+use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Order, FRAMES};
+use super::params::{ChoiceParam, FloatParam, IntParam};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::consts::{MBOIT_BIAS, MBOIT_TRIG_BIAS};
 use crate::error::{invalid, Result};
@@ -15,8 +15,8 @@ use crate::shader::Const;
 
 const MOMENTS: IntParam = IntParam::new(
     "moments",
-    (2, 8, 6),
-    "moments of the optical depth: 4, 6 or 8 power moments, 2, 3 or 4 trigonometric (more: closer to the exact composite)",
+    (4, 8, 6),
+    "real moments of the optical depth: 4, 6 or 8 (the trigonometric basis: 2, 3 or 4 complex moments); more: closer to the exact composite",
 )
 .compiled_as("MOMENTS");
 const BASIS: ChoiceParam<u32> = ChoiceParam::new(
@@ -36,23 +36,15 @@ const BIAS: FloatParam = FloatParam::new(
 const OVERESTIMATION: FloatParam =
     FloatParam::new("overestimation", (0.0, 1.0, 0.25), "share of the fragment's own depth's mass counted in front of it");
 
-/// The moment counts of the power and the trigonometric basis.
-const COUNTS: [[u32; 3]; 2] = [[4, 6, 8], [2, 3, 4]];
-
-/// Floats a pixel's moments take besides b0: a power moment is one, a trigonometric one two.
-fn floats(params: &Params) -> u64 {
-    MOMENTS.of(params) as u64 * if BASIS.of(params) == 0 { 1 } else { 2 }
-}
+/// The moment counts (real values: a complex trigonometric moment is two).
+const COUNTS: [u32; 3] = [4, 6, 8];
 
 /// The shade pass's two RGBA32F targets: the weighted color, and the optical depth, the error
 /// bound's sum and the fragment count.
 const SHADE_FORMATS: [wgpu::TextureFormat; 2] = [wgpu::TextureFormat::Rgba32Float; 2];
 
-/// b0 (R32F), the moments (4 floats a texel: RGBA32F, then RG32F or RGBA32F), and the shade
-/// pass's targets.
-fn bytes(pixels: u64, params: &Params) -> u64 {
-    pixels * (4 + 4 * floats(params) + 32)
-}
+/// b0 (R32F), the moments (4 a texel: RGBA32F, then RG32F or RGBA32F), and the shade pass's targets.
+const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(MOMENTS, 4, 4 + 32), fixed: 0 };
 
 pub const INFO: MethodInfo = MethodInfo {
     name: "mboit",
@@ -64,7 +56,7 @@ pub const INFO: MethodInfo = MethodInfo {
     features: wgpu::Features::FLOAT32_BLENDABLE,
     order: Order::Rounding,
     antialias_modes: FRAMES,
-    memory: Memory::Computed { formula: "W·H·(4·moments + 36) (power), W·H·(8·moments + 36) (trigonometric)", bytes },
+    memory: Memory::Frame(BYTES),
     error_bound: ErrorBound::PerPixel,
     census: false,
     census_when: never,
@@ -96,10 +88,8 @@ struct Mboit {
 impl Method for Mboit {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let (m, basis) = (MOMENTS.of(cx.params), BASIS.of(cx.params) as usize);
-        let Some(at) = COUNTS[basis].iter().position(|&c| c == m) else {
-            let [a, b, c] = COUNTS[basis];
-            let name = ["power", "trigonometric"][basis];
-            return Err(invalid!("mboit: moments = {m} is not a count of the {name} basis; use {a}, {b} or {c}"));
+        let Some(at) = COUNTS.iter().position(|&c| c == m) else {
+            return Err(invalid!("mboit: moments = {m} is not a moment count; use 4, 6 or 8 (2, 3 or 4 complex trigonometric moments)"));
         };
         let bias = match BIAS.of(cx.params) {
             b if b > 0.0 => b as f32,
@@ -112,7 +102,7 @@ impl Method for Mboit {
             Const::F32("MBOIT_OVERESTIMATION", OVERESTIMATION.of(cx.params) as f32),
         ];
         let f32x4 = wgpu::TextureFormat::Rgba32Float;
-        let (formats, bindings, moments_fs, shade_fs) = match floats(cx.params) {
+        let (formats, bindings, moments_fs, shade_fs) = match m {
             4 => (vec![AUX_FORMAT, f32x4], MOMENTS4, "fs_moments4", "fs_shade4"),
             6 => (vec![AUX_FORMAT, f32x4, wgpu::TextureFormat::Rg32Float], MOMENTS8, "fs_moments", "fs_shade"),
             _ => (vec![AUX_FORMAT, f32x4, f32x4], MOMENTS8, "fs_moments", "fs_shade"),
@@ -129,6 +119,6 @@ impl Method for Mboit {
         accum.blend("shade", cx, &mut enc, &[wgpu::Color::TRANSPARENT; 2], &shade, &[cx.targets_group(), &moments.group]);
         cx.resolve(&mut enc, "resolve", &resolve, &accum.group, true);
         cx.submit(enc);
-        Ok(Outcome::Done(MethodReport { memory_bytes: bytes(cx.pixels(), cx.params), error_bound: true, ..Default::default() }))
+        Ok(Outcome::Done(MethodReport { memory_bytes: BYTES.at(cx.pixels(), cx.params), error_bound: true, ..Default::default() }))
     }
 }
