@@ -9,7 +9,7 @@ use super::info::{never, ErrorBound, FrameBytes, Linear, Memory, MethodInfo, Ord
 use super::params::{ChoiceParam, FloatParam, IntParam};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::consts::{MBOIT_BIAS, MBOIT_TRIG_BIAS};
-use crate::error::{invalid, Result};
+use crate::error::Result;
 use crate::pipeline;
 use crate::shader::Const;
 
@@ -18,6 +18,7 @@ const MOMENTS: IntParam = IntParam::new(
     (4, 8, 6),
     "real moments of the optical depth: 4, 6 or 8 (the trigonometric basis: 2, 3 or 4 complex moments); more: closer to the exact composite",
 )
+.stepped(2)
 .compiled_as("MOMENTS");
 const BASIS: ChoiceParam<u32> = ChoiceParam::new(
     "basis",
@@ -88,9 +89,7 @@ struct Mboit {
 impl Method for Mboit {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let (m, basis) = (MOMENTS.of(cx.params), BASIS.of(cx.params) as usize);
-        let Some(at) = COUNTS.iter().position(|&c| c == m) else {
-            return Err(invalid!("mboit: moments = {m} is not a moment count; use 4, 6 or 8 (2, 3 or 4 complex trigonometric moments)"));
-        };
+        let at = COUNTS.iter().position(|&c| c == m).expect("resolve_params checked the range and step");
         let bias = match BIAS.of(cx.params) {
             b if b > 0.0 => b as f32,
             _ => [MBOIT_BIAS, MBOIT_TRIG_BIAS][basis][at],
