@@ -372,6 +372,7 @@ fn trig_transmittance(given: array<f32, 9>, phi: f32) -> vec3<f32> {
         start = cmul(start, vec2<f32>(0.4, 0.9));
     }
     for (var it = 0u; it < 64u; it++) {
+        var moved = 0.0;
         for (var j = 0u; j < TRIG_N; j++) {
             var v = c[TRIG_N];
             for (var k = i32(TRIG_N) - 1; k >= 0; k--) {
@@ -383,7 +384,13 @@ fn trig_transmittance(given: array<f32, 9>, phi: f32) -> vec3<f32> {
                     den = cmul(den, r[j] - r[k]);
                 }
             }
-            r[j] -= cdiv(v, den);
+            let step = cdiv(v, den);
+            r[j] -= step;
+            moved = max(moved, dot(step, step));
+        }
+        // Converged to float32 (the roots are on the unit circle).
+        if moved <= 1e-14 {
+            break;
         }
     }
     let zone = 6.28318531 - MBOIT_WRAP;
