@@ -119,6 +119,9 @@ def test_sweep_follows_the_declared_ranges():
     assert {r["seed"] for r in runs} == {0}
     assert harness.sweep(method, quick=True) == [base]
     assert harness.sweep({"name": "plain", "params": []}) == [{}]
+    # A stepped count (mboit's moments: 4, 6, 8) keeps to its step.
+    stepped = {"name": "s", "params": [{"name": "n", "type": "int", "min": 4, "max": 8, "default": 6, "step": 2}]}
+    assert [r["n"] for r in harness.sweep(stepped)] == [4, 6, 8]
 
 
 def test_image_errors():

@@ -58,7 +58,7 @@ def method_params(draw):
     params = {}
     for p in INFO[name]["params"]:
         if p["type"] == "int":
-            params[p["name"]] = draw(st.sampled_from(sorted({p["min"], p["default"], min(p["max"], p["min"] + 1)})))
+            params[p["name"]] = draw(st.sampled_from(sorted({p["min"], p["default"], min(p["max"], p["min"] + p["step"])})))
         elif p["type"] == "float":
             params[p["name"]] = draw(st.floats(p["min"], p["max"]))
         else:

@@ -33,6 +33,7 @@ class _ParamInfo(TypedDict, total=False):
     type: Literal["int", "float", "choice"]
     min: int | float  # int and float only
     max: int | float  # int and float only
+    step: int  # int only: valid values are min, min + step, .., max
     choices: list[str]  # choice only
     default: _ParamValue
 

@@ -48,7 +48,7 @@ def plan(names: Sequence[str] | None = None) -> list[tuple[str, Params]]:
         main = next((p for p in m["params"] if p["name"] == m["main"]), None)
         if main is not None:
             runs += [(m["name"], {**defaults, main["name"]: v}) for v in INT_SWEEP
-                     if main["min"] <= v <= main["max"] and v != main["default"]]
+                     if main["min"] <= v <= main["max"] and (v - main["min"]) % main.get("step", 1) == 0 and v != main["default"]]
     return runs
 
 

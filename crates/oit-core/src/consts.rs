@@ -63,6 +63,26 @@ pub const SWEEP_SAMPLE_WORDS: u32 = 4;
 /// queue for in one wave, and far below llvmpipe's 65,535-iteration loop limit.
 pub const LOCK_TRIES: u32 = 4096;
 
+/// mboit: the smallest 1 - alpha its optical depth -ln(1 - alpha) takes (alpha 1 would be
+/// infinite), 2^-24: T = exp(-b0) stays within 2^-24 of 0 behind an alpha-1 fragment.
+pub const MBOIT_MIN_TRANSMITTANCE: f32 = 5.960_464_5e-8;
+/// mboit's smallest transmittance in front of a fragment, 2^-100: a pixel whose weights alpha T
+/// would all underflow float32 (thousands of dense layers) averages its colors by alpha instead
+/// of showing none, and alpha T C stays a normal float.
+pub const MBOIT_MIN_WEIGHT: f32 = 7.888_609e-31;
+/// mboit's bias vectors b* (even moments; the odd ones are 0) for 4, 6 and 8 power moments at
+/// 32 bits, the paper's (Münstermann et al. 2018, Sec. 3.5; shaders/mboit.wgsl).
+pub const MBOIT_STAR4: [f32; 2] = [0.375, 0.375];
+pub const MBOIT_STAR6: [f32; 3] = [0.48, 0.451, 0.45];
+pub const MBOIT_STAR8: [f32; 4] = [0.75, 0.676_666_7, 0.63, 0.600_303];
+/// mboit's default moment bias for 4, 6 and 8 power moments at 32 bits (the paper's, Sec. 3.5).
+pub const MBOIT_BIAS: [f32; 3] = [5e-7, 5e-6, 5e-5];
+/// mboit's default moment bias for 2, 3 and 4 complex trigonometric moments (4, 6, 8 real) at
+/// 32 bits (toward 0, the moments of the uniform angle).
+pub const MBOIT_TRIG_BIAS: [f32; 3] = [4e-7, 3.8e-7, 8e-7];
+/// The angle of the trigonometric basis' wrapping zone, 0.1 pi (the paper's code's default).
+pub const MBOIT_WRAP: f32 = 0.314_159_27;
+
 /// Every shared constant, in the order they are prepended (float64 ones as the float32 the
 /// shaders compute with).
 pub const SHARED: &[Const] = &[
@@ -129,4 +149,22 @@ pub const SHARED: &[Const] = &[
     Const::U32("SWEEP_PIXEL_WORDS", SWEEP_PIXEL_WORDS),
     Const::U32("SWEEP_SAMPLE_WORDS", SWEEP_SAMPLE_WORDS),
     Const::U32("LOCK_TRIES", LOCK_TRIES),
+    Const::F32("MBOIT_MIN_TRANSMITTANCE", MBOIT_MIN_TRANSMITTANCE),
+    Const::F32("MBOIT_MIN_WEIGHT", MBOIT_MIN_WEIGHT),
+    Const::F32("MBOIT_STAR4_2", MBOIT_STAR4[0]),
+    Const::F32("MBOIT_STAR4_4", MBOIT_STAR4[1]),
+    Const::F32("MBOIT_STAR6_2", MBOIT_STAR6[0]),
+    Const::F32("MBOIT_STAR6_4", MBOIT_STAR6[1]),
+    Const::F32("MBOIT_STAR6_6", MBOIT_STAR6[2]),
+    Const::F32("MBOIT_STAR8_2", MBOIT_STAR8[0]),
+    Const::F32("MBOIT_STAR8_4", MBOIT_STAR8[1]),
+    Const::F32("MBOIT_STAR8_6", MBOIT_STAR8[2]),
+    Const::F32("MBOIT_STAR8_8", MBOIT_STAR8[3]),
+    Const::F32("MBOIT_BIAS_4", MBOIT_BIAS[0]),
+    Const::F32("MBOIT_BIAS_6", MBOIT_BIAS[1]),
+    Const::F32("MBOIT_BIAS_8", MBOIT_BIAS[2]),
+    Const::F32("MBOIT_TRIG_BIAS_2", MBOIT_TRIG_BIAS[0]),
+    Const::F32("MBOIT_TRIG_BIAS_3", MBOIT_TRIG_BIAS[1]),
+    Const::F32("MBOIT_TRIG_BIAS_4", MBOIT_TRIG_BIAS[2]),
+    Const::F32("MBOIT_WRAP", MBOIT_WRAP),
 ];

@@ -49,10 +49,11 @@ pub fn methods<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
             pd.set_item("name", p.name)?;
             pd.set_item("doc", p.doc)?;
             match p.kind {
-                ParamKind::Int { min, max, default } => {
+                ParamKind::Int { min, max, default, step } => {
                     pd.set_item("type", "int")?;
                     pd.set_item("min", min)?;
                     pd.set_item("max", max)?;
+                    pd.set_item("step", step)?;
                     pd.set_item("default", default)?;
                 }
                 ParamKind::Float { min, max, default } => {

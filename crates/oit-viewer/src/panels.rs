@@ -90,8 +90,9 @@ fn method_section(ui: &mut egui::Ui, s: &mut Settings, out: &mut Vec<Action>) {
 /// all layers"), a list for choices. Returns whether the value changed.
 fn param_widget(ui: &mut egui::Ui, method: &MethodInfo, p: &ParamInfo, v: &mut ParamValue) -> bool {
     let changed = match (p.kind, v) {
-        (ParamKind::Int { min, max, .. }, ParamValue::Int(x)) if max - min <= 4096 => {
-            ui.add(egui::Slider::new(x, min..=max).text(p.name).logarithmic(max >= 64 && min >= 0)).changed()
+        (ParamKind::Int { min, max, step, .. }, ParamValue::Int(x)) if max - min <= 4096 => {
+            let slider = egui::Slider::new(x, min..=max).text(p.name).logarithmic(max >= 64 && min >= 0);
+            ui.add(slider.step_by(step as f64)).changed()
         }
         (ParamKind::Int { min, max, .. }, ParamValue::Int(x)) => {
             ui.horizontal(|ui| {

@@ -129,7 +129,8 @@ def _swept(method: dict) -> list[Params]:
     out = []
     for p in method["params"]:
         if p["name"] in SWEPT:
-            for v in sorted({v for v in INT_SWEEP if p["min"] <= v <= p["max"]} | {p["default"]}):
+            on_step = {v for v in INT_SWEEP if p["min"] <= v <= p["max"] and (v - p["min"]) % p.get("step", 1) == 0}
+            for v in sorted(on_step | {p["default"]}):
                 out.append({**_defaults(method), p["name"]: v})
     return out
 

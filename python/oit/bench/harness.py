@@ -52,7 +52,8 @@ def sweep(method: dict, quick: bool = False) -> list[Params]:
         if p["type"] == "choice":
             values = list(p["choices"])
         elif p["type"] == "int":
-            values = sorted({v for v in INT_SWEEP if p["min"] <= v <= p["max"]} | {p["default"]})
+            values = sorted({v for v in INT_SWEEP if p["min"] <= v <= p["max"] and (v - p["min"]) % p.get("step", 1) == 0}
+                            | {p["default"]})
         else:
             values = sorted({p["min"], p["default"], p["max"]})
         runs += [run for run in ({**defaults, p["name"]: v} for v in values) if run not in runs]

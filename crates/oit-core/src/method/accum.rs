@@ -49,6 +49,7 @@ pub const TARGET_BYTES: u64 = 16 + 4;
 /// hybrid's blended tail's four (ktab.rs). Tiles of a frame share them, each drawing its part.
 pub(crate) struct FloatTargets {
     size: (u32, u32),
+    formats: Vec<wgpu::TextureFormat>,
     views: Vec<wgpu::TextureView>,
     /// The targets as textures at `bindings` (the layout `Layout::Textures(bindings)`, in the
     /// order of the formats).
@@ -56,7 +57,7 @@ pub(crate) struct FloatTargets {
 }
 
 impl FloatTargets {
-    /// The targets of `formats` in `slot`, made anew when the frame size changed; a resolve
+    /// The targets of `formats` in `slot`, made anew when the frame size or formats changed; a resolve
     /// reads them at `bindings` of its group.
     pub fn ensure<'s>(
         slot: &'s mut Option<FloatTargets>,
@@ -65,7 +66,7 @@ impl FloatTargets {
         bindings: &'static [(&'static str, u32)],
     ) -> &'s FloatTargets {
         let size = (cx.targets.width, cx.targets.height);
-        if slot.as_ref().is_none_or(|t| t.size != size) {
+        if slot.as_ref().is_none_or(|t| t.size != size || t.formats != formats) {
             let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
             let views: Vec<wgpu::TextureView> = formats
                 .iter()
@@ -76,7 +77,7 @@ impl FloatTargets {
             let resources: Vec<(&str, wgpu::BindingResource<'_>)> =
                 bindings.iter().zip(&views).map(|((name, _), v)| (*name, wgpu::BindingResource::TextureView(v))).collect();
             let group = cx.group(Layout::Textures(bindings), &resources);
-            *slot = Some(FloatTargets { size, views, group });
+            *slot = Some(FloatTargets { size, formats: formats.to_vec(), views, group });
         }
         slot.as_ref().expect("made above")
     }
@@ -118,13 +119,27 @@ impl FloatTargets {
         groups: &[&wgpu::BindGroup],
     ) {
         let aux_clear = if aux == Companion::Reveal { wgpu::Color::WHITE } else { wgpu::Color::TRANSPARENT };
-        let attachments = self.attachments(&[wgpu::Color::TRANSPARENT, aux_clear]);
+        self.blend("accumulate", cx, enc, &[wgpu::Color::TRANSPARENT, aux_clear], pipeline, groups);
+    }
+
+    /// Records a blended geometry pass named `label` into these targets, each cleared to its
+    /// value in `clears`, as `accumulate` does.
+    pub fn blend(
+        &self,
+        label: &'static str,
+        cx: &mut FrameCtx<'_>,
+        enc: &mut wgpu::CommandEncoder,
+        clears: &[wgpu::Color],
+        pipeline: &wgpu::RenderPipeline,
+        groups: &[&wgpu::BindGroup],
+    ) {
+        let attachments = self.attachments(clears);
         let (depth, scene) = (&cx.targets.depth, cx.scene);
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("accumulate"),
+            label: Some(label),
             color_attachments: &attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: depth, depth_ops: None, stencil_ops: None }),
-            timestamp_writes: cx.timer.render_pass("accumulate"),
+            timestamp_writes: cx.timer.render_pass(label),
             occlusion_query_set: None,
             multiview_mask: None,
         });

@@ -39,6 +39,7 @@ registry! {
     stochastic: [INFO],
     mlab: [INFO],
     mlab_lists: [INFO],
+    mboit: [INFO],
     bucket_peeling: [INFO],
     auto: [INFO],
 }

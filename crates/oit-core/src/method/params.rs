@@ -9,9 +9,22 @@ use crate::shader::Const;
 /// A parameter's type, range and default.
 #[derive(Clone, Copy, Debug)]
 pub enum ParamKind {
-    Int { min: i64, max: i64, default: i64 },
-    Float { min: f64, max: f64, default: f64 },
-    Choice { choices: &'static [&'static str], default: &'static str },
+    /// Valid values: min, min + step, .., max.
+    Int {
+        min: i64,
+        max: i64,
+        default: i64,
+        step: i64,
+    },
+    Float {
+        min: f64,
+        max: f64,
+        default: f64,
+    },
+    Choice {
+        choices: &'static [&'static str],
+        default: &'static str,
+    },
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -32,7 +45,14 @@ pub struct IntParam(pub ParamInfo);
 impl IntParam {
     pub const fn new(name: &'static str, (min, max, default): (i64, i64, i64), doc: &'static str) -> Self {
         assert!(0 <= min && min <= default && default <= max && max <= u32::MAX as i64, "an integer parameter is a u32 in range");
-        Self(ParamInfo { name, kind: ParamKind::Int { min, max, default }, doc, compiled: None })
+        Self(ParamInfo { name, kind: ParamKind::Int { min, max, default, step: 1 }, doc, compiled: None })
+    }
+
+    /// The same parameter valid only at min, min + step, .., max (its default and max among them).
+    pub const fn stepped(self, step: i64) -> Self {
+        let ParamKind::Int { min, max, default, .. } = self.0.kind else { unreachable!() };
+        assert!(step >= 1 && (default - min) % step == 0 && (max - min) % step == 0, "default and max on the step");
+        Self(ParamInfo { kind: ParamKind::Int { min, max, default, step }, ..self.0 })
     }
 
     /// The same parameter compiled into the shader constant `constant`.
@@ -177,9 +197,13 @@ pub(crate) fn did_you_mean<'a>(name: &str, options: impl Iterator<Item = &'a str
 pub(crate) fn check(method: &str, info: &ParamInfo, value: &ParamValue) -> Result<ParamValue> {
     let name = info.name;
     match (info.kind, value) {
-        (ParamKind::Int { min, max, .. }, ParamValue::Int(v)) => {
+        (ParamKind::Int { min, max, step, .. }, ParamValue::Int(v)) => {
             if *v < min || *v > max {
                 return Err(invalid!("{method}: {name} = {v} is out of range; use {min} <= {name} <= {max}"));
+            }
+            if (*v - min) % step != 0 {
+                let valid: Vec<String> = (min..=max).step_by(step as usize).map(|x| x.to_string()).collect();
+                return Err(invalid!("{method}: {name} = {v} is not a valid count; use one of {}", valid.join(", ")));
             }
             Ok(ParamValue::Int(*v))
         }
