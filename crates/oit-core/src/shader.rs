@@ -5,6 +5,20 @@
 
 include!(concat!(env!("OUT_DIR"), "/shader_sources.rs"));
 
+// The list of shaders is this checkout's: a target directory shared with another checkout whose
+// build script ran last (with other shader files) is refused here rather than missing a shader
+// at run time. The remedy: `touch crates/oit-core/build.rs`, then build again.
+const _: () = assert!(same_str(SOURCES_OF, env!("CARGO_MANIFEST_DIR")), "shader list of another checkout: touch crates/oit-core/build.rs");
+
+const fn same_str(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    let mut i = 0;
+    while i < a.len() && i < b.len() && a[i] == b[i] {
+        i += 1;
+    }
+    i == a.len() && i == b.len()
+}
+
 pub use crate::consts::Const;
 
 /// The engine's constants a shader needs when it is validated without a pipeline (tests,
