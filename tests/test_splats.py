@@ -242,3 +242,24 @@ def test_scene_files_carry_splats(tmp_path, harmonics):
     b = oit.reference(again, PERSPECTIVE, 24, 24)
     np.testing.assert_array_equal(a, b)
     assert a[..., 3].max() > 0.1
+
+
+@pytest.mark.parametrize("kind", ["surface", "cloud"])
+def test_the_splat_scenes_render_exactly_with_abuffer(renderer, kind):
+    """oit.scenes.splats: flat Gaussians on a surface and a faint anisotropic cloud, one set
+    each; the A-buffer equals the float64 reference off the ambiguous pixels."""
+    built = oit.scenes.splats(2000, kind=kind, seed=3)
+    frame = renderer(64, 64).render(built.scene, built.camera, "abuffer")
+    ref, ambiguous = oit.reference(built.scene, built.camera, 64, 64, return_mask=True)
+    assert frame.stats["max_depth_complexity"] > 4
+    err = np.abs(frame.image[..., :3].astype(np.float64) - ref[..., :3])[~ambiguous]
+    assert err.max() < 1e-4, err.max()
+    again = oit.scenes.splats(2000, kind=kind, seed=3)
+    assert np.array_equal(again.meshes[0].positions, built.meshes[0].positions)
+
+
+def test_the_splat_scenes_refuse_what_they_cannot_build():
+    with pytest.raises(ValueError, match="kind must be"):
+        oit.scenes.splats(10, kind="smoke")
+    with pytest.raises(ValueError, match="count must be at least 1"):
+        oit.scenes.splats(0)

@@ -27,7 +27,7 @@ from ._meshes import (
 )
 
 __all__ = ["BuiltScene", "MeshArrays", "from_meshes", "is_lit", "unlit", "hair", "smoke", "foliage",
-           "dragons", "glass", "stacks", "ALPHA_KINDS", "DRAGON_ALPHAS", "DRAGON_FILE", "shared_data_dir",
+           "dragons", "glass", "stacks", "splats", "ALPHA_KINDS", "DRAGON_ALPHAS", "DRAGON_FILE", "shared_data_dir",
            "default_dragon_path", "SCENES", "SHOWCASE", "PEER_FAN_SEGMENTS"]
 
 
@@ -238,6 +238,65 @@ def glass(detail: int = 32) -> BuiltScene:
     camera = Camera.look_at(eye=(1.2, 0.9, 1.8), target=(0.0, 0.0, 0.0), fov_y=45.0, near=1.0, far=5.0)
     lights = [((-0.5, -0.7, -0.6), (1.0, 0.97, 0.92), 0.75), ((0.8, -0.2, -0.3), (0.6, 0.7, 1.0), 0.3)]
     return from_meshes(meshes, camera, (512, 512), {}, lights=lights, ambient=(0.35, 0.35, 0.35))
+
+
+def _quaternions_to(normals: np.ndarray) -> np.ndarray:
+    """wxyz quaternions turning +z onto each unit normal (a half-turn about x for -z)."""
+    w = 1.0 + normals[:, 2]
+    q = np.stack([w, -normals[:, 1], normals[:, 0], np.zeros(len(normals))], 1)
+    q[w < 1e-6] = (0.0, 1.0, 0.0, 0.0)
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def splats(count: int = 20000, kind: str = "surface", seed: int = 0) -> BuiltScene:
+    """Gaussian splats (`Scene.add_gaussians`), as 3D Gaussian splatting fits them, in one set.
+
+    `kind="surface"`: flat Gaussians fitted to a bumpy blob's surface, each lying in the tangent
+    plane at a point drawn by area (in-plane spread about half the point spacing, a tenth of
+    that across), colored by their normal, mostly opaque (0.6-0.95): overlapping discs, a few
+    deep where the surface folds or turns edge-on. `kind="cloud"`: anisotropic Gaussians in random orientations
+    filling an ellipsoid, faint (0.03-0.25) and deep, as a volume of smoke is fitted. Any count
+    from thousands to millions."""
+    if kind not in ("surface", "cloud"):
+        raise ValueError(f"kind must be 'surface' or 'cloud', got {kind!r}")
+    if count < 1:
+        raise ValueError(f"count must be at least 1, got {count}")
+    rng = np.random.default_rng(seed)
+    if kind == "surface":
+        positions, indices = geometry.blob((0.0, 0.0, 0.0), 1.1, bumps=0.25)
+        tri = positions[indices]
+        cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        area = 0.5 * np.linalg.norm(cross, axis=1)
+        which = rng.choice(len(indices), count, p=area / area.sum())
+        u, v = rng.uniform(0.0, 1.0, (2, count))
+        flip = u + v > 1.0
+        u[flip], v[flip] = 1.0 - u[flip], 1.0 - v[flip]
+        t = tri[which]
+        means = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
+        normals = cross[which] / np.linalg.norm(cross[which], axis=1, keepdims=True)
+        spacing = np.sqrt(area.sum() / count)
+        spread = 0.5 * spacing * rng.uniform(0.6, 1.0, (count, 1))
+        scales = np.concatenate([spread, spread * rng.uniform(0.6, 1.0, (count, 1)), 0.1 * spread], 1)
+        rotations = _quaternions_to(normals)
+        rgb = np.clip(0.25 + 0.6 * (0.5 + 0.5 * normals) * np.array([1.0, 0.8, 0.6]), 0.0, 1.0)
+        opacity = rng.uniform(0.6, 0.95, count)
+    else:
+        d = rng.normal(size=(count, 3))
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        means = d * rng.uniform(0.0, 1.0, (count, 1)) ** (1 / 3) * np.array([0.9, 0.6, 0.6])
+        base = 0.6 * count ** (-1 / 3)
+        scales = base * rng.uniform(0.3, 1.0, (count, 3))
+        rotations = rng.normal(size=(count, 4))
+        rotations /= np.linalg.norm(rotations, axis=1, keepdims=True)
+        height = (means[:, 1] + 0.6) / 1.2
+        rgb = np.clip(np.array([0.55, 0.6, 0.7]) + 0.35 * height[:, None] * np.array([0.6, 0.5, 0.3]), 0.0, 1.0)
+        opacity = rng.uniform(0.03, 0.25, count)
+    colors = np.concatenate([rgb, opacity[:, None]], 1).astype(np.float32)
+    primitive = {"kind": "gaussians", "scales": scales.astype(np.float32), "rotations": rotations.astype(np.float32),
+                 "sh": None, "degree": 0}
+    set_ = MeshArrays(means.astype(np.float32), np.zeros((0, 3), np.uint32), colors, primitive=primitive)
+    camera = Camera.look_at(eye=(0.6, 0.5, 2.8), target=(0.0, 0.0, 0.0), fov_y=45.0, near=1.0, far=5.0)
+    return from_meshes([set_], camera, (512, 512), {"splats": count, "kind": kind})
 
 
 # The opacities of the hybrid paper's 22 dragons (Maule et al. 2013), front to back.
