@@ -22,6 +22,9 @@ fn main() {
     // run, and cargo checks relative paths in the clone being built (absolute ones would be the
     // clone that ran it last, whose files may be others).
     println!("cargo::rerun-if-changed=../../shaders");
+    // And again whenever cargo is run from another directory (another checkout): a relative path
+    // whose files are older than the other checkout's run would not say so.
+    println!("cargo::rerun-if-env-changed=PWD");
     let mut files = Vec::new();
     collect(&root, &root, &mut files);
     let mut code = String::from(

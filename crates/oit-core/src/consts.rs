@@ -10,6 +10,25 @@ pub enum Const {
     F32(&'static str, f32),
 }
 
+impl Const {
+    /// The WGSL name it is declared as.
+    pub const fn name(&self) -> &'static str {
+        match *self {
+            Const::U32(n, _) | Const::F32(n, _) => n,
+        }
+    }
+}
+
+/// Whether two names are the same, in `const` code (a declaration checked at compile time).
+pub const fn same_str(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    let mut i = 0;
+    while i < a.len() && i < b.len() && a[i] == b[i] {
+        i += 1;
+    }
+    i == a.len() && i == b.len()
+}
+
 /// Words per pixel of hybrid's accumulators, kept by atomicMax: the nearest evicted key and the
 /// tail colors' smallest and largest channel (shaders/hybrid.wgsl).
 pub const HYBRID_ACCUM_WORDS: u32 = 3;

@@ -8,16 +8,10 @@ include!(concat!(env!("OUT_DIR"), "/shader_sources.rs"));
 // The list of shaders is this checkout's: a target directory shared with another checkout whose
 // build script ran last (with other shader files) is refused here rather than missing a shader
 // at run time. The remedy: `touch crates/oit-core/build.rs`, then build again.
-const _: () = assert!(same_str(SOURCES_OF, env!("CARGO_MANIFEST_DIR")), "shader list of another checkout: touch crates/oit-core/build.rs");
-
-const fn same_str(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    let mut i = 0;
-    while i < a.len() && i < b.len() && a[i] == b[i] {
-        i += 1;
-    }
-    i == a.len() && i == b.len()
-}
+const _: () = assert!(
+    crate::consts::same_str(SOURCES_OF, env!("CARGO_MANIFEST_DIR")),
+    "shader list of another checkout: touch crates/oit-core/build.rs"
+);
 
 pub use crate::consts::Const;
 
@@ -152,10 +146,7 @@ const UNLIT: SceneVariant = SceneVariant {
 /// `base` with `variant`'s constants in place of those of the same names.
 pub fn with_variant(base: &[Const], variant: SceneVariant) -> Vec<Const> {
     let own = variant.consts();
-    let name = |c: &Const| match *c {
-        Const::U32(n, _) | Const::F32(n, _) => n,
-    };
-    let mut consts: Vec<Const> = base.iter().copied().filter(|c| !own.iter().any(|o| name(o) == name(c))).collect();
+    let mut consts: Vec<Const> = base.iter().copied().filter(|c| !own.iter().any(|o| o.name() == c.name())).collect();
     consts.extend(own);
     consts
 }
@@ -250,10 +241,7 @@ fn with_defines(path: &str, consts: &[Const]) -> Vec<Const> {
             (name, value)
         })
         .collect();
-    let name = |c: &Const| match *c {
-        Const::U32(n, _) | Const::F32(n, _) => n,
-    };
-    let mut out: Vec<Const> = consts.iter().copied().filter(|c| !own.iter().any(|(n, _)| *n == name(c))).collect();
+    let mut out: Vec<Const> = consts.iter().copied().filter(|c| !own.iter().any(|(n, _)| *n == c.name())).collect();
     out.extend(own.iter().map(|&(n, v)| Const::U32(n, v)));
     out
 }

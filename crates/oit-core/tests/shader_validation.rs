@@ -162,9 +162,7 @@ fn shared_constants_reach_every_shader_with_the_rust_values() {
     // Defined once: no WGSL file declares a shared constant of its own.
     for (path, src) in SOURCES {
         for c in SHARED {
-            let name = match *c {
-                Const::U32(n, _) | Const::F32(n, _) => n,
-            };
+            let name = c.name();
             assert!(!src.contains(&format!("const {name}:")), "{path} defines {name}, which consts.rs owns");
         }
     }

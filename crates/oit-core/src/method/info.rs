@@ -176,7 +176,7 @@ impl FrameBytes {
             let b = buffers[i].bytes;
             let param = match (out.per_pixel.param, b.per_pixel.param) {
                 (Some(a), Some(c)) => {
-                    assert!(same(a, c), "buffers of one method grow with one parameter");
+                    assert!(crate::consts::same_str(a, c), "buffers of one method grow with one parameter");
                     Some(a)
                 }
                 (a, None) => a,
@@ -188,16 +188,6 @@ impl FrameBytes {
         }
         out
     }
-}
-
-/// Whether two names are the same (for `const` code).
-const fn same(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    let mut i = 0;
-    while i < a.len() && i < b.len() && a[i] == b[i] {
-        i += 1;
-    }
-    i == a.len() && i == b.len()
 }
 
 /// One buffer of a method's own storage group, declared once: its binding's name (as its WGSL

@@ -63,13 +63,10 @@ pub fn methods() -> &'static [MethodInfo] {
 /// their defaults and its other constants (`MethodInfo::constants`), the first of a name kept.
 pub fn default_consts() -> Vec<Const> {
     let mut out: Vec<Const> = shader::ENGINE_CONSTS.to_vec();
-    let name = |c: &Const| match *c {
-        Const::U32(n, _) | Const::F32(n, _) => n,
-    };
     for m in REGISTRY {
         let compiled = m.params.iter().filter_map(|p| p.compiled).map(|(n, v)| Const::U32(n, v));
         for c in compiled.chain(m.constants.iter().copied()) {
-            if !out.iter().any(|o| name(o) == name(&c)) {
+            if !out.iter().any(|o| o.name() == c.name()) {
                 out.push(c);
             }
         }
