@@ -38,8 +38,9 @@ fn optical_depth(a: f32) -> f32 {
 // inverse projection: there w = 1 / h.w); under an orthographic one (w the same at both planes)
 // the window depth, linear in the view depth already.
 fn warp(clip: vec4<f32>, view_w: f32) -> f32 {
-    let near = 1.0 / (frame.inv_view_proj * vec4<f32>(0.0, 0.0, 0.0, 1.0)).w;
-    let far = 1.0 / (frame.inv_view_proj * vec4<f32>(0.0, 0.0, 1.0, 1.0)).w;
+    // The w rows of the inverse projection times (0, 0, 0, 1) and (0, 0, 1, 1).
+    let near = 1.0 / frame.inv_view_proj[3].w;
+    let far = 1.0 / (frame.inv_view_proj[2].w + frame.inv_view_proj[3].w);
     if !(abs(far - near) > 1e-6 * abs(near)) || near <= 0.0 || view_w <= 0.0 {
         return 2.0 * clip.z - 1.0;
     }
@@ -107,165 +108,179 @@ fn fs_moments(raw: VsOut) -> Moments {
     return Moments(vec4<f32>(od, 0.0, 0.0, 0.0), vec4<f32>(p[0], p[1], p[2], p[3]) * od, vec4<f32>(p[4], p[5], p[6], p[7]) * od);
 }
 
-// The even moments of the bias vector b* for MOMENTS (its odd ones are 0).
-fn bias_vector(k: u32) -> f32 {
-    if k % 2u == 1u {
-        return 0.0;
-    }
-    var star: array<f32, 4>;
+// The bias vector b* for MOMENTS as (b1 .. b4) and (b5 .. b8) (its odd moments are 0).
+fn bias_lo() -> vec4<f32> {
     if MOMENTS == 4u {
-        star = array<f32, 4>(MBOIT_STAR4_2, MBOIT_STAR4_4, 0.0, 0.0);
+        return vec4<f32>(0.0, MBOIT_STAR4_2, 0.0, MBOIT_STAR4_4);
     } else if MOMENTS == 6u {
-        star = array<f32, 4>(MBOIT_STAR6_2, MBOIT_STAR6_4, MBOIT_STAR6_6, 0.0);
+        return vec4<f32>(0.0, MBOIT_STAR6_2, 0.0, MBOIT_STAR6_4);
+    }
+    return vec4<f32>(0.0, MBOIT_STAR8_2, 0.0, MBOIT_STAR8_4);
+}
+
+fn bias_hi() -> vec4<f32> {
+    if MOMENTS == 6u {
+        return vec4<f32>(0.0, MBOIT_STAR6_6, 0.0, 0.0);
+    }
+    return vec4<f32>(0.0, MBOIT_STAR8_6, 0.0, MBOIT_STAR8_8);
+}
+
+// The Hankel matrix H[i][j] = m[i + j], i, j = 0 .. N, of the normalized moments (m0 = 1) as
+// L D L^T. L's first column is m = (m1 .. m4) itself (d0 = 1); `l1` is column 1 from row 1
+// (L11 = 1, L21, L31, L41), `l2` column 2 from row 2, `l3` column 3 from row 3; d = (d1 .. d4).
+// Straight-line vector code throughout: a loop indexing a local array runs lane by lane on a
+// software rasterizer (it made this pass 25 times the cost of the moments pass).
+struct Hankel {
+    m: vec4<f32>,
+    l1: vec4<f32>,
+    l2: vec3<f32>,
+    l3: vec2<f32>,
+    d: vec4<f32>,
+}
+
+fn hankel(lo: vec4<f32>, hi: vec4<f32>) -> Hankel {
+    var h: Hankel;
+    h.m = lo;
+    h.d = vec4<f32>(1.0);
+    // L[i][j] = (m[i + j] - sum over k < j of L[i][k] L[j][k] d[k]) / d[j].
+    h.d.x = lo.y - lo.x * lo.x;
+    h.l1 = (vec4<f32>(lo.yzw, hi.x) - lo * lo.x) / h.d.x;
+    h.d.y = lo.w - lo.y * lo.y - h.l1.y * h.l1.y * h.d.x;
+    h.l2 = (vec3<f32>(lo.w, hi.xy) - lo.yzw * lo.y - h.l1.yzw * h.l1.y * h.d.x) / h.d.y;
+    if N >= 3u {
+        h.d.z = hi.y - lo.z * lo.z - h.l1.z * h.l1.z * h.d.x - h.l2.y * h.l2.y * h.d.y;
+        h.l3 = (hi.yz - lo.zw * lo.z - h.l1.zw * h.l1.z * h.d.x - h.l2.yz * h.l2.y * h.d.y) / h.d.z;
+    }
+    if N >= 4u {
+        h.d.w = hi.w - lo.w * lo.w - dot(vec3<f32>(h.l1.w, h.l2.z, h.l3.y) * vec3<f32>(h.l1.w, h.l2.z, h.l3.y), h.d.xyz);
+    }
+    return h;
+}
+
+// L^-1 (1, x, .., x^N) at four points x at once: y1 .. y4, a component a point (y0 = 1).
+struct Forward {
+    y1: vec4<f32>,
+    y2: vec4<f32>,
+    y3: vec4<f32>,
+    y4: vec4<f32>,
+}
+
+fn forward(h: Hankel, x: vec4<f32>) -> Forward {
+    var f: Forward;
+    let x2 = x * x;
+    f.y1 = x - h.m.x;
+    f.y2 = x2 - h.m.y - h.l1.y * f.y1;
+    if N >= 3u {
+        f.y3 = x2 * x - h.m.z - h.l1.z * f.y1 - h.l2.y * f.y2;
+    }
+    if N >= 4u {
+        f.y4 = x2 * x2 - h.m.w - h.l1.w * f.y1 - h.l2.z * f.y2 - h.l3.y * f.y3;
+    }
+    return f;
+}
+
+// The Christoffel function 1 / (v(x)^T H^-1 v(x)) = 1 / (1 + sum of y_k^2 / d_k) at four
+// points: the weight of a node of a representation of the moments there.
+fn christoffel(h: Hankel, f: Forward) -> vec4<f32> {
+    var s = 1.0 + f.y1 * f.y1 / h.d.x + f.y2 * f.y2 / h.d.y;
+    if N >= 3u {
+        s += f.y3 * f.y3 / h.d.z;
+    }
+    if N >= 4u {
+        s += f.y4 * f.y4 / h.d.w;
+    }
+    return 1.0 / s;
+}
+
+// L^-1 (1, z, .., z^N) at one point: (y1 .. y4).
+fn forward_at(h: Hankel, z: f32) -> vec4<f32> {
+    var y = vec4<f32>(z - h.m.x, 0.0, 0.0, 0.0);
+    y.y = z * z - h.m.y - h.l1.y * y.x;
+    if N >= 3u {
+        y.z = z * z * z - h.m.z - h.l1.z * y.x - h.l2.y * y.y;
+    }
+    if N >= 4u {
+        y.w = z * z * z * z - h.m.w - dot(vec3<f32>(h.l1.w, h.l2.z, h.l3.y), y.xyz);
+    }
+    return y;
+}
+
+// H^-1 v(z) from g = D^-1 L^-1 v(z): the kernel polynomial's coefficients (c0 .. c3) and c4,
+// by the back substitution c_i = g_i - sum over k > i of L[k][i] c_k.
+fn kernel(h: Hankel, g: vec4<f32>) -> array<vec4<f32>, 2> {
+    var c = vec4<f32>(1.0, g.xyz);
+    var c4 = 0.0;
+    if N >= 4u {
+        c4 = g.w;
+        c.w -= h.l3.y * c4;
+    }
+    if N >= 3u {
+        c.z -= h.l2.y * c.w + h.l2.z * c4;
     } else {
-        star = array<f32, 4>(MBOIT_STAR8_2, MBOIT_STAR8_4, MBOIT_STAR8_6, MBOIT_STAR8_8);
+        c.w = 0.0;
     }
-    return star[k / 2u - 1u];
+    c.y -= h.l1.y * c.z + h.l1.z * c.w + h.l1.w * c4;
+    c.x = 1.0 - dot(h.m, vec4<f32>(c.yzw, c4));
+    return array<vec4<f32>, 2>(c, vec4<f32>(c4, 0.0, 0.0, 0.0));
 }
 
-// p(x), p'(x), p''(x) of the polynomial c[0] + c[1] x + ... + c[deg] x^deg (Horner).
-fn horner(coefs: array<f32, 5>, deg: u32, x: f32) -> vec3<f32> {
-    var c = coefs;
-    var v = vec3<f32>(c[deg], 0.0, 0.0);
-    for (var k = i32(deg) - 1; k >= 0; k--) {
-        v = vec3<f32>(v.x * x + c[k], v.y * x + v.x, v.z * x + 2.0 * v.y);
+// The kernel polynomial's N roots (all real) in the first N components: the quadratic's
+// formula; the cubic's trigonometric one, polished by a Newton step; Aberth's simultaneous
+// iteration on the quartic, a root a lane.
+fn kernel_roots(kc: array<vec4<f32>, 2>) -> vec4<f32> {
+    let c = kc[0];
+    if N == 2u {
+        let p = 0.5 * c.y / c.z;
+        let r = sqrt(max(p * p - c.x / c.z, 0.0));
+        return vec4<f32>(-p - r, -p + r, 0.0, 0.0);
     }
-    return v;
-}
-
-// The largest root of the polynomial c (degree N, all its roots real) that is not one of the
-// `count` roots in `found`: Laguerre's method on c divided by (x - found[j]), the division
-// implicit in the logarithmic derivatives (an explicit one loses the small roots to rounding
-// after a large one), from above every root (Cauchy's bound), where it converges
-// monotonically, cubically near the root.
-fn largest_root(coefs: array<f32, 5>, given: array<f32, 5>, count: u32) -> f32 {
-    var c = coefs;
-    var found = given;
-    var bound = 0.0;
-    for (var k = 0u; k < N; k++) {
-        bound = max(bound, abs(c[k] / c[N]));
+    if N == 3u {
+        // x^3 + a.z x^2 + a.y x + a.x; x = t - s gives t^3 + p t + q.
+        let a = c.xyz / c.w;
+        let s = a.z / 3.0;
+        let p = a.y - 3.0 * s * s;
+        let q = (2.0 * s * s - a.y) * s + a.x;
+        let rho = sqrt(max(-p / 3.0, 0.0));
+        let cos3 = clamp(-q / max(2.0 * rho * rho * rho, 1e-30), -1.0, 1.0);
+        let theta = acos(cos3) / 3.0 - vec3<f32>(0.0, 2.09439510, 4.18879020);
+        var x = 2.0 * rho * cos(theta) - s;
+        let v = ((x + a.z) * x + a.y) * x + a.x;
+        let dv = (3.0 * x + 2.0 * a.z) * x + a.y;
+        x -= select(vec3<f32>(0.0), v / dv, dv != vec3<f32>(0.0));
+        return vec4<f32>(x, 0.0);
     }
-    var x = 1.0 + bound;
-    let n = f32(N - count);
-    for (var it = 0u; it < 40u; it++) {
-        let v = horner(coefs, N, x);
-        if v.x == 0.0 {
-            break;
-        }
-        var g = v.y / v.x;
-        var h = g * g - v.z / v.x;
-        for (var j = 0u; j < count; j++) {
-            let q = 1.0 / (x - found[j]);
-            g -= q;
-            h -= q * q;
-        }
-        let s = sqrt(max((n - 1.0) * (n * h - g * g), 0.0));
-        let den = select(g - s, g + s, g >= 0.0);
-        if den == 0.0 {
-            break;
-        }
-        let step = n / den;
+    // x^4 + a.w x^3 + a.z x^2 + a.y x + a.x.
+    let a = c / kc[1].x;
+    var x = vec4<f32>(-0.87, -0.33, 0.35, 0.86);
+    for (var it = 0u; it < 32u; it++) {
+        let v = (((x + a.w) * x + a.z) * x + a.y) * x + a.x;
+        let dv = ((4.0 * x + 3.0 * a.w) * x + 2.0 * a.z) * x + a.y;
+        let ratio = v / dv;
+        let pull = 1.0 / (x - x.yzwx) + 1.0 / (x - x.zwxy) + 1.0 / (x - x.wxyz);
+        let step = ratio / (1.0 - ratio * pull);
         x -= step;
-        if abs(step) <= 1e-7 * abs(x) {
+        if all(abs(step) <= vec4<f32>(1e-7)) {
             break;
         }
     }
     return x;
 }
 
-// The integral against m of the polynomial through (x[i], f[i]), i = 0 .. N: Newton's divided
-// differences, then its monomial coefficients.
-fn integral(nodes: array<f32, 5>, values: array<f32, 5>, moments: array<f32, 9>) -> f32 {
-    var x = nodes;
-    var f = values;
-    var m = moments;
-    for (var j = 1u; j <= N; j++) {
-        for (var i = N; i >= j; i--) {
-            f[i] = (f[i] - f[i - 1u]) / (x[i] - x[i - j]);
-        }
-    }
-    var p: array<f32, 5>;
-    p[0] = f[N];
-    for (var j = i32(N) - 1; j >= 0; j--) {
-        for (var k = N - u32(j); k >= 1u; k--) {
-            p[k] = p[k - 1u] - x[j] * p[k];
-        }
-        p[0] = f[j] - x[j] * p[0];
-    }
-    var sum = 0.0;
-    for (var k = 0u; k <= N; k++) {
-        sum += p[k] * m[k];
-    }
-    return sum;
-}
-
-// The normalized absorbance in front of warped depth z from b = (b0, b1, .., b8) (paper
-// Algorithm 1), with the biased measure's mass in front of z and up to it (the moment
-// problem's lower and upper bounds: the reconstruction with 0 and with 1 at z).
-fn transmittance(given: array<f32, 9>, z: f32) -> vec3<f32> {
-    var b = given;
-    // Normalized and biased toward b*: m = (1 - beta) b / b0 + beta b*.
-    var m: array<f32, 9>;
-    m[0] = 1.0;
-    for (var k = 1u; k <= 2u * N; k++) {
-        m[k] = mix(b[k] / b[0], bias_vector(k), MBOIT_BIAS);
-    }
-    // Hankel matrix H[i][j] = m[i + j] = L D L^T.
-    var l: array<array<f32, 5>, 5>;
-    var d: array<f32, 5>;
-    for (var i = 0u; i <= N; i++) {
-        for (var j = 0u; j < i; j++) {
-            var s = m[i + j];
-            for (var k = 0u; k < j; k++) {
-                s -= l[i][k] * l[j][k] * d[k];
-            }
-            l[i][j] = s / d[j];
-        }
-        var e = m[2u * i];
-        for (var k = 0u; k < i; k++) {
-            e -= l[i][k] * l[i][k] * d[k];
-        }
-        d[i] = e;
-    }
-    // H c = (1, z, .., z^N): the kernel polynomial's coefficients.
-    var c: array<f32, 5>;
-    var zk = 1.0;
-    for (var i = 0u; i <= N; i++) {
-        var s = zk;
-        for (var k = 0u; k < i; k++) {
-            s -= l[i][k] * c[k];
-        }
-        c[i] = s;
-        zk *= z;
-    }
-    for (var i = 0u; i <= N; i++) {
-        c[i] /= d[i];
-    }
-    for (var i = i32(N); i >= 0; i--) {
-        var s = c[i];
-        for (var k = u32(i) + 1u; k <= N; k++) {
-            s -= l[k][i] * c[k];
-        }
-        c[i] = s;
-    }
-    // Nodes: z (value: the overestimation), then the kernel polynomial's N roots (value 1 in
-    // front of z, 0 behind it), largest first.
-    var x: array<f32, 5>;
-    var f: array<f32, 5>;
-    x[0] = z;
-    f[0] = MBOIT_OVERESTIMATION;
-    var roots: array<f32, 5>;
-    for (var r = 0u; r < N; r++) {
-        roots[r] = largest_root(c, roots, r);
-        x[r + 1u] = roots[r];
-        f[r + 1u] = select(0.0, 1.0, roots[r] < z);
-    }
-    // The interpolating polynomial through (x, f), integrated against the biased moments.
-    let estimate = integral(x, f, m);
-    f[0] = 0.0;
-    let lower = integral(x, f, m);
-    f[0] = 1.0;
-    return vec3<f32>(estimate, lower, integral(x, f, m));
+// The normalized absorbance in front of warped depth z from b0 and the moments b1 .. b8 (paper
+// Algorithm 1), with the biased measure's mass in front of z and up to it (the moment problem's
+// lower and upper bounds). The nodes of the representation through z are z and the kernel
+// polynomial's roots; integrating the polynomial interpolating the overestimation at z, 1 at the
+// roots in front and 0 behind is summing the nodes' Christoffel weights with those factors.
+fn transmittance(b0: f32, lo: vec4<f32>, hi: vec4<f32>, z: f32) -> vec3<f32> {
+    let h = hankel(mix(lo / b0, bias_lo(), MBOIT_BIAS), mix(hi / b0, bias_hi(), MBOIT_BIAS));
+    // Components past N are 0 in y and 1 in d.
+    let y = forward_at(h, z);
+    let g = y / h.d;
+    let own = 1.0 / (1.0 + dot(g, y));
+    let roots = kernel_roots(kernel(h, g));
+    let used = vec4<f32>(1.0, 1.0, select(0.0, 1.0, N >= 3u), select(0.0, 1.0, N >= 4u));
+    let front = dot(christoffel(h, forward(h, roots)) * used, select(vec4<f32>(0.0), vec4<f32>(1.0), roots < vec4<f32>(z)));
+    return vec3<f32>(front + MBOIT_OVERESTIMATION * own, front, front + own);
 }
 
 // ---- trigonometric moments (Sec. 3.6): complex numbers as vec2 (re, im).
@@ -286,7 +301,7 @@ fn conj(a: vec2<f32>) -> vec2<f32> {
 }
 
 // The Hermitian Toeplitz matrix of the moments, T[k][l] = m[k - l] (m[-j] = conj(m[j])),
-// factored as L D L^H; `christoffel` and `kernel` solve with it.
+// factored as L D L^H; `trig_christoffel` and `trig_transmittance` solve with it.
 struct Toeplitz {
     l: array<array<vec2<f32>, 5>, 5>,
     d: array<f32, 5>,
@@ -313,7 +328,7 @@ fn toeplitz(m: array<vec2<f32>, 5>) -> Toeplitz {
 }
 
 // L^-1 (1, e^(i theta), .., e^(i TRIG_N theta)).
-fn forward(t: Toeplitz, theta: f32) -> array<vec2<f32>, 5> {
+fn trig_forward(t: Toeplitz, theta: f32) -> array<vec2<f32>, 5> {
     var tt = t;
     var y: array<vec2<f32>, 5>;
     for (var i = 0u; i <= TRIG_N; i++) {
@@ -327,9 +342,9 @@ fn forward(t: Toeplitz, theta: f32) -> array<vec2<f32>, 5> {
 }
 
 // The Christoffel function 1 / (e^H T^-1 e) at angle theta: the weight of a node there.
-fn christoffel(t: Toeplitz, theta: f32) -> f32 {
+fn trig_christoffel(t: Toeplitz, theta: f32) -> f32 {
     var tt = t;
-    var y = forward(t, theta);
+    var y = trig_forward(t, theta);
     var k = 0.0;
     for (var i = 0u; i <= TRIG_N; i++) {
         k += dot(y[i], y[i]) / tt.d[i];
@@ -350,7 +365,7 @@ fn trig_transmittance(given: array<f32, 9>, phi: f32) -> vec3<f32> {
     }
     var t = toeplitz(m);
     // q = T^-1 e(phi); the kernel polynomial sum conj(q[k]) z^k.
-    var q = forward(t, phi);
+    var q = trig_forward(t, phi);
     for (var i = 0u; i <= TRIG_N; i++) {
         q[i] /= t.d[i];
     }
@@ -394,14 +409,14 @@ fn trig_transmittance(given: array<f32, 9>, phi: f32) -> vec3<f32> {
         }
     }
     let zone = 6.28318531 - MBOIT_WRAP;
-    let own = christoffel(t, phi);
+    let own = trig_christoffel(t, phi);
     var front = 0.0;
     var zone_part = 0.0;
     var zone_mass = 0.0;
     for (var j = 0u; j < TRIG_N; j++) {
         var theta = atan2(r[j].y, r[j].x);
         theta = select(theta, theta + 6.28318531, theta < 0.0);
-        let w = christoffel(t, theta);
+        let w = trig_christoffel(t, theta);
         if theta > zone {
             zone_part += (theta - zone) / MBOIT_WRAP * w;
             zone_mass += w;
@@ -416,23 +431,23 @@ fn trig_transmittance(given: array<f32, 9>, phi: f32) -> vec3<f32> {
 // A fragment's color weighted by alpha T (T from the estimate of the absorbance in front of
 // it), its optical depth, and its share of the error bound: alpha max(C) times how far T can
 // be from the transmittance of every measure with these moments (docs/methods.md, "mboit").
-fn shade_with(raw: VsOut, b: array<f32, 9>) -> Accum {
+fn shade_with(raw: VsOut, b0: f32, lo: vec4<f32>, hi: vec4<f32>) -> Accum {
     let in = shaded(raw);
     let a = in.color.a;
     if a <= 0.0 { discard; }
     let z = warp(in.clip, in.view_w);
     var masses: vec3<f32>;
     if MBOIT_BASIS == 0u {
-        masses = transmittance(b, z);
+        masses = transmittance(b0, lo, hi, z);
     } else {
-        masses = trig_transmittance(b, angle(z));
+        masses = trig_transmittance(array<f32, 9>(b0, lo.x, lo.y, lo.z, lo.w, hi.x, hi.y, hi.z, hi.w), angle(z));
     }
-    let t = clamp(exp(-b[0] * masses.x), MBOIT_MIN_WEIGHT, 1.0);
+    let t = clamp(exp(-b0 * masses.x), MBOIT_MIN_WEIGHT, 1.0);
     // The bias mixed beta of another measure in: the true mass in front is within
     // [(lower - beta) / (1 - beta), upper / (1 - beta)].
     let lower = max(masses.y - MBOIT_BIAS, 0.0) / (1.0 - MBOIT_BIAS);
     let upper = min(masses.z / (1.0 - MBOIT_BIAS), 1.0);
-    let dev = max(max(t - exp(-b[0] * upper), exp(-b[0] * lower) - t), 0.0) + MBOIT_MIN_TRANSMITTANCE;
+    let dev = max(max(t - exp(-b0 * upper), exp(-b0 * lower) - t), 0.0) + MBOIT_MIN_TRANSMITTANCE;
     let w = a * t;
     let c = in.color.rgb;
     return Accum(vec4<f32>(c * w, w), vec4<f32>(optical_depth(a), a * max(max(c.r, c.g), c.b) * dev, 1.0, 0.0));
@@ -441,18 +456,13 @@ fn shade_with(raw: VsOut, b: array<f32, 9>) -> Accum {
 @fragment
 fn fs_shade4(raw: VsOut) -> Accum {
     let p = vec2<i32>(raw.clip.xy);
-    let lo = textureLoad(low_tex, p, 0);
-    let b = array<f32, 9>(textureLoad(b0_tex, p, 0).r, lo.x, lo.y, lo.z, lo.w, 0.0, 0.0, 0.0, 0.0);
-    return shade_with(raw, b);
+    return shade_with(raw, textureLoad(b0_tex, p, 0).r, textureLoad(low_tex, p, 0), vec4<f32>(0.0));
 }
 
 @fragment
 fn fs_shade(raw: VsOut) -> Accum {
     let p = vec2<i32>(raw.clip.xy);
-    let lo = textureLoad(low_tex, p, 0);
-    let hi = textureLoad(high_tex, p, 0);
-    let b = array<f32, 9>(textureLoad(b0_tex, p, 0).r, lo.x, lo.y, lo.z, lo.w, hi.x, hi.y, hi.z, hi.w);
-    return shade_with(raw, b);
+    return shade_with(raw, textureLoad(b0_tex, p, 0).r, textureLoad(low_tex, p, 0), textureLoad(high_tex, p, 0));
 }
 
 @group(2) @binding(3) var accum_tex: texture_2d<f32>;
