@@ -122,3 +122,21 @@ def test_the_tail_term_scales_with_the_range_of_the_colors_behind_the_core(rende
     # A white background widens the range to 0.5: T_core * 0.5 comes back.
     bright = r.render(build_scene(meshes), IDENTITY, method, k=2, background=(1.0, 1.0, 1.0))
     assert bright.error_bound.max() > 0.3
+
+
+def test_auto_renders_mboit_where_a_weighted_average_is_within_the_tolerance(renderer):
+    # Ten faint layers (coverage 1 - 0.98^10, about 0.18) over black: any average of their colors
+    # that keeps the exact coverage errs by at most their range with the base's (0 to 0.77) times
+    # 0.18, and mboit's own bound meets 0.2, so auto renders it, at less memory than any hybrid.
+    scene = build_scene([layer(0.1 + 0.08 * i, (0.5 + 0.03 * i, 0.4, 0.6 - 0.02 * i, 0.02)) for i in range(10)])
+    r = renderer(8, 8)
+    frame = r.render(scene, IDENTITY, "auto", tolerance=0.2)
+    exact = r.render(scene, IDENTITY, "abuffer")
+    extra = frame.stats["extra"]
+    assert extra["auto_moments"] == 2 and extra["auto_exact"] == 0 and extra["auto_k"] == 0
+    assert np.array_equal(frame.image, r.render(scene, IDENTITY, "mboit", moments=4).image)
+    assert measured(frame, exact).max() <= frame.error_bound.max() + 1e-6 <= 0.2 + 1e-6
+    assert frame.stats["memory_bytes"] == oit.memory_bytes("mboit", 8, 8, moments=4) + 8 * 8 * 20
+    # A tolerance below that: mboit is not tried, and hybrid meets it.
+    tight = r.render(scene, IDENTITY, "auto", tolerance=0.01)
+    assert tight.stats["extra"]["auto_moments"] == 0 and tight.stats["extra"]["auto_k"] > 0

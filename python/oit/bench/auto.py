@@ -84,7 +84,8 @@ def auto_vs_fixed(scenes: list[str], sizes: list[int] | None = None, tolerances:
 
 
 # Stats that auto reports beside the image (docs/methods.md, "Error bounds per pixel, and auto").
-AUTO_STATS = ("auto_k", "auto_mean_k", "auto_slots", "auto_predicted_k", "auto_exact", "auto_attempts", "error_bound_max")
+AUTO_STATS = ("auto_k", "auto_mean_k", "auto_slots", "auto_predicted_k", "auto_exact", "auto_attempts", "auto_moments",
+              "error_bound_max")
 _AUTO_EMPTY = {**{f"{who}_{what}": math.nan for who in ("auto", "fixed") for what in
                   ("gpu_ms", "wall_ms", "mib", "max_abs", "max_err", "max_err_all", "mean_err")},
                **dict.fromkeys(AUTO_STATS, math.nan), "within_t": None, "fixed_k": "",
@@ -102,7 +103,7 @@ def _measured(who: str, frame: Any, gpu: list[float], wall: list[float], exact: 
 
 AUTO_COLUMNS = [
     ("scene", "{}"), ("size", "{}"), ("tolerance", "{:.5f}"), ("auto_k", "{:.0f}"), ("auto_mean_k", "{:.1f}"),
-    ("auto_exact", "{:.0f}"),
+    ("auto_exact", "{:.0f}"), ("auto_moments", "{:.0f}"),
     ("auto_attempts", "{:.0f}"), ("auto_gpu_ms", "{:.1f}"), ("auto_wall_ms", "{:.1f}"), ("auto_mib", "{:.2f}"),
     ("auto_max_abs", "{:.5f}"), ("auto_max_err", "{:.5f}"), ("auto_max_err_all", "{:.5f}"), ("within_t", "{}"),
     ("fixed_k", "{}"),

@@ -1,8 +1,11 @@
-//! `auto`: accuracy on demand. Given a tolerance t, it picks per frame the cheapest hybrid
-//! whose per-pixel error bound (docs/methods.md, "hybrid") is at most t everywhere, or the
-//! exact A-buffer. It decides before rendering: an estimate pass gathers per pixel the
-//! optical depth of the fragments and their alpha-quantization error; with the census's
-//! fragment counts that predicts hybrid's bound for every k (`predicted_bound`). Each pixel gets
+//! `auto`: accuracy on demand. Given a tolerance t, it picks per frame the cheapest of mboit,
+//! hybrid and the exact A-buffer whose per-pixel error bound (docs/methods.md, "mboit",
+//! "hybrid") is at most t everywhere. It decides before rendering: an estimate pass gathers per
+//! pixel the optical depth of the fragments and their alpha-quantization error. Where every
+//! pixel's colors times its coverage are within t (`weighted_average_bound`: the error of any
+//! average that keeps the exact coverage, as mboit's does), mboit with 4 moments is rendered
+//! first, at less memory than any hybrid, and kept if its own bound meets t. Otherwise, with the
+//! census's fragment counts, the sums predict hybrid's bound for every k (`predicted_bound`). Each pixel gets
 //! the smallest k predicted to meet t (its own slots: `Slots::PerPixel`, no more than its
 //! fragments) and the real bound is read back; where it misses, those pixels get twice the
 //! slots once, and then the exact A-buffer is rendered. When some pixel has no k ≤ 32
@@ -11,7 +14,7 @@
 use super::frame::{FrameCtx, Method, Outcome};
 use super::info::{never, ErrorBound, Memory, MethodInfo, Order, SceneBytes, FRAMES};
 use super::ktab::{self, KTab, Slots};
-use super::params::{FloatParam, Params};
+use super::params::{FloatParam, ParamValue, Params};
 use crate::cache::{spec, Layout, PipelineSpec};
 use crate::consts::{self, ALPHA_8BIT_ERROR, ROUNDING_TERM as ROUNDING};
 use crate::context::GpuContext;
@@ -34,6 +37,7 @@ pub const INFO: MethodInfo = MethodInfo {
     passes: &[
         "census",
         "estimate",
+        "mboit with 4 moments where every pixel's colors times its coverage are within the tolerance",
         "hybrid with each pixel's smallest k predicted to meet the tolerance (twice that where it misses), else abuffer",
     ],
     params: &[TOLERANCE.0],
@@ -41,7 +45,7 @@ pub const INFO: MethodInfo = MethodInfo {
     order: Order::Bitwise,
     antialias_modes: FRAMES,
     memory: Memory::Slots {
-        formula: "2·Σk·4 + W·H·84 + 8 (hybrid with per-pixel slots and the estimate), or the A-buffer's",
+        formula: "W·H·(20 + 52) (mboit with 4 moments and the estimate), 2·Σk·4 + W·H·84 + 8 (hybrid with per-pixel slots and the estimate), or the A-buffer's",
         bytes: memory_bytes,
         storage: SceneBytes { per_pixel: 84, per_fragment: 24, per_triangle: 0 },
     },
@@ -49,7 +53,7 @@ pub const INFO: MethodInfo = MethodInfo {
     census: true,
     census_when: never,
     main: None,
-    pipelines: &[PIPELINES, ktab::PIPELINES],
+    pipelines: &[PIPELINES, ktab::PIPELINES, super::mboit::INFO.pipelines[0]],
     constants: &[],
     create: |gpu, limits| Box::new(Auto::new(gpu, limits)),
 };
@@ -62,6 +66,7 @@ const TAU2_SCALE: f64 = consts::TAU2_SCALE as f64;
 const QUANT_SCALE: f64 = consts::QUANT_SCALE as f64;
 
 struct Auto {
+    moments: Box<dyn Method>,
     hybrid: KTab,
     exact: Box<dyn Method>,
     /// The estimate pass's sums, and their readback by size.
@@ -73,7 +78,27 @@ impl Auto {
     fn new(gpu: &GpuContext, limits: &super::frame::Limits) -> Self {
         let hybrid = KTab::new(true);
         let exact = super::abuffer::INFO.instantiate(gpu, limits);
-        Self { hybrid, exact, estimate: None, readback: None }
+        let moments = super::mboit::INFO.instantiate(gpu, limits);
+        Self { moments, hybrid, exact, estimate: None, readback: None }
+    }
+
+    /// Renders mboit with 4 power moments: Ok(report with auto's extras) when its bound meets
+    /// `tolerance` at every pixel, Err(the bytes its targets hold) when it does not (the caller
+    /// goes on to hybrid; the targets stay for the next frame, and count in this one's memory).
+    fn try_moments(&mut self, cx: &mut FrameCtx<'_>, tolerance: f64) -> Result<std::result::Result<Outcome, u64>> {
+        let given = [("moments".to_string(), ParamValue::Int(4))];
+        let params = super::mboit::INFO.resolve_params(&given)?;
+        let Outcome::Done(mut report) = self.moments.render(&mut cx.with_params(&params))? else {
+            unreachable!("mboit's memory is per pixel: it never asks to grow or retile")
+        };
+        let (t, tile) = (cx.targets, cx.tile);
+        let bound = read_region(cx.gpu, &t.bound_texture, &t.bound_readback, 4, tile.local())?;
+        if bound.iter().any(|&b| b as f64 > tolerance) {
+            return Ok(Err(report.memory_bytes));
+        }
+        report.memory_bytes += cx.pixels() * WORDS * 4;
+        report.extra.extend(extras((0.0, 0.0, 0.0), 0.0, 0.0, MOMENTS_KEPT, 1.0));
+        Ok(Ok(Outcome::Done(report)))
     }
 
     /// Runs the estimate pass; returns its sums per pixel.
@@ -156,6 +181,22 @@ pub fn predicted_bound(n: u32, s: PixelSums, k: u32) -> f64 {
     quant_term + tail + (k + n + 2) as f64 * ROUNDING
 }
 
+/// The error bound of any composite that weights a pixel's colors by weights summing to its
+/// exact coverage 1 − e^(−τ) (mboit's resolve does): |Σ Cᵢ(wᵢ' − wᵢ)| ≤ range·(1 − e^(−τ)), with
+/// the colors' range from the estimate pass; the largest over the pixels, with the estimate's
+/// fixed-point rounding of τ (half a step a fragment) and float32 compositing's rounding.
+pub fn weighted_average_bound(counts: &[u32], sums: &[PixelSums]) -> f64 {
+    counts
+        .iter()
+        .zip(sums)
+        .filter(|(&n, _)| n > 0)
+        .map(|(&n, s)| {
+            let tau = s.tau + 0.5 * n as f64 / TAU_SCALE;
+            s.range * -(-tau).exp_m1() + (n + 2) as f64 * ROUNDING
+        })
+        .fold(0.0, f64::max)
+}
+
 /// Each pixel's smallest k ≤ min(32, its fragments) predicted to meet `tolerance` (0 where it
 /// has no fragments); None when some pixel has no such k.
 pub fn choose_slots(counts: &[u32], sums: &[PixelSums], tolerance: f64) -> Option<Vec<u32>> {
@@ -184,6 +225,26 @@ fn widen(slots: &[u32], counts: &[u32], bound: &[f32], tolerance: f64) -> Option
         .collect()
 }
 
+/// `auto_moments`: mboit was tried and its bound missed the tolerance; it was kept (the frame is
+/// mboit's with 4 moments). 0: not tried.
+const MOMENTS_MISSED: f64 = 1.0;
+const MOMENTS_KEPT: f64 = 2.0;
+
+/// auto's figures in the frame's stats: the largest and mean k and all the slots of the hybrid
+/// it rendered (0 for mboit and the A-buffer), the largest k predicted, whether it rendered the
+/// A-buffer, what became of mboit (`MOMENTS_MISSED`, `MOMENTS_KEPT`), and its attempts.
+fn extras((k, mean_k, slots): (f64, f64, f64), predicted_k: f64, exact: f64, moments: f64, attempts: f64) -> [(&'static str, f64); 7] {
+    [
+        ("auto_k", k),
+        ("auto_mean_k", mean_k),
+        ("auto_slots", slots),
+        ("auto_predicted_k", predicted_k),
+        ("auto_exact", exact),
+        ("auto_attempts", attempts),
+        ("auto_moments", moments),
+    ]
+}
+
 impl Method for Auto {
     fn render(&mut self, cx: &mut FrameCtx<'_>) -> Result<Outcome> {
         let tolerance = TOLERANCE.of(cx.params);
@@ -191,6 +252,18 @@ impl Method for Auto {
         let pixels = cx.pixels();
         let counts = cx.depth_complexity;
         let sums = self.measure(cx)?;
+        // mboit's targets when it was tried and missed (they count in the frame's memory).
+        let mut moments_bytes = None;
+        if weighted_average_bound(counts, &sums) <= tolerance {
+            match self.try_moments(cx, tolerance)? {
+                Ok(done) => return Ok(done),
+                Err(bytes) => moments_bytes = Some(bytes),
+            }
+        }
+        let (moments, tried) = match moments_bytes {
+            Some(bytes) => (MOMENTS_MISSED, bytes),
+            None => (0.0, 0),
+        };
         let predicted = choose_slots(counts, &sums, tolerance);
         let predicted_k = predicted.as_ref().map_or(0, |s| s.iter().copied().max().unwrap_or(0));
         let mut attempts = 0u32;
@@ -206,15 +279,10 @@ impl Method for Auto {
             if worst <= tolerance {
                 let covered = counts.iter().filter(|&&n| n > 0).count().max(1) as f64;
                 let total: u64 = current.iter().map(|&k| k as u64).sum();
-                report.memory_bytes += pixels * WORDS * 4;
-                report.extra.extend([
-                    ("auto_k", current.iter().copied().max().unwrap_or(0) as f64),
-                    ("auto_mean_k", total as f64 / covered),
-                    ("auto_slots", total as f64),
-                    ("auto_predicted_k", predicted_k as f64),
-                    ("auto_exact", 0.0),
-                    ("auto_attempts", attempts as f64),
-                ]);
+                report.memory_bytes += pixels * WORDS * 4 + tried;
+                let k = current.iter().copied().max().unwrap_or(0) as f64;
+                let tries = attempts as f64 + moments.min(1.0);
+                report.extra.extend(extras((k, total as f64 / covered, total as f64), predicted_k as f64, 0.0, moments, tries));
                 return Ok(Outcome::Done(report));
             }
             if attempts < 2 {
@@ -242,15 +310,9 @@ impl Method for Auto {
             wgpu::Extent3d { width: tile.width, height: tile.height, depth_or_array_layers: 1 },
         );
         report.error_bound = true;
-        report.memory_bytes += pixels * WORDS * 4 + hybrid_bytes;
-        report.extra.extend([
-            ("auto_k", 0.0),
-            ("auto_mean_k", 0.0),
-            ("auto_slots", 0.0),
-            ("auto_predicted_k", predicted_k as f64),
-            ("auto_exact", 1.0),
-            ("auto_attempts", (attempts + 1) as f64),
-        ]);
+        report.memory_bytes += pixels * WORDS * 4 + hybrid_bytes + tried;
+        let tries = (attempts + 1) as f64 + moments.min(1.0);
+        report.extra.extend(extras((0.0, 0.0, 0.0), predicted_k as f64, 1.0, moments, tries));
         Ok(Outcome::Done(report))
     }
 }

@@ -19,6 +19,7 @@ pub const EXTRAS: &[(&str, Merge)] = &[
     ("auto_predicted_k", Merge::Max),
     ("auto_exact", Merge::Max),
     ("auto_attempts", Merge::Max),
+    ("auto_moments", Merge::Max),
     ("lock_failures", Merge::Sum),
     ("lock_waits", Merge::Sum),
 ];
