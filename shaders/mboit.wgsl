@@ -322,6 +322,8 @@ fn fs_shade(raw: VsOut) -> Accum {
     return shade_with(raw, textureLoad(b0_tex, p, 0).r, textureLoad(low_tex, p, 0), textureLoad(high_tex, p, 0));
 }
 
+//!include common/mboit16.wgsl
+
 @group(2) @binding(3) var accum_tex: texture_2d<f32>;
 @group(2) @binding(4) var aux_tex: texture_2d<f32>;
 

@@ -449,10 +449,13 @@ def mboit_transmittance(b, z, bias, overestimation=0.25) -> float:
 
 
 def mboit(z, rgb, alpha, bg, bg_a=0.0, moments=6, basis="power", precision="32", bias=0.0, overestimation=0.25):
-    """Moment-based OIT (Münstermann et al. 2018) at 32 bits: each fragment's color weighted by
+    """Moment-based OIT (Münstermann et al. 2018) at 32 bits (16: models_mboit16): each fragment's color weighted by
     alpha and its reconstructed transmittance, averaged, times 1 - exp(-b0); the color behind
     times exp(-b0). `moments` counts reals (a complex trigonometric moment is two); `bias` 0 is
     the paper's for the basis and count (MBOIT_BIAS, MBOIT_TRIG_BIAS)."""
+    if str(precision) == "16":
+        from .models_mboit16 import mboit16
+        return mboit16(z, rgb, alpha, bg, bg_a, moments, basis, bias, overestimation)
     defaults = {"power": MBOIT_BIAS, "trigonometric": MBOIT_TRIG_BIAS}.get(basis, {})
     if str(precision) != "32" or moments not in defaults:
         raise ValueError(f"mboit model: no model of basis={basis!r}, precision={precision!r}, moments={moments}")

@@ -102,6 +102,12 @@ pub const MBOIT_BIAS: [f32; 3] = [5e-7, 5e-7, 5e-7];
 /// mboit's default moment bias for 2, 3 and 4 complex trigonometric moments (4, 6, 8 real) at
 /// 32 bits (toward 0, the moments of the uniform angle).
 pub const MBOIT_TRIG_BIAS: [f32; 3] = [4e-7, 3.8e-7, 8e-7];
+/// mboit's default moment bias at 16 bits (precision "16"), power 4, 6, 8 and trigonometric
+/// 2, 3, 4 complex moments: larger than at 32 bits, so that the quantization of the stored
+/// moments (2^-16 of their range) cannot make the biased Hankel or Toeplitz matrix singular;
+/// chosen on a grid by the mean error and the outliers on the built-in scenes (docs/methods.md).
+pub const MBOIT_BIAS16: [f32; 3] = [5e-5, 5e-5, 2e-4];
+pub const MBOIT_TRIG_BIAS16: [f32; 3] = [1e-4, 5e-5, 1e-4];
 /// The angle of the trigonometric basis' wrapping zone, 0.1 pi (the paper's code's default).
 pub const MBOIT_WRAP: f32 = 0.314_159_27;
 
@@ -188,5 +194,11 @@ pub const SHARED: &[Const] = &[
     Const::F32("MBOIT_TRIG_BIAS_2", MBOIT_TRIG_BIAS[0]),
     Const::F32("MBOIT_TRIG_BIAS_3", MBOIT_TRIG_BIAS[1]),
     Const::F32("MBOIT_TRIG_BIAS_4", MBOIT_TRIG_BIAS[2]),
+    Const::F32("MBOIT_BIAS16_4", MBOIT_BIAS16[0]),
+    Const::F32("MBOIT_BIAS16_6", MBOIT_BIAS16[1]),
+    Const::F32("MBOIT_BIAS16_8", MBOIT_BIAS16[2]),
+    Const::F32("MBOIT_TRIG_BIAS16_2", MBOIT_TRIG_BIAS16[0]),
+    Const::F32("MBOIT_TRIG_BIAS16_3", MBOIT_TRIG_BIAS16[1]),
+    Const::F32("MBOIT_TRIG_BIAS16_4", MBOIT_TRIG_BIAS16[2]),
     Const::F32("MBOIT_WRAP", MBOIT_WRAP),
 ];
