@@ -82,8 +82,9 @@ impl Scene {
 
     /// A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
     /// colors (n, 3) float32, each with n rows or one; or spherical harmonics `sh`, ((n k, 3)
-    /// coefficients, k = (degree + 1)², the DC first; degree), in place of the colors.
-    #[pyo3(signature = (means, scales, rotations, opacities, colors, sh=None))]
+    /// coefficients, k = (degree + 1)², the DC first; degree), in place of the colors; the
+    /// fragment depth `splat_depth` ("center" or "ray").
+    #[pyo3(signature = (means, scales, rotations, opacities, colors, sh=None, splat_depth="center"))]
     fn add_gaussians(
         &mut self,
         means: PyReadonlyArray2<'_, f32>,
@@ -92,8 +93,11 @@ impl Scene {
         opacities: PyReadonlyArray1<'_, f32>,
         colors: PyReadonlyArray2<'_, f32>,
         sh: Option<primitives::Harmonics<'_>>,
+        splat_depth: &str,
     ) -> PyResult<usize> {
-        Ok(self.inner.add_mesh(primitives::gaussians(&means, &scales, &rotations, &opacities, &colors, sh.as_ref())?))
+        let mut mesh = primitives::gaussians(&means, &scales, &rotations, &opacities, &colors, sh.as_ref())?;
+        mesh.material.splat_depth = oit_core::shading::SplatDepth::from_name(splat_depth).map_err(Error::from)?;
+        Ok(self.inner.add_mesh(mesh))
     }
 
     /// Mesh `mesh` as the triangles it is drawn as under `view_proj`.
