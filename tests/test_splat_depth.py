@@ -75,3 +75,35 @@ def test_crossing_splats_swap_order_along_the_ray_and_not_by_centers(renderer):
 def test_a_bad_splat_depth_is_refused():
     with pytest.raises(ValueError, match="splat_depth must be 'center' or 'ray'"):
         oit.Scene().add_gaussians(**splats(2), splat_depth="peak")
+
+
+def test_sorted_blends_a_sets_splats_back_to_front_by_their_means(renderer):
+    """`sorted` orders a splat set's splats by their means' depth (3DGS): the frame equals a
+    numpy back-to-front blend of each splat's own alpha and color (each rendered alone), in
+    that order; the set's order would give another picture."""
+    n = 10
+    data = splats(n, seed=7)
+    # Stacked along the view axis in the wrong order (nearest first) and overlapping on screen.
+    data["means"][:, 2] = np.linspace(0.8, -0.8, n)
+    data["means"][:, :2] *= 0.2
+    data["opacities"] = np.full(n, 0.7)
+    scene = oit.Scene()
+    scene.add_gaussians(**data)
+    size, bg = 40, np.array([0.2, 0.3, 0.4])
+    r = renderer(size, size)
+    frame = r.render(scene, PERSPECTIVE, "sorted", background=bg)
+    layers = []
+    for k in range(n):
+        one = oit.Scene()
+        one.add_gaussians(**{key: v[k:k + 1] for key, v in data.items()})
+        alpha = r.render(one, PERSPECTIVE, "abuffer", background=bg).image[..., 3].astype(np.float64)
+        layers.append(alpha)
+    vp = np.asarray(PERSPECTIVE.view_proj, dtype=np.float64)
+    clip = np.c_[data["means"].astype(np.float64), np.ones(n)] @ vp.T
+    out = np.broadcast_to(bg, (size, size, 3)).copy()
+    for k in np.argsort(-clip[:, 2] / clip[:, 3], kind="stable"):
+        a = layers[k][..., None]
+        out = a * data["colors"][k] + (1 - a) * out
+    assert np.abs(frame.image[..., :3] - out).max() < 1e-5
+    unsorted = r.render(scene, PERSPECTIVE, "unsorted", background=bg).image[..., :3]
+    assert np.abs(unsorted - out).max() > 0.05

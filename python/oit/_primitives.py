@@ -126,7 +126,7 @@ class PrimitiveMethods:
             if not np.isfinite(h).all():
                 raise ValueError("sh has NaN or Inf coefficients")
             harmonics = (np.ascontiguousarray(h.reshape(-1, 3)), degrees[h.shape[1]])
-        return self._native.add_gaussians(m, s, q, np.ascontiguousarray(o), c, harmonics, splat_depth)
+        return self._native.add_gaussians(m, s, q, np.ascontiguousarray(o), c, (harmonics, splat_depth))
 
     def primitives(self) -> list[str]:
         """What each mesh is: "triangles", "strands", "particles" or "gaussians"."""

@@ -176,9 +176,9 @@ mod tests {
         assert!((ray_depth(&vp, mean, &round, o, d).0 - 0.4).abs() < 1e-12);
         // Flat (thin along z' tilted 45 degrees about y): where the ray meets its plane, for
         // any positive multiple of the inverse (the GPU's adjugate).
-        let h = std::f32::consts::FRAC_1_SQRT_2;
-        let flat = covariance([0.3, 0.3, 1e-4], [h, 0.0, h, 0.0]);
-        let normal = rotation([h, 0.0, h, 0.0]) * DVec3::Z;
+        let q = [std::f32::consts::FRAC_PI_8.cos(), 0.0, std::f32::consts::FRAC_PI_8.sin(), 0.0];
+        let flat = covariance([0.3, 0.3, 1e-4], q);
+        let normal = rotation(q) * DVec3::Z;
         let plane = (mean - o).dot(normal) / d.dot(normal);
         for p in [flat.inverse(), flat.inverse() * 7.0] {
             assert!((ray_depth(&vp, mean, &p, o, d).0 - plane).abs() < 1e-6, "{plane}");

@@ -81,10 +81,9 @@ impl Scene {
     }
 
     /// A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
-    /// colors (n, 3) float32, each with n rows or one; or spherical harmonics `sh`, ((n k, 3)
-    /// coefficients, k = (degree + 1)², the DC first; degree), in place of the colors; the
-    /// fragment depth `splat_depth` ("center" or "ray").
-    #[pyo3(signature = (means, scales, rotations, opacities, colors, sh=None, splat_depth="center"))]
+    /// colors (n, 3) float32, each with n rows or one; `look`: spherical harmonics ((n k, 3)
+    /// coefficients, k = (degree + 1)², the DC first; degree) in place of the colors, or None,
+    /// and the fragment depth ("center" or "ray").
     fn add_gaussians(
         &mut self,
         means: PyReadonlyArray2<'_, f32>,
@@ -92,11 +91,11 @@ impl Scene {
         rotations: PyReadonlyArray2<'_, f32>,
         opacities: PyReadonlyArray1<'_, f32>,
         colors: PyReadonlyArray2<'_, f32>,
-        sh: Option<primitives::Harmonics<'_>>,
-        splat_depth: &str,
+        look: (Option<primitives::Harmonics<'_>>, String),
     ) -> PyResult<usize> {
+        let (sh, splat_depth) = look;
         let mut mesh = primitives::gaussians(&means, &scales, &rotations, &opacities, &colors, sh.as_ref())?;
-        mesh.material.splat_depth = oit_core::shading::SplatDepth::from_name(splat_depth).map_err(Error::from)?;
+        mesh.material.splat_depth = oit_core::shading::SplatDepth::from_name(&splat_depth).map_err(Error::from)?;
         Ok(self.inner.add_mesh(mesh))
     }
 
