@@ -30,7 +30,8 @@ fn bucket(px: u32, z: f32) -> u32 {
 }
 
 @fragment @early_depth_test(force)
-fn fs_bounds(in: VsOut) {
+fn fs_bounds(raw: VsOut) {
+    let in = splat_depth(raw);
     if behind_opaque(in.clip) {
         return;
     }
@@ -41,7 +42,8 @@ fn fs_bounds(in: VsOut) {
 }
 
 @fragment @early_depth_test(force)
-fn fs_keys(in: VsOut) {
+fn fs_keys(raw: VsOut) {
+    let in = splat_depth(raw);
     if behind_opaque(in.clip) {
         return;
     }

@@ -66,7 +66,8 @@ fn cs_allocate(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 
 @fragment @early_depth_test(force)
-fn fs_capture(in: VsOut) {
+fn fs_capture(raw: VsOut) {
+    let in = splat_depth(raw);
     if behind_opaque(in.clip) {
         return;
     }

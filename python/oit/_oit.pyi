@@ -137,11 +137,12 @@ class Scene:
         rotations: npt.NDArray[np.float32],
         opacities: npt.NDArray[np.float32],
         colors: npt.NDArray[np.float32],
-        sh: tuple[npt.NDArray[np.float32], int] | None = None,
+        look: tuple[tuple[npt.NDArray[np.float32], int] | None, str],
     ) -> int:
         """A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
-        colors (n, 3) float32, each with n rows or one; or spherical harmonics `sh`, ((n k, 3)
-        coefficients, k = (degree + 1)², the DC first; degree), in place of the colors."""
+        colors (n, 3) float32, each with n rows or one; `look`: spherical harmonics ((n k, 3)
+        coefficients, k = (degree + 1)², the DC first; degree) in place of the colors, or None,
+        and the fragment depth ("center" or "ray")."""
     def to_triangles(
         self, mesh: int, view_proj: npt.NDArray[np.float64]
     ) -> tuple[

@@ -67,7 +67,7 @@ class PrimitiveMethods:
                                           _bool(opaque, "opaque"), falloff=falloff, opacity=float(opacity))
 
     def add_gaussians(self, means: Any, scales: Any, rotations: Any, opacities: Any, colors: Any = None,
-                      sh: Any = None) -> int:
+                      sh: Any = None, splat_depth: str = "center") -> int:
         """Adds a set of 3D Gaussian splats (Kerbl et al. 2023) and returns its index (a mesh
         index).
 
@@ -81,8 +81,13 @@ class PrimitiveMethods:
         all. A Gaussian is drawn as its EWA-projected
         ellipse (a 0.3-pixel² low-pass added) on a 3-sigma quad built on the GPU, its alpha
         opacity * exp(-d'Σ'⁻¹d / 2) at most 0.99 and 0 below 1/255 or past 3 sigma, at the depth
-        of its mean (docs/methods.md, "Gaussian splats").
+        of its mean (splat_depth="center", one depth a splat, as 3DGS sorts them) or of the
+        Gaussian's peak along each pixel's ray (splat_depth="ray", t* = d'Σ⁻¹(μ - o) / d'Σ⁻¹d
+        for the ray o + t d, as StopThePop: a depth a fragment, what exact methods then sort
+        by; docs/methods.md, "Gaussian splats").
         """
+        if splat_depth not in ("center", "ray"):
+            raise ValueError(f"splat_depth must be 'center' or 'ray', got {splat_depth!r}")
         m = _rows(_float_array(means, "means"), 3, "means")
         n = len(m)
 
@@ -121,7 +126,7 @@ class PrimitiveMethods:
             if not np.isfinite(h).all():
                 raise ValueError("sh has NaN or Inf coefficients")
             harmonics = (np.ascontiguousarray(h.reshape(-1, 3)), degrees[h.shape[1]])
-        return self._native.add_gaussians(m, s, q, np.ascontiguousarray(o), c, harmonics)
+        return self._native.add_gaussians(m, s, q, np.ascontiguousarray(o), c, (harmonics, splat_depth))
 
     def primitives(self) -> list[str]:
         """What each mesh is: "triangles", "strands", "particles" or "gaussians"."""

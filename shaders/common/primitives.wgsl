@@ -119,15 +119,8 @@ fn particle_corners(q: u32, ii: u32) -> array<vec3<f32>, 4> {
 // and w (so the disc coordinates interpolate affinely on screen), back in world space. A mean
 // behind the eye gives four equal corners, no fragments.
 fn gaussian_corners(q: u32, ii: u32) -> array<vec3<f32>, 4> {
-    let b = splat_stride() * q;
-    let mean = placed_at(vec3<f32>(positions[b], positions[b + 1u], positions[b + 2u]), ii).xyz;
-    let local = mat3x3<f32>(
-        vec3<f32>(positions[b + 4u], positions[b + 5u], positions[b + 6u]),
-        vec3<f32>(positions[b + 5u], positions[b + 7u], positions[b + 8u]),
-        vec3<f32>(positions[b + 6u], positions[b + 8u], positions[b + 9u]),
-    );
-    let a = placed_linear(ii);
-    let cov = a * local * transpose(a);
+    let mean = gaussian_mean(q, ii);
+    let cov = gaussian_covariance(q, ii);
     let vp = frame.view_proj;
     let c = vp * vec4<f32>(mean, 1.0);
     if !(c.w > 1e-30) {
@@ -156,6 +149,24 @@ fn gaussian_corners(q: u32, ii: u32) -> array<vec3<f32>, 4> {
         out[j] = h.xyz / h.w;
     }
     return out;
+}
+
+// Splat `q`'s mean placed by instance `ii`, and its world covariance A Σ Aᵀ (A the instance's
+// linear part).
+fn gaussian_mean(q: u32, ii: u32) -> vec3<f32> {
+    let b = splat_stride() * q;
+    return placed_at(vec3<f32>(positions[b], positions[b + 1u], positions[b + 2u]), ii).xyz;
+}
+
+fn gaussian_covariance(q: u32, ii: u32) -> mat3x3<f32> {
+    let b = splat_stride() * q;
+    let local = mat3x3<f32>(
+        vec3<f32>(positions[b + 4u], positions[b + 5u], positions[b + 6u]),
+        vec3<f32>(positions[b + 5u], positions[b + 7u], positions[b + 8u]),
+        vec3<f32>(positions[b + 6u], positions[b + 8u], positions[b + 9u]),
+    );
+    let a = placed_linear(ii);
+    return a * local * transpose(a);
 }
 
 // Floats a splat in `positions`: 12, and 3 a harmonic coefficient (the chunk's set has one
@@ -219,6 +230,22 @@ fn expanded_vertex(vi: u32, ii: u32) -> VsOut {
     out.normal = k.tangent;
     out.uv = k.uv;
     out.material = chunk.set_surface;
+//!endif
+//!if SPLAT_RAY
+    let ray = (bitcast<u32>(surfaces[MATERIAL_VEC4S * chunk.set_surface].w) & RAY_DEPTH) != 0u;
+    if chunk.kind == PRIM_GAUSSIANS && ray {
+        // Its peak along each pixel's ray needs the mean and the covariance's adjugate (the
+        // inverse times the determinant, which cancels in t*: a thin splat's tiny
+        // determinant is never divided by).
+        let c = gaussian_covariance(vi / 6u, ii);
+        out.splat_mean = vec4<f32>(gaussian_mean(vi / 6u, ii), 1.0);
+        out.splat_adj0 = vec3<f32>(
+            c[1].y * c[2].z - c[2].y * c[2].y,
+            c[2].x * c[2].y - c[1].x * c[2].z,
+            c[1].x * c[2].y - c[2].x * c[1].y,
+        );
+        out.splat_adj1 = vec3<f32>(c[0].x * c[2].z - c[2].x * c[2].x, c[1].x * c[2].x - c[0].x * c[2].y, c[0].x * c[1].y - c[1].x * c[1].x);
+    }
 //!endif
     return out;
 }

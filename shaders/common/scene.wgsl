@@ -88,6 +88,13 @@ struct VsOut {
     @location(4) uv: vec2<f32>,
     @location(5) @interpolate(flat) material: u32,
 //!endif
+//!if SPLAT_RAY
+    // A ray-depth splat's world mean (w = 1; zero for every other fragment) and the adjugate
+    // of its world covariance (xx xy xz, yy yz zz): what `splat_depth` reads.
+    @location(9) @interpolate(flat) splat_mean: vec4<f32>,
+    @location(10) @interpolate(flat) splat_adj0: vec3<f32>,
+    @location(11) @interpolate(flat) splat_adj1: vec3<f32>,
+//!endif
 //!if TEXTURES
     // The triangle's UV planes (`uv_planes`): what a texture's mip level is chosen from.
     @location(6) @interpolate(flat) uv_plane_u: vec3<f32>,

@@ -245,7 +245,7 @@ fn shade(in: VsOut) -> vec4<f32> {
 // The fragment with its shaded alpha (the same bits as shade()'s) and its vertex RGB: for
 // passes that read only alpha (hybrid's k-TAB store, stochastic's depth pass), no lights.
 fn shaded_alpha(raw: VsOut) -> VsOut {
-    var out = raw;
+    var out = splat_depth(raw);
     out.color.a = surface_base(raw, surfaces[MATERIAL_VEC4S * raw.material]).a;
     return out;
 }
@@ -260,12 +260,13 @@ fn shade(in: VsOut) -> vec4<f32> {
 
 // Unlit: alpha is the vertex alpha.
 fn shaded_alpha(raw: VsOut) -> VsOut {
-    return raw;
+    return splat_depth(raw);
 }
 //!endif
 
 // The fragment with its shaded color: the rest of a fragment entry reads `in.color` as before.
-fn shaded(raw: VsOut) -> VsOut {
+fn shaded(placed: VsOut) -> VsOut {
+    let raw = splat_depth(placed);
     if SHADED == 0u && SHADING_COST == 0u {
         return raw;
     }
@@ -273,3 +274,35 @@ fn shaded(raw: VsOut) -> VsOut {
     out.color = shade(raw);
     return out;
 }
+
+//!if SPLAT_RAY
+// A ray-depth splat's fragment at the depth of the Gaussian's peak along its pixel's ray
+// o + t d (o on the near plane, d to the far plane): t* = dᵀP(μ - o) / dᵀPd, P the
+// covariance's adjugate, the point's NDC depth clamped to [0, 1] (0 where it is not in front
+// of the eye) and its clip w as view_w (oit_core::splat::ray_depth). Every other fragment as
+// it is. The opaque depth test of the rasterizer has seen the quad's depth, the mean's.
+fn splat_depth(raw: VsOut) -> VsOut {
+    if raw.splat_mean.w == 0.0 {
+        return raw;
+    }
+    let at = frame_xy(raw.clip.xy);
+    let ndc = vec2<f32>(at.x * 2.0 / f32(frame.size.x) - 1.0, 1.0 - at.y * 2.0 / f32(frame.size.y));
+    let near = frame.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
+    let far = frame.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
+    let o = near.xyz / near.w;
+    let d = far.xyz / far.w - o;
+    let a = raw.splat_adj0;
+    let b = raw.splat_adj1;
+    let p = mat3x3<f32>(a, vec3<f32>(a.y, b.x, b.y), vec3<f32>(a.z, b.y, b.z));
+    let t = dot(d, p * (raw.splat_mean.xyz - o)) / dot(d, p * d);
+    let c = frame.view_proj * vec4<f32>(o + d * t, 1.0);
+    var out = raw;
+    out.clip.z = select(0.0, clamp(c.z / c.w, 0.0, 1.0), c.w > 0.0);
+    out.view_w = select(raw.view_w, c.w, c.w > 0.0);
+    return out;
+}
+//!else
+fn splat_depth(raw: VsOut) -> VsOut {
+    return raw;
+}
+//!endif

@@ -135,6 +135,7 @@ pub const SHARED: &[Const] = &[
     Const::U32("SHADING_FLAT", crate::shading::Shading::Flat as u32),
     Const::U32("SHADING_SMOOTH", crate::shading::Shading::Smooth as u32),
     Const::U32("TWO_SIDED", crate::shading::TWO_SIDED),
+    Const::U32("RAY_DEPTH", crate::shading::RAY_DEPTH),
     Const::U32("TEXTURED", crate::shading::TEXTURED),
     Const::U32("CULL_BACK", crate::shading::CULL_BACK),
     Const::U32("EMISSIVE_TEXTURED", crate::shading::EMISSIVE_TEXTURED),

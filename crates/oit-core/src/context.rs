@@ -134,6 +134,7 @@ pub fn wanted_features() -> wgpu::Features {
         | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
         | wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS
         | wgpu::Features::SHADER_EARLY_DEPTH_TEST
+        | wgpu::Features::INDIRECT_FIRST_INSTANCE
 }
 
 /// Adapter preference, lower first: hardware before software (lavapipe).

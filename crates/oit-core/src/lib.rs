@@ -39,5 +39,5 @@ pub use primitive::Primitive;
 pub use reference::{reference, reference_antialiased, ReferenceImage};
 pub use renderer::{coverage_methods, shared_context, Antialias, Frame, Renderer, Target, COVERAGE_SAMPLES};
 pub use scene::{Camera, Instance, Mesh, Scene};
-pub use shading::{Falloff, Filter, Light, Material, Sampler, Shading, Texture, TextureMap, Wrap, MAX_LIGHTS};
+pub use shading::{Falloff, Filter, Light, Material, Sampler, Shading, SplatDepth, Texture, TextureMap, Wrap, MAX_LIGHTS};
 pub use stats::Stats;

@@ -162,7 +162,15 @@ impl Mesh {
             let which = if matches!(self.primitive, Primitive::Strands { .. }) { "'unlit' or 'hair'" } else { "'unlit'" };
             return Err(invalid!("{} shade {which}, got '{}'", self.primitive.name(), shading.name()));
         }
-        let material = Material { shading, specular, shininess, opacity, falloff: self.material.falloff, ..Default::default() };
+        let material = Material {
+            shading,
+            specular,
+            shininess,
+            opacity,
+            falloff: self.material.falloff,
+            splat_depth: self.material.splat_depth,
+            ..Default::default()
+        };
         material.validate()?;
         self.material = material;
         Ok(self)

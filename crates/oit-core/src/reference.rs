@@ -4,7 +4,7 @@
 //! model of src/shading/model.rs at its ray barycentrics (perspective-correct). The edge and tie
 //! rule is in docs/methods.md ("The reference").
 
-use glam::{DMat4, DVec2, DVec3, DVec4, Vec3A};
+use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::{builder::build_bvh2, Bvh2};
 use obvhs::ray::Ray;
@@ -46,6 +46,9 @@ struct Tri {
     back: bool,
     /// Whether the triangle's instance mirrors: its front faces are clockwise.
     mirror: bool,
+    /// A ray-depth splat's quad: the Gaussian's world mean and inverse covariance (its hits
+    /// take the depth of its peak along the ray, `splat::ray_depth`).
+    peak: Option<(DVec3, DMat3)>,
 }
 
 struct Bounds(Aabb);
@@ -58,6 +61,9 @@ impl Boundable for Bounds {
 
 struct Hit {
     z: f64,
+    /// The depth the opaque surfaces are tested against: `z`, or for a ray-depth splat its
+    /// quad's (its mean's), as the rasterizer's depth test sees it.
+    quad_z: f64,
     color: DVec4,
     opaque: bool,
 }
@@ -156,10 +162,14 @@ pub fn reference_antialiased(
         for inst in instances {
             if m.primitive != crate::primitive::Primitive::Triangles {
                 // Strands and particles: the triangles the vertex stage builds, in float64.
-                for c in crate::primitive::expand(m, inst, camera, DVec2::new(width as f64, height as f64)).chunks_exact(3) {
+                let peaks = ray_peaks(m, inst);
+                let corners = crate::primitive::expand(m, inst, camera, DVec2::new(width as f64, height as f64));
+                for (j, c) in corners.chunks_exact(3).enumerate() {
                     let c = [c[0], c[1], c[2]];
                     let (v, c, n, uv) = (c.map(|k| k.position), c.map(|k| k.color), c.map(|k| k.tangent), c.map(|k| k.uv));
-                    tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull: false, mirror: false, back: false });
+                    // Two triangles a splat.
+                    let peak = peaks.get(j / 2).copied();
+                    tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull: false, mirror: false, back: false, peak });
                 }
                 continue;
             }
@@ -177,7 +187,7 @@ pub fn reference_antialiased(
                 };
                 let uv = if m.uvs.is_empty() { [DVec2::ZERO; 3] } else { ix.map(|i| DVec2::from(m.uvs[i as usize].map(|x| x as f64))) };
                 let cull = m.material.cull_back_faces;
-                tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull, mirror: inst.mirrors(), back: false });
+                tris.push(Tri { v, c, n, uv, mesh, opaque: m.opaque, screen: None, cull, mirror: inst.mirrors(), back: false, peak: None });
             }
         }
     }
@@ -219,6 +229,20 @@ pub fn reference_antialiased(
     let n = offsets.len() as f64;
     out.image.iter_mut().for_each(|v| *v /= n);
     Ok(out)
+}
+
+/// A ray-depth splat set's Gaussians placed by `inst`: world mean and inverse covariance,
+/// splat after splat (empty for any other set).
+fn ray_peaks(m: &crate::Mesh, inst: &crate::Instance) -> Vec<(DVec3, DMat3)> {
+    let crate::primitive::Primitive::Gaussians { scales, rotations, .. } = &m.primitive else { return Vec::new() };
+    if m.material.splat_depth != crate::shading::SplatDepth::Ray {
+        return Vec::new();
+    }
+    let linear = DMat3::from_mat4(inst.transform);
+    let placed = |i: usize| {
+        (inst.apply(m.positions[i]), (linear * crate::splat::covariance(scales[i], rotations[i]) * linear.transpose()).inverse())
+    };
+    (0..scales.len()).map(placed).collect()
 }
 
 /// What the hits are shaded with: each mesh's material, the lights under the frame's camera.
@@ -380,7 +404,9 @@ fn trace(bvh: &Bvh2, tris: &[Tri], appearance: &Appearance<'_>, ray: &PixelRay, 
                 color = shaded;
                 *edge |= grazing;
             }
-            hits.push(Hit { z: c.z / c.w, color, opaque: t.opaque });
+            let quad_z = c.z / c.w;
+            let z = t.peak.map_or(quad_z, |(mean, precision)| crate::splat::ray_depth(vp, mean, &precision, o, d).0);
+            hits.push(Hit { z, quad_z, color, opaque: t.opaque });
         }
     });
 }
@@ -397,9 +423,22 @@ fn composite(hits: &mut [Hit], background: [f64; 3]) -> ([f64; 4], u32, bool) {
             tie = true;
         }
     }
+    // What the opaque surface hides: a hit behind it in the depth order, but a ray-depth
+    // splat's by its quad's depth (the rasterizer's test), so that one in front by its quad
+    // and behind by its peak is still composited, last but in its ray-depth order.
+    let opaque_z = opaque.map_or(f64::INFINITY, |i| hits[i].z);
+    let shown: Vec<&Hit> = hits
+        .iter()
+        .enumerate()
+        .filter(|(k, h)| !h.opaque && if h.quad_z == h.z { *k < end } else { h.quad_z < opaque_z })
+        .map(|(_, h)| h)
+        .collect();
+    tie |= hits.iter().any(|h| h.quad_z != h.z && (h.quad_z - opaque_z).abs() < DEPTH_TIE);
+    tie |= shown.windows(2).any(|w| (w[1].z - w[0].z).abs() < DEPTH_TIE && w[0].color != w[1].color);
+    let end = shown.len();
     let mut accum = DVec3::ZERO;
     let mut trans = 1.0f64;
-    for h in &hits[..end] {
+    for h in shown {
         accum += trans * h.color.w * h.color.truncate();
         trans *= 1.0 - h.color.w;
     }

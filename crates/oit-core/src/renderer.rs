@@ -358,6 +358,7 @@ impl Renderer {
             falloff: scene.falloff,
             emissive: scene.emissive,
             alpha_test: scene.alpha_test,
+            splat_ray: scene.splat_ray,
         }
     }
 }

@@ -59,6 +59,7 @@ pub const ENGINE_CONSTS: &[Const] = &[
     Const::U32("FALLOFF", 1),
     Const::U32("EMISSIVE", 1),
     Const::U32("ALPHA_TESTS", 1),
+    Const::U32("SPLAT_RAY", 1),
     // Whether `expanded` is writable: the expansion pass of strands and particles only.
     Const::U32("EXPANDING", 0),
 ];
@@ -93,10 +94,13 @@ pub struct SceneVariant {
     /// alpha against a cutoff (glTF's MASK): without one, that code is not compiled.
     pub emissive: bool,
     pub alpha_test: bool,
+    /// Whether any splat set takes its fragments' depth along the pixel's ray
+    /// (`SplatDepth::Ray`): without one, that code and its varyings are not compiled.
+    pub splat_ray: bool,
 }
 
 impl SceneVariant {
-    pub fn consts(&self) -> [Const; 12] {
+    pub fn consts(&self) -> [Const; 13] {
         [
             Const::U32("SHADED", self.shaded as u32),
             Const::U32("LIGHTS", if self.shaded { self.lights } else { 0 }),
@@ -109,6 +113,7 @@ impl SceneVariant {
             Const::U32("FALLOFF", (self.shaded && self.primitives && self.falloff) as u32),
             Const::U32("EMISSIVE", (self.shaded && self.emissive) as u32),
             Const::U32("ALPHA_TESTS", (self.shaded && self.alpha_test) as u32),
+            Const::U32("SPLAT_RAY", (self.shaded && self.primitives && self.falloff && self.splat_ray) as u32),
             // Only shaders/expand.wgsl writes the corners (its own //!define).
             Const::U32("EXPANDING", 0),
         ]
@@ -141,6 +146,7 @@ const UNLIT: SceneVariant = SceneVariant {
     falloff: true,
     emissive: false,
     alpha_test: false,
+    splat_ray: false,
 };
 
 /// `base` with `variant`'s constants in place of those of the same names.

@@ -138,6 +138,22 @@ pub fn corner(f: &SplatFootprint, uv: DVec2, inv_view_proj: &DMat4, size: DVec2)
     h.truncate() / h.w
 }
 
+/// The NDC depth of the Gaussian's peak along the ray `o + t d` (`SplatDepth::Ray`, as
+/// StopThePop): t* = dᵀP(μ - o) / dᵀPd, P the covariance's inverse (or any positive multiple of
+/// it: the GPU takes its adjugate, which a thin splat's tiny determinant does not blow up),
+/// then the point o + t* d under `view_proj`, its depth z / w clamped to [0, 1]; 0 where the
+/// peak is not in front of the eye (w <= 0). Mirrored by `splat_peak_depth`
+/// (shaders/common/shading.wgsl).
+pub fn ray_depth(view_proj: &DMat4, mean: DVec3, precision: &DMat3, o: DVec3, d: DVec3) -> (f64, f64) {
+    let t = d.dot(*precision * (mean - o)) / d.dot(*precision * d);
+    let c = *view_proj * (o + d * t).extend(1.0);
+    if c.w > 0.0 {
+        ((c.z / c.w).clamp(0.0, 1.0), c.w)
+    } else {
+        (0.0, c.w)
+    }
+}
+
 /// 3DGS's alpha: `alpha` clamped to `ALPHA_MAX` and 0 below `ALPHA_MIN`, and whether float32
 /// may land on the other side of the cut (an ambiguous pixel).
 pub fn clamp_alpha(alpha: f64) -> (f64, bool) {
@@ -148,6 +164,30 @@ pub fn clamp_alpha(alpha: f64) -> (f64, bool) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_ray_peak_is_the_closest_point_of_a_round_gaussian_and_the_plane_of_a_flat_one() {
+        // Depth as the parameter itself: view_proj maps z to NDC z, w = 1 (orthographic).
+        let vp = DMat4::IDENTITY;
+        let (o, d) = (DVec3::new(0.1, -0.2, 0.0), DVec3::new(0.0, 0.0, 1.0));
+        let mean = DVec3::new(0.5, 0.3, 0.4);
+        // Round: the point of the ray nearest the mean, whatever the scale.
+        let round = covariance([0.2; 3], [1.0, 0.0, 0.0, 0.0]).inverse();
+        assert!((ray_depth(&vp, mean, &round, o, d).0 - 0.4).abs() < 1e-12);
+        // Flat (thin along z' tilted 45 degrees about y): where the ray meets its plane, for
+        // any positive multiple of the inverse (the GPU's adjugate).
+        let q = [std::f32::consts::FRAC_PI_8.cos(), 0.0, std::f32::consts::FRAC_PI_8.sin(), 0.0];
+        let flat = covariance([0.3, 0.3, 1e-4], q);
+        let normal = rotation(q) * DVec3::Z;
+        let plane = (mean - o).dot(normal) / d.dot(normal);
+        for p in [flat.inverse(), flat.inverse() * 7.0] {
+            assert!((ray_depth(&vp, mean, &p, o, d).0 - plane).abs() < 1e-6, "{plane}");
+        }
+        // Past the far plane: clamped to 1; behind the eye (w <= 0): 0.
+        assert_eq!(ray_depth(&vp, DVec3::new(0.1, -0.2, 3.0), &round, o, d).0, 1.0);
+        let flip = DMat4::from_diagonal(glam::DVec4::new(1.0, 1.0, 1.0, -1.0));
+        assert_eq!(ray_depth(&flip, mean, &round, o, d).0, 0.0);
+    }
 
     #[test]
     fn covariance_is_r_s_s_r() {

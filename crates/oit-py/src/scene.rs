@@ -81,9 +81,9 @@ impl Scene {
     }
 
     /// A splat set: means (n, 3), scales (n, 3), wxyz rotations (n, 4), opacities (n,), RGB
-    /// colors (n, 3) float32, each with n rows or one; or spherical harmonics `sh`, ((n k, 3)
-    /// coefficients, k = (degree + 1)², the DC first; degree), in place of the colors.
-    #[pyo3(signature = (means, scales, rotations, opacities, colors, sh=None))]
+    /// colors (n, 3) float32, each with n rows or one; `look`: spherical harmonics ((n k, 3)
+    /// coefficients, k = (degree + 1)², the DC first; degree) in place of the colors, or None,
+    /// and the fragment depth ("center" or "ray").
     fn add_gaussians(
         &mut self,
         means: PyReadonlyArray2<'_, f32>,
@@ -91,9 +91,12 @@ impl Scene {
         rotations: PyReadonlyArray2<'_, f32>,
         opacities: PyReadonlyArray1<'_, f32>,
         colors: PyReadonlyArray2<'_, f32>,
-        sh: Option<primitives::Harmonics<'_>>,
+        look: (Option<primitives::Harmonics<'_>>, String),
     ) -> PyResult<usize> {
-        Ok(self.inner.add_mesh(primitives::gaussians(&means, &scales, &rotations, &opacities, &colors, sh.as_ref())?))
+        let (sh, splat_depth) = look;
+        let mut mesh = primitives::gaussians(&means, &scales, &rotations, &opacities, &colors, sh.as_ref())?;
+        mesh.material.splat_depth = oit_core::shading::SplatDepth::from_name(&splat_depth).map_err(Error::from)?;
+        Ok(self.inner.add_mesh(mesh))
     }
 
     /// Mesh `mesh` as the triangles it is drawn as under `view_proj`.

@@ -115,6 +115,22 @@ mod tests {
     }
 
     #[test]
+    fn a_3dgs_ply_opens_as_splats_with_its_own_opacities() {
+        let props =
+            ["x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"];
+        let mut text = String::from("ply\nformat ascii 1.0\nelement vertex 2\n");
+        props.iter().for_each(|p| text += &format!("property float {p}\n"));
+        text += "end_header\n0 0 0 0.5 0 -0.5 0 -2 -2 -3 1 0 0 0\n0.5 0 -1 0 0 0 -1 -1 -2 -2 1 0 0 0\n";
+        let s = load(&tmp("splats.ply", text.as_bytes()), None).unwrap();
+        assert_eq!(s.meshes.len(), 1);
+        let m = &s.meshes[0].mesh;
+        assert!(matches!(m.primitive, oit_core::Primitive::Gaussians { .. }), "{:?}", m.primitive);
+        // The logits' sigmoids, not the viewing alpha: the splats blend.
+        let want = [0.5, 1.0 / (1.0 + 1f32.exp())];
+        m.colors.iter().zip(want).for_each(|(c, w)| assert!((c[3] - w).abs() < 1e-6, "{c:?}"));
+    }
+
+    #[test]
     fn obj_with_a_quad_and_alpha_override() {
         let p = tmp("quad.obj", b"o quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
         let s = load(&p, Some(0.25)).unwrap();

@@ -31,8 +31,8 @@ pub const UNSORTED: MethodInfo = MethodInfo {
 
 pub const SORTED: MethodInfo = MethodInfo {
     name: "sorted",
-    summary: "per-mesh back-to-front sort by centroid, then over-blending (wrong for interpenetrating meshes)",
-    passes: &["sort meshes (CPU)", "blend"],
+    summary: "per-mesh back-to-front sort by centroid, a splat set's splats by their means (3DGS), then over-blending (wrong for interpenetrating meshes)",
+    passes: &["sort meshes and splats (CPU)", "blend"],
     order: Order::Submission,
     create: |_, _| Box::new(Blend { kind: Blending::Sorted }),
     ..UNSORTED
@@ -106,18 +106,22 @@ impl Method for Blend {
         let pipeline = cx.draw_pipeline(spec(PIPELINES, self.kind.entry()), &[], vec![Some(target)], pipeline::depth_test_only());
         let geo = &cx.scene.transparent;
         let mut order: Vec<usize> = (0..geo.placements.len()).collect();
+        let vp = cx.camera.matrix_f32();
+        // Far to near: larger NDC depth first; behind the eye (w <= 0) first.
+        let key = |p: glam::Vec3| {
+            let c = vp * p.extend(1.0);
+            if c.w > 0.0 {
+                c.z / c.w
+            } else {
+                f32::INFINITY
+            }
+        };
+        // A splat set's splats far to near by their means (3DGS's order), sorted on the host
+        // and drawn by one indirect draw a splat (a run a chunk).
+        let mut splats: Vec<Option<Vec<SplatRun>>> = Vec::new();
         if self.kind == Blending::Sorted {
-            let vp = cx.camera.matrix_f32();
-            // Far to near: larger NDC depth first; instances behind the eye (w <= 0) go first.
-            let key = |i: usize| {
-                let c = vp * geo.placements[i].centroid.extend(1.0);
-                if c.w > 0.0 {
-                    c.z / c.w
-                } else {
-                    f32::INFINITY
-                }
-            };
-            order.sort_by(|&a, &b| key(b).total_cmp(&key(a)));
+            order.sort_by(|&a, &b| key(geo.placements[b].centroid).total_cmp(&key(geo.placements[a].centroid)));
+            splats = geo.splat_means.iter().enumerate().map(|(i, means)| (!means.is_empty()).then(|| sorted_splats(cx, i, means, &key))).collect();
         }
         let t = cx.targets;
         let mut enc = cx.gpu.device.create_command_encoder(&Default::default());
@@ -125,7 +129,18 @@ impl Method for Blend {
             let mut pass = passes::over_base_pass(&mut enc, "blend", t, &t.depth, None, cx.tile, cx.timer.render_pass("blend"));
             pass.set_pipeline(&pipeline);
             if self.kind == Blending::Sorted {
-                order.iter().for_each(|&i| geo.draw_placement(&mut pass, &geo.placements[i]));
+                for &i in &order {
+                    match &splats[i] {
+                        Some(runs) => runs.iter().for_each(|r| {
+                            geo.bind_chunk(&mut pass, r.chunk);
+                            match &r.buffer {
+                                Some(b) => pass.multi_draw_indirect(b, 0, r.args.len() as u32),
+                                None => r.args.iter().for_each(|&[n, _, first, inst]| pass.draw(first..first + n, inst..inst + 1)),
+                            }
+                        }),
+                        None => geo.draw_placement(&mut pass, &geo.placements[i]),
+                    }
+                }
             } else {
                 geo.draw_all(&mut pass);
             }
@@ -133,4 +148,35 @@ impl Method for Blend {
         cx.gpu.queue.submit([enc.finish()]);
         Ok(Outcome::Done(MethodReport::default()))
     }
+}
+
+/// A run of a splat set's sorted draws in one chunk: its indirect draw arguments, and the
+/// buffer that holds them (None where the device cannot start an indirect draw at an
+/// instance other than 0 and the set has instances: then one direct draw a splat).
+struct SplatRun {
+    chunk: usize,
+    args: Vec<[u32; 4]>,
+    buffer: Option<wgpu::Buffer>,
+}
+
+/// Placement `i`'s splats (world means `means`) sorted far to near by `key` (ties in the set's
+/// order), as its runs of draws (`Geometry::splat_draws`).
+fn sorted_splats(cx: &FrameCtx<'_>, i: usize, means: &[glam::Vec3], key: &impl Fn(glam::Vec3) -> f32) -> Vec<SplatRun> {
+    use wgpu::util::DeviceExt;
+    let keys: Vec<f32> = means.iter().map(|&m| key(m)).collect();
+    let mut order: Vec<u32> = (0..means.len() as u32).collect();
+    order.sort_by(|&a, &b| keys[b as usize].total_cmp(&keys[a as usize]));
+    let geo = &cx.scene.transparent;
+    let indirect = cx.gpu.device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE);
+    geo.splat_draws(&geo.placements[i], &order)
+        .into_iter()
+        .map(|(chunk, args)| {
+            let buffer = (indirect || args.iter().all(|a| a[3] == 0)).then(|| {
+                let contents: Vec<u8> = args.iter().flatten().flat_map(|w| w.to_le_bytes()).collect();
+                let desc = wgpu::util::BufferInitDescriptor { label: Some("sorted splats"), contents: &contents, usage: wgpu::BufferUsages::INDIRECT };
+                cx.gpu.device.create_buffer_init(&desc)
+            });
+            SplatRun { chunk, args, buffer }
+        })
+        .collect()
 }

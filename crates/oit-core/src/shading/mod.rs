@@ -33,6 +33,9 @@ pub const ALPHA_TEST: u32 = 0x8000;
 /// function of the distance from its center (uv, the disc coordinates); 0 for every other surface.
 pub const FALLOFF_SHIFT: u32 = 12;
 pub const FALLOFF_MASK: u32 = 0x7000;
+/// A splat set whose fragments take the depth of the Gaussian's peak along the pixel's ray
+/// (`SplatDepth::Ray`) rather than its mean's.
+pub const RAY_DEPTH: u32 = 0x10000;
 
 /// How a mesh's normal is found; `Unlit` keeps the vertex color (times texture and opacity).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -82,6 +85,35 @@ impl Shading {
             | if material.emissive_texture.is_some() { EMISSIVE_TEXTURED } else { 0 }
             | if material.alpha_cutoff.is_some() { ALPHA_TEST } else { 0 }
             | material.falloff.code() << FALLOFF_SHIFT
+            | if material.splat_depth == SplatDepth::Ray { RAY_DEPTH } else { 0 }
+    }
+}
+
+/// The depth a splat's fragments sort and are tested at (docs/methods.md, "Gaussian splats").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SplatDepth {
+    /// The mean's depth, one a splat (3DGS).
+    #[default]
+    Center,
+    /// The depth of the Gaussian's peak along the pixel's ray, t* = dᵀΣ⁻¹(μ - o) / dᵀΣ⁻¹d
+    /// (StopThePop, Radl et al. 2024): one a fragment (`splat::ray_peak`).
+    Ray,
+}
+
+impl SplatDepth {
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "center" => Ok(Self::Center),
+            "ray" => Ok(Self::Ray),
+            _ => Err(invalid!("splat_depth must be 'center' or 'ray', got '{name}'")),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Center => "center",
+            Self::Ray => "ray",
+        }
     }
 }
 
@@ -164,6 +196,9 @@ pub struct Material {
     pub alpha_cutoff: Option<f32>,
     /// A particle set's falloff (set by `Mesh::particles`; `None` for every other surface).
     pub falloff: Falloff,
+    /// A splat set's fragment depth (set by `Mesh::gaussians` and its callers; `Center` for
+    /// every other surface, where it means nothing).
+    pub splat_depth: SplatDepth,
 }
 
 impl Default for Material {
@@ -180,6 +215,7 @@ impl Default for Material {
             emissive_texture: None,
             alpha_cutoff: None,
             falloff: Falloff::None,
+            splat_depth: SplatDepth::Center,
         }
     }
 }

@@ -46,6 +46,9 @@ pub struct Geometry {
     /// Triangles drawn, instances included.
     pub triangles: u32,
     pub placements: Vec<Placement>,
+    /// A splat set's placement: its Gaussians' means in world space (its instance applied),
+    /// what `sorted` orders them by (`splat_draws`); empty for every other placement.
+    pub splat_means: Vec<Vec<Vec3>>,
     /// Per mesh of this geometry: its segments, its first instance and its instance count.
     segments: Vec<Vec<Segment>>,
     instances: Vec<(u32, u32)>,
@@ -107,6 +110,32 @@ impl Geometry {
         }
     }
 
+    /// The draws of splat set placement `p` with its splats in `order` (indices into the set):
+    /// runs of consecutive splats in one chunk, each its chunk and the indirect draw arguments
+    /// of its splats (six vertices, one instance each: vertex count, instance count, first
+    /// vertex, first instance), for `multi_draw_indirect`; the instance is 0 where the passes
+    /// read no instance table.
+    pub fn splat_draws(&self, p: &Placement, order: &[u32]) -> Vec<(usize, Vec<[u32; 4]>)> {
+        // Each splat's chunk and first vertex, in the set's order (two triangles a splat).
+        let slots: Vec<(usize, u32)> =
+            self.segments[p.mesh].iter().flat_map(|s| (s.lo..s.hi).step_by(2).map(move |t| (s.chunk, 3 * t))).collect();
+        let instance = if self.instanced { p.instance } else { 0 };
+        let mut runs: Vec<(usize, Vec<[u32; 4]>)> = Vec::new();
+        for &k in order {
+            let (chunk, first) = slots[k as usize];
+            match runs.last_mut() {
+                Some((c, args)) if *c == chunk => args.push([6, 1, first, instance]),
+                _ => runs.push((chunk, vec![[6, 1, first, instance]])),
+            }
+        }
+        runs
+    }
+
+    /// Binds chunk `chunk`'s group 0 (for draws of `splat_draws`).
+    pub fn bind_chunk(&self, pass: &mut wgpu::RenderPass<'_>, chunk: usize) {
+        pass.set_bind_group(0, &self.chunks[chunk].group, &[]);
+    }
+
     fn draw_segment(&self, pass: &mut wgpu::RenderPass<'_>, s: Segment, instances: std::ops::Range<u32>) {
         if s.lo < s.hi && !instances.is_empty() {
             pass.set_bind_group(0, &self.chunks[s.chunk].group, &[]);
@@ -141,6 +170,7 @@ pub(super) fn upload<'a>(
     let mut done: Vec<Gather> = Vec::new();
     let mut cur = Gather { shaded: bindings.shaded, ..Default::default() };
     let mut placements = Vec::new();
+    let mut splat_means = Vec::new();
     let mut segments: Vec<Vec<Segment>> = Vec::new();
     let mut instances: Vec<(u32, u32)> = Vec::new();
     let mut table: Vec<GpuInstance> = Vec::new();
@@ -172,6 +202,12 @@ pub(super) fn upload<'a>(
         for inst in list {
             let instance = placements.len() as u32;
             placements.push(Placement { centroid: inst.transform.transform_point3(centroid).as_vec3(), mesh: local, instance });
+            splat_means.push(match m.primitive {
+                Primitive::Gaussians { .. } => {
+                    m.positions.iter().map(|p| inst.transform.transform_point3(glam::DVec3::from(p.map(|x| x as f64))).as_vec3()).collect()
+                }
+                _ => Vec::new(),
+            });
             // Without instances the passes read no table: none is built.
             if bindings.instanced {
                 table.push(GpuInstance::new(inst, (drawn as u32).wrapping_sub(unique as u32)));
@@ -322,5 +358,15 @@ pub(super) fn upload<'a>(
             Chunk { group, triangles: g.triangles(), drawn: chunk_drawn[k], expand }
         })
         .collect();
-    Ok(Geometry { chunks, triangles: drawn as u32, placements, segments, instances, instanced: bindings.instanced, bytes, expanded_bytes })
+    Ok(Geometry {
+        chunks,
+        triangles: drawn as u32,
+        placements,
+        splat_means,
+        segments,
+        instances,
+        instanced: bindings.instanced,
+        bytes,
+        expanded_bytes,
+    })
 }

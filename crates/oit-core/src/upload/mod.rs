@@ -37,6 +37,8 @@ pub struct GpuScene {
     /// whether any has a falloff (FALLOFF).
     pub phong: bool,
     pub falloff: bool,
+    /// Whether any splat set takes the depth of its peak along the ray (SPLAT_RAY).
+    pub splat_ray: bool,
     /// Whether any material gives off light (EMISSIVE), and whether any tests alpha
     /// (ALPHA_TESTS).
     pub emissive: bool,
@@ -91,6 +93,7 @@ impl GpuScene {
         let sets_only = scene.meshes().iter().all(|m| m.primitive != Primitive::Triangles);
         let phong = scene.meshes().iter().any(|m| matches!(m.material.shading, Shading::Flat | Shading::Smooth));
         let falloff = scene.meshes().iter().any(|m| m.material.falloff != crate::shading::Falloff::None);
+        let splat_ray = scene.meshes().iter().any(|m| m.material.splat_depth == crate::shading::SplatDepth::Ray);
         let instances = scene.instance_count() as u64;
         let emissive = scene.meshes().iter().any(|m| m.material.emissive != [0.0; 3]);
         let alpha_test = scene.meshes().iter().any(|m| m.material.alpha_cutoff.is_some());
@@ -107,6 +110,7 @@ impl GpuScene {
             sets_only,
             phong,
             falloff,
+            splat_ray,
             texture_bytes: atlas.bytes,
             expanded_view: Default::default(),
         })
