@@ -219,8 +219,14 @@ fn kernel(h: Hankel, g: vec4<f32>) -> array<vec4<f32>, 2> {
     } else {
         c.w = 0.0;
     }
-    c.y -= h.l1.y * c.z + h.l1.z * c.w + h.l1.w * c4;
-    c.x = 1.0 - dot(h.m, vec4<f32>(c.yzw, c4));
+    c.y -= h.l1.y * c.z + h.l1.z * c.w;
+    if N >= 4u {
+        c.y -= h.l1.w * c4;
+    }
+    c.x = 1.0 - dot(h.m.xyz, c.yzw);
+    if N >= 4u {
+        c.x -= h.m.w * c4;
+    }
     return array<vec4<f32>, 2>(c, vec4<f32>(c4, 0.0, 0.0, 0.0));
 }
 
@@ -242,8 +248,10 @@ fn kernel_roots(kc: array<vec4<f32>, 2>) -> vec4<f32> {
         let q = (2.0 * s * s - a.y) * s + a.x;
         let rho = sqrt(max(-p / 3.0, 0.0));
         let cos3 = clamp(-q / max(2.0 * rho * rho * rho, 1e-30), -1.0, 1.0);
-        let theta = acos(cos3) / 3.0 - vec3<f32>(0.0, 2.09439510, 4.18879020);
-        var x = 2.0 * rho * cos(theta) - s;
+        // cos(theta - 2 pi k / 3) from cos and sin of theta = acos(cos3) / 3 in [0, pi / 3].
+        let c0 = cos(acos(cos3) / 3.0);
+        let s0 = sqrt(max(1.0 - c0 * c0, 0.0)) * 0.866025404;
+        var x = 2.0 * rho * vec3<f32>(c0, -0.5 * c0 - s0, -0.5 * c0 + s0) - s;
         let v = ((x + a.z) * x + a.y) * x + a.x;
         let dv = (3.0 * x + 2.0 * a.z) * x + a.y;
         x -= select(vec3<f32>(0.0), v / dv, dv != vec3<f32>(0.0));
@@ -278,8 +286,15 @@ fn transmittance(b0: f32, lo: vec4<f32>, hi: vec4<f32>, z: f32) -> vec3<f32> {
     let g = y / h.d;
     let own = 1.0 / (1.0 + dot(g, y));
     let roots = kernel_roots(kernel(h, g));
-    let used = vec4<f32>(1.0, 1.0, select(0.0, 1.0, N >= 3u), select(0.0, 1.0, N >= 4u));
-    let front = dot(christoffel(h, forward(h, roots)) * used, select(vec4<f32>(0.0), vec4<f32>(1.0), roots < vec4<f32>(z)));
+    // Summed lane by lane up to N, so that the compiler drops the unused lanes' work.
+    let w = christoffel(h, forward(h, roots)) * select(vec4<f32>(0.0), vec4<f32>(1.0), roots < vec4<f32>(z));
+    var front = w.x + w.y;
+    if N >= 3u {
+        front += w.z;
+    }
+    if N >= 4u {
+        front += w.w;
+    }
     return vec3<f32>(front + MBOIT_OVERESTIMATION * own, front, front + own);
 }
 
