@@ -231,8 +231,8 @@ fn kernel(h: Hankel, g: vec4<f32>) -> array<vec4<f32>, 2> {
 }
 
 // The kernel polynomial's N roots (all real) in the first N components: the quadratic's
-// formula; the cubic's trigonometric one, polished by a Newton step; Aberth's simultaneous
-// iteration on the quartic, a root a lane.
+// formula; the cubic's trigonometric one and the quartic's (Ferrari's), each root polished by a
+// Newton step.
 fn kernel_roots(kc: array<vec4<f32>, 2>) -> vec4<f32> {
     let c = kc[0];
     if N == 2u {
@@ -257,19 +257,42 @@ fn kernel_roots(kc: array<vec4<f32>, 2>) -> vec4<f32> {
         x -= select(vec3<f32>(0.0), v / dv, dv != vec3<f32>(0.0));
         return vec4<f32>(x, 0.0);
     }
-    // x^4 + a.w x^3 + a.z x^2 + a.y x + a.x.
+    // x^4 + a.w x^3 + a.z x^2 + a.y x + a.x; x = y - s gives y^4 + p y^2 + q y + r, which is
+    // (y^2 + p / 2 + m)^2 - 2 m (y - q / (4 m))^2 at the largest root m of Ferrari's resolvent
+    // m^3 + p m^2 + (p^2 / 4 - r) m - q^2 / 8 (the cubic's trigonometric formula): two
+    // quadratics. Where q is 0 (m = 0) the quartic is a quadratic in y^2.
     let a = c / kc[1].x;
-    var x = vec4<f32>(-0.87, -0.33, 0.35, 0.86);
-    for (var it = 0u; it < 32u; it++) {
+    let s = a.w / 4.0;
+    let p = a.z - 6.0 * s * s;
+    let q = a.y - 2.0 * a.z * s + 8.0 * s * s * s;
+    let r = a.x - a.y * s + a.z * s * s - 3.0 * s * s * s * s;
+    let e2 = p / 3.0;
+    let e1 = 0.25 * p * p - r;
+    let pp = e1 - 3.0 * e2 * e2;
+    let qq = (2.0 * e2 * e2 - e1) * e2 - 0.125 * q * q;
+    let rho = sqrt(max(-pp / 3.0, 0.0));
+    let m = max(2.0 * rho * cos(acos(clamp(-qq / max(2.0 * rho * rho * rho, 1e-30), -1.0, 1.0)) / 3.0) - e2, 0.0);
+    var y: vec4<f32>;
+    if m > 1e-12 {
+        let w = sqrt(2.0 * m);
+        let k = 0.5 * p + m + vec2<f32>(0.5, -0.5) * q / w;
+        let d = sqrt(max(2.0 * m - 4.0 * k, vec2<f32>(0.0)));
+        y = 0.5 * vec4<f32>(w - d.x, w + d.x, -w - d.y, -w + d.y);
+    } else {
+        let h = sqrt(max(p * p - 4.0 * r, 0.0));
+        let u = sqrt(max(0.5 * vec2<f32>(-p - h, -p + h), vec2<f32>(0.0)));
+        y = vec4<f32>(-u.y, -u.x, u.x, u.y);
+    }
+    // In float32 the formula loses close roots to cancellation: two steps of Aberth's
+    // simultaneous iteration (Newton's with the other roots divided out) restore them.
+    var x = y - s;
+    for (var it = 0u; it < 2u; it++) {
         let v = (((x + a.w) * x + a.z) * x + a.y) * x + a.x;
         let dv = ((4.0 * x + 3.0 * a.w) * x + 2.0 * a.z) * x + a.y;
         let ratio = v / dv;
         let pull = 1.0 / (x - x.yzwx) + 1.0 / (x - x.zwxy) + 1.0 / (x - x.wxyz);
         let step = ratio / (1.0 - ratio * pull);
-        x -= step;
-        if all(abs(step) <= vec4<f32>(1e-7)) {
-            break;
-        }
+        x -= select(vec4<f32>(0.0), step, abs(step) < vec4<f32>(1.0));
     }
     return x;
 }
