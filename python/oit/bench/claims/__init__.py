@@ -8,12 +8,12 @@ from __future__ import annotations
 
 from ... import Renderer
 from ..harness import Result
-from . import adaptive, hybrid, kerzner, rtr
+from . import adaptive, hybrid, kerzner, later, rtr
 from .common import FAILS, HOLDS, NOT_HERE, Claim
 
 __all__ = ["CLAIMS", "CLAIM_COLUMNS", "Claim", "FAILS", "HOLDS", "NOT_HERE", "run_claims"]
 
-CLAIMS: list[Claim] = hybrid.CLAIMS + adaptive.CLAIMS + kerzner.CLAIMS + rtr.CLAIMS
+CLAIMS: list[Claim] = hybrid.CLAIMS + adaptive.CLAIMS + kerzner.CLAIMS + rtr.CLAIMS + later.CLAIMS
 
 CLAIM_COLUMNS = [("id", "{}"), ("source", "{}"), ("claim", "{}"), ("measured", "{}"), ("verdict", "{}")]
 
