@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._api import constants
+from .models_wavelet import wavelet
 
 _SHARED = constants()  # the core's numbers (crates/oit-core/src/consts.rs), not copies
 # 24-bit depths of k-TAB keys: z * DEPTH_SCALE in float32, at most DEPTH_MAX.
@@ -475,3 +476,4 @@ MODELS = {"abuffer": exact, "hybrid": hybrid, "hybrid64": hybrid64, "ktab": ktab
           "bucket_peeling": bucket_peeling, "stochastic": stochastic, "mboit": mboit, "auto": auto}
 # The list versions run the same update in the same (submission) order.
 MODELS.update({"adaptive_lists": adaptive, "mlab_lists": mlab})
+MODELS["wavelet"] = wavelet  # its own module: python/oit/models_wavelet.py
