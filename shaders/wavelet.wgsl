@@ -10,7 +10,8 @@
 //                        the finest cells, linear within one), T = exp(-A) without the
 //                        fragment's own share, adds (C alpha T, alpha T) and, in the companion
 //                        target, tau, its share of the error bound (the range of the optical
-//                        depth in front of it over its cell) and a count;
+//                        depth in front of it over its cell), a count and its largest |C|
+//                        (blended by max);
 //   fs_resolve           as mboit's: the weighted average of the colors times 1 - exp(-b0),
 //                        the opaque base times exp(-b0), and the per-pixel error bound.
 // RANK is injected. Model: python/oit/models_wavelet.py; docs/methods.md ("wavelet").
@@ -174,7 +175,8 @@ fn shade_with(raw: VsOut, d: Coefficients) -> Accum {
     let dev = max(max(t - lower, upper - t), 0.0) + MBOIT_MIN_TRANSMITTANCE;
     let w = a * t;
     let c = in.color.rgb;
-    return Accum(vec4<f32>(c * w, w), vec4<f32>(tau, a * max(max(c.r, c.g), c.b) * dev, 1.0, 0.0));
+    let m = max(max(abs(c.r), abs(c.g)), abs(c.b));
+    return Accum(vec4<f32>(c * w, w), vec4<f32>(tau, a * m * dev, 1.0, m));
 }
 
 // The coefficients of a pixel as the shade pass reads them, one entry point a target count
@@ -216,7 +218,9 @@ const LOG_ERROR: f32 = 4.7683716e-7;
 // (|s - 1| max(sum C alpha T) + sum alpha max(C) dev, s the factor the average scales the sums
 // by, and a rounding term a fragment), plus 3 (e^E - 1) for float32's error E in every A: the
 // n-term sums into the coefficients and the reconstruction's, each term at most b0, and each
-// tau's log (docs/methods.md, "wavelet").
+// tau's log. Both composites weigh the colors by weights summing to 1 - exp(-b0), so it is also
+// at most that times the largest |C| (aux.a, blended by max), plus exp(-b0)'s own float32 error
+// times the colors (docs/methods.md, "wavelet").
 @fragment
 fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
     let base = base_at(pos);
@@ -224,12 +228,17 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> Final {
     let acc = textureLoad(accum_tex, p, 0);
     let aux = textureLoad(aux_tex, p, 0);
     let t = exp(-aux.r);
-    let sums = 3.0 * (aux.r * UNIT_ROUNDOFF * (aux.b + f32(RANK) + 4.0) + aux.b * LOG_ERROR);
-    let rounding = (aux.b + 2.0) * ROUNDING_TERM + 3.0 * (exp(min(sums, 80.0)) - 1.0);
+    let n = aux.b;
+    let sums = 3.0 * (aux.r * UNIT_ROUNDOFF * (n + f32(RANK) + 4.0) + n * LOG_ERROR);
+    let total = aux.r * UNIT_ROUNDOFF * n + n * LOG_ERROR;
+    let rounding = (n + 2.0) * ROUNDING_TERM;
+    let colors = aux.a + max(max(abs(base.r), abs(base.g)), abs(base.b));
+    let convex = (1.0 - t) * aux.a + t * (exp(min(total, 80.0)) - 1.0) * colors + rounding;
+    let out = vec4<f32>(base.rgb * t, 1.0 - t * (1.0 - base.a));
     if acc.a <= 0.0 {
-        return Final(vec4<f32>(base.rgb * t, 1.0 - t * (1.0 - base.a)), aux.g + (1.0 - t) + rounding);
+        return Final(out, min(aux.g + (1.0 - t) + rounding + 3.0 * (exp(min(sums, 80.0)) - 1.0), convex));
     }
     let s = (1.0 - t) / acc.a;
-    let bound = abs(s - 1.0) * max(max(acc.r, acc.g), acc.b) + aux.g + rounding;
-    return Final(vec4<f32>(acc.rgb / acc.a * (1.0 - t) + base.rgb * t, 1.0 - t * (1.0 - base.a)), bound);
+    let bound = abs(s - 1.0) * max(max(acc.r, acc.g), acc.b) + aux.g + rounding + 3.0 * (exp(min(sums, 80.0)) - 1.0);
+    return Final(vec4<f32>(acc.rgb / acc.a * (1.0 - t) + out.rgb, out.a), min(bound, convex));
 }

@@ -20,9 +20,16 @@ const RANK: IntParam = IntParam::new(
 .compiled_as("RANK");
 
 /// The coefficient targets (four a texel) and the shade pass's two: the weighted color, and
-/// the optical depth, the error bound's sum and the fragment count.
+/// the optical depth, the error bound's sum, the fragment count and the largest |C|.
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 const SHADE_FORMATS: [wgpu::TextureFormat; 2] = [FORMAT; 2];
+
+/// The shade pass's companion target: the optical depth, the bound's sum and the count added,
+/// the largest |C| in alpha by max.
+const COMPANION: wgpu::BlendState = wgpu::BlendState {
+    color: ADD,
+    alpha: wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Max },
+};
 
 /// The coefficients (RGBA32F, four a texel) and the shade pass's targets.
 const BYTES: FrameBytes = FrameBytes { per_pixel: Linear::per(RANK, 4, 32), fixed: 0 };
@@ -84,7 +91,8 @@ impl Method for Wavelet {
         let formats = vec![FORMAT; targets];
         let blend_targets = formats.iter().map(|&f| blended(f, ADD)).collect();
         let gather = cx.draw_pipeline(spec(PIPELINES, PASS1[at]), &consts, blend_targets, pipeline::depth_test_only());
-        let shade_targets = SHADE_FORMATS.iter().map(|&f| blended(f, ADD)).collect();
+        let companion = wgpu::ColorTargetState { format: FORMAT, blend: Some(COMPANION), write_mask: wgpu::ColorWrites::ALL };
+        let shade_targets = vec![blended(FORMAT, ADD), Some(companion)];
         let shade = cx.draw_pipeline(spec(PIPELINES, PASS2[at]), &consts, shade_targets, pipeline::depth_test_only());
         let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, true);
         let coefficients = FloatTargets::ensure(&mut self.coefficients, cx, &formats, COEFFICIENTS[at]);
