@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from ._api import constants
+from ._stack import out as _out
+from ._stack import visible as _visible
 from .models_wavelet import wavelet
 
 _SHARED = constants()  # the core's numbers (crates/oit-core/src/consts.rs), not copies
@@ -32,16 +34,6 @@ def alpha_8bit(alpha) -> np.ndarray:
     """The 8-bit key alpha (0..255) of straight alphas, as the shaders compute it in float32."""
     a = np.clip(np.asarray(alpha, np.float32), 0, 1) * np.float32(255.0) + np.float32(0.5) + ALPHA_8BIT_BIAS
     return np.minimum(np.floor(a), 255).astype(np.uint64)
-
-
-def _visible(z, rgb, alpha):
-    z, rgb, alpha = np.asarray(z, np.float64), np.asarray(rgb, np.float64).reshape(-1, 3), np.asarray(alpha, np.float64)
-    keep = alpha > 0.0  # alpha-0 fragments are invisible and skipped by every method
-    return z[keep], rgb[keep], alpha[keep]
-
-
-def _out(rgb, t, bg, bg_a):
-    return np.append(rgb + t * np.asarray(bg, np.float64), 1.0 - t * (1.0 - bg_a))
 
 
 def exact(z, rgb, alpha, bg, bg_a=0.0):

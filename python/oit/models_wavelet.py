@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._api import constants
+from ._stack import out, visible
 
 _SHARED = constants()
 # mboit's floors, shared: the smallest 1 - alpha and the smallest weight.
@@ -71,12 +72,10 @@ def wavelet(z, rgb, alpha, bg, bg_a=0.0, rank=16):
     averaged, times 1 - exp(-d_0); the color behind times exp(-d_0)."""
     if rank not in RANKS:
         raise ValueError(f"wavelet model: no model of rank={rank}; use one of {RANKS}")
-    from .models import _out, _visible  # models re-exports this module: imported when called
-
-    z, rgb, alpha = _visible(z, rgb, alpha)
+    z, rgb, alpha = visible(z, rgb, alpha)
     d = wavelet_coefficients(z, alpha, rank)
     w = np.array([a * wavelet_transmittance(d, zi, a) for zi, a in zip(z, alpha)])
     t = float(np.exp(-d[0]))
     if len(w) == 0 or w.sum() <= 0:
-        return _out(np.zeros(3), t, bg, bg_a)
-    return _out((rgb * w[:, None]).sum(0) / w.sum() * (1.0 - t), t, bg, bg_a)
+        return out(np.zeros(3), t, bg, bg_a)
+    return out((rgb * w[:, None]).sum(0) / w.sum() * (1.0 - t), t, bg, bg_a)
