@@ -168,6 +168,13 @@ def tolerance(name: str, n: int, mass: float = 1.0, **params) -> float:
         # the stored moment differs by one step (2^-15 of [-1, 1]) and the reconstruction by its
         # sensitivity to it. No a-priori bound: within the same budget on every suite's stacks,
         # measured at most 2.8e-5 on 40 random layers.
+    elif name == "wavelet":
+        # A(u) is off by E = 3 ((n + rank + 4) U b0 + n POW_LOG2): n-term float32 sums into
+        # each coefficient and the reconstruction's (each term at most b0, and at most three
+        # tents at a depth), and each optical depth's log; b0 <= 17 mass (tau / alpha is at most
+        # -ln(2^-24) < 17). Each weight moves relatively by E, the average of colors in [0, 1]
+        # by twice that, the total transmittance by E.
+        tol += 9 * ((n + params.get("rank", 16) + 4) * U * 17 * mass + n * POW_LOG2)
     elif name == "auto":
         # The model is the exact composite (oit.models.auto): auto's rendered bound is at most
         # its `tolerance` where it keeps hybrid, (n + 2) ROUNDING_TERM where it falls back to

@@ -61,7 +61,7 @@ def test_error_falls_as_moments_grow(basis):
 @pytest.mark.parametrize("precision,layers", [("32", 10), ("16", 10), ("16", 40)])
 def test_gpu_agrees_with_the_model(renderer, basis, moments, precision, layers):
     # At 16 bits the model stores each fragment's renormalized moments in turn, in submission
-    # order, as the critical sections do on these stacks (oit.models_mboit16).
+    # order, as the critical sections do on these stacks (oit.models_mboit.mboit16).
     s = stacks(8, 6, layers, seed=moments)
     params = params_for("mboit", moments=moments, basis=basis, precision=precision)
     frame = renderer(8, 6).render(s.scene, IDENTITY, "mboit", background=tuple(BG), **params)

@@ -15,6 +15,10 @@ from __future__ import annotations
 import numpy as np
 
 from ._api import constants
+from ._stack import out as _out
+from ._stack import visible as _visible
+from .models_mboit import mboit, mboit_transmittance, mboit_trig_transmittance  # noqa: F401 (oit.models' API)
+from .models_wavelet import wavelet
 
 _SHARED = constants()  # the core's numbers (crates/oit-core/src/consts.rs), not copies
 # 24-bit depths of k-TAB keys: z * DEPTH_SCALE in float32, at most DEPTH_MAX.
@@ -31,16 +35,6 @@ def alpha_8bit(alpha) -> np.ndarray:
     """The 8-bit key alpha (0..255) of straight alphas, as the shaders compute it in float32."""
     a = np.clip(np.asarray(alpha, np.float32), 0, 1) * np.float32(255.0) + np.float32(0.5) + ALPHA_8BIT_BIAS
     return np.minimum(np.floor(a), 255).astype(np.uint64)
-
-
-def _visible(z, rgb, alpha):
-    z, rgb, alpha = np.asarray(z, np.float64), np.asarray(rgb, np.float64).reshape(-1, 3), np.asarray(alpha, np.float64)
-    keep = alpha > 0.0  # alpha-0 fragments are invisible and skipped by every method
-    return z[keep], rgb[keep], alpha[keep]
-
-
-def _out(rgb, t, bg, bg_a):
-    return np.append(rgb + t * np.asarray(bg, np.float64), 1.0 - t * (1.0 - bg_a))
 
 
 def exact(z, rgb, alpha, bg, bg_a=0.0):
@@ -358,123 +352,9 @@ def auto(z, rgb, alpha, bg, bg_a=0.0, tolerance=1.0 / 255.0):
     return exact(z, rgb, alpha, bg, bg_a)
 
 
-# mboit's shared numbers (crates/oit-core/src/consts.rs): the smallest 1 - alpha, the bias
-# vectors' even moments and the default biases for 4, 6 and 8 power moments.
-MBOIT_MIN_TRANSMITTANCE = float(np.float32(_SHARED["MBOIT_MIN_TRANSMITTANCE"]))
-MBOIT_MIN_WEIGHT = float(np.float32(_SHARED["MBOIT_MIN_WEIGHT"]))
-MBOIT_STAR = {m: [float(np.float32(_SHARED[f"MBOIT_STAR{m}_{k}"])) for k in range(2, m + 1, 2)] for m in (4, 6, 8)}
-MBOIT_BIAS = {m: float(np.float32(_SHARED[f"MBOIT_BIAS_{m}"])) for m in (4, 6, 8)}
-# Trigonometric biases by real moment count (2, 3, 4 complex moments).
-MBOIT_TRIG_BIAS = {2 * m: float(np.float32(_SHARED[f"MBOIT_TRIG_BIAS_{m}"])) for m in (2, 3, 4)}
-MBOIT_WRAP = float(np.float32(_SHARED["MBOIT_WRAP"]))
-
-
-def mboit_angle(z) -> np.ndarray:
-    """The trigonometric basis' angle of window depth z: [0, 2 pi - MBOIT_WRAP]."""
-    half = np.pi - 0.5 * MBOIT_WRAP
-    return (2.0 * np.asarray(z, np.float64) - 1.0) * half + half
-
-
-def mboit_trig_moments(z, alpha, moments=3) -> np.ndarray:
-    """(b0, b1, .., b_moments) complex (`moments` complex ones: twice as many reals): the
-    optical depths' sum and their sums times exp(i j angle(z))."""
-    od = -np.log(np.maximum(1.0 - np.asarray(alpha, np.float64), MBOIT_MIN_TRANSMITTANCE))
-    phi = mboit_angle(z)
-    return np.array([np.sum(od * np.exp(1j * j * phi)) for j in range(moments + 1)])
-
-
-def mboit_trig_transmittance(b, z, bias, overestimation=0.25) -> float:
-    """The transmittance in front of window depth z that mboit reconstructs from trigonometric
-    moments b (mboit_trig_moments), as shaders/mboit.wgsl: the normalized moments biased toward
-    0, the Hermitian Toeplitz matrix T, the nodes of the canonical representation through the
-    fragment's angle (the kernel polynomial's roots on the unit circle) weighted by their
-    Christoffel numbers 1 / (e^H T^-1 e), counted 1 in front, 0 behind, rising from 0 to 1
-    across the wrapping zone, the fragment's own by the overestimation."""
-    n = len(b) - 1
-    m = np.concatenate([[1.0], (1.0 - bias) * np.asarray(b[1:]) / b[0].real])
-    toeplitz = np.array([[m[k - j] if k >= j else np.conj(m[j - k]) for j in range(n + 1)] for k in range(n + 1)])
-
-    def e(theta):
-        return np.exp(1j * np.arange(n + 1) * theta)
-
-    def christoffel(theta):
-        return 1.0 / np.real(np.conj(e(theta)) @ np.linalg.solve(toeplitz, e(theta)))
-
-    phi = float(mboit_angle(z))
-    q = np.linalg.solve(toeplitz, e(phi))
-    theta = np.mod(np.angle(np.roots(np.conj(q)[::-1])), 2.0 * np.pi)
-    zone = 2.0 * np.pi - MBOIT_WRAP
-    f = np.where(theta > zone, (theta - zone) / MBOIT_WRAP, (theta < phi).astype(np.float64))
-    absorbance = overestimation * christoffel(phi) + sum(fi * christoffel(t) for fi, t in zip(f, theta))
-    return float(np.clip(np.exp(-b[0].real * absorbance), MBOIT_MIN_WEIGHT, 1.0))
-
-
-def mboit_moments(z, alpha, moments=6) -> np.ndarray:
-    """(b0, b1, .., b_moments): the sums of the optical depths -ln(1 - alpha) (1 - alpha at least
-    MBOIT_MIN_TRANSMITTANCE) and of the optical depths times the warped depth 2 z - 1 to the k
-    (the shader's warp under an orthographic camera, the identity included)."""
-    od = -np.log(np.maximum(1.0 - np.asarray(alpha, np.float64), MBOIT_MIN_TRANSMITTANCE))
-    w = 2.0 * np.asarray(z, np.float64) - 1.0
-    return np.array([np.sum(od * w ** k) for k in range(moments + 1)])
-
-
-def mboit_transmittance(b, z, bias, overestimation=0.25) -> float:
-    """The transmittance in front of window depth z that mboit reconstructs from the moments b
-    (mboit_moments), as shaders/mboit.wgsl: the normalized moments biased toward the bias vector,
-    the Hankel system's kernel polynomial through the warped depth, its roots, and the
-    polynomial interpolating the overestimation there, 1 at the roots in front and 0 behind,
-    integrated against the biased moments (Münstermann et al. 2018, Algorithm 1); at least
-    MBOIT_MIN_WEIGHT."""
-    moments = len(b) - 1
-    n = moments // 2
-    star = np.zeros(moments + 1)
-    star[2::2] = MBOIT_STAR[moments]
-    m = np.empty(moments + 1)
-    m[0] = 1.0
-    m[1:] = (1.0 - bias) * (np.asarray(b[1:]) / b[0]) + bias * star[1:]
-    x0 = 2.0 * z - 1.0
-    hankel = np.array([[m[i + j] for j in range(n + 1)] for i in range(n + 1)])
-    c = np.linalg.solve(hankel, x0 ** np.arange(n + 1))
-    roots = np.sort(np.roots(c[::-1]).real)[::-1]  # real for a positive definite Hankel matrix
-    x = np.concatenate([[x0], roots])
-    f = np.concatenate([[overestimation], (roots < x0).astype(np.float64)])
-    for j in range(1, n + 1):  # Newton's divided differences
-        f[j:] = (f[j:] - f[j - 1:-1]) / (x[j:] - x[:-j])
-    p = np.zeros(n + 1)
-    p[0] = f[n]
-    for j in range(n - 1, -1, -1):  # to monomial coefficients: p = p (t - x_j) + f_j
-        p[1:] = p[:-1] - x[j] * p[1:]
-        p[0] = f[j] - x[j] * p[0]
-    return float(np.clip(np.exp(-b[0] * np.dot(p, m[:n + 1])), MBOIT_MIN_WEIGHT, 1.0))
-
-
-def mboit(z, rgb, alpha, bg, bg_a=0.0, moments=6, basis="power", precision="32", bias=0.0, overestimation=0.25):
-    """Moment-based OIT (Münstermann et al. 2018) at 32 bits (16: models_mboit16): each fragment's color weighted by
-    alpha and its reconstructed transmittance, averaged, times 1 - exp(-b0); the color behind
-    times exp(-b0). `moments` counts reals (a complex trigonometric moment is two); `bias` 0 is
-    the paper's for the basis and count (MBOIT_BIAS, MBOIT_TRIG_BIAS)."""
-    if str(precision) == "16":
-        from .models_mboit16 import mboit16
-        return mboit16(z, rgb, alpha, bg, bg_a, moments, basis, bias, overestimation)
-    defaults = {"power": MBOIT_BIAS, "trigonometric": MBOIT_TRIG_BIAS}.get(basis, {})
-    if str(precision) != "32" or moments not in defaults:
-        raise ValueError(f"mboit model: no model of basis={basis!r}, precision={precision!r}, moments={moments}")
-    z, rgb, alpha = _visible(z, rgb, alpha)
-    beta = bias if bias > 0 else defaults[moments]
-    if basis == "power":
-        b = mboit_moments(z, alpha, moments)
-        w = np.array([a * mboit_transmittance(b, zi, beta, overestimation) for zi, a in zip(z, alpha)])
-    else:
-        b = mboit_trig_moments(z, alpha, moments // 2)
-        w = np.array([a * mboit_trig_transmittance(b, zi, beta, overestimation) for zi, a in zip(z, alpha)])
-    t = float(np.exp(-b[0].real))
-    if len(w) == 0 or w.sum() <= 0:
-        return _out(np.zeros(3), t, bg, bg_a)
-    return _out((rgb * w[:, None]).sum(0) / w.sum() * (1.0 - t), t, bg, bg_a)
-
-
 MODELS = {"abuffer": exact, "hybrid": hybrid, "hybrid64": hybrid64, "ktab": ktab, "wavg": wavg, "wsum": wsum, "wboit": wboit,
           "adaptive": adaptive, "additive": additive, "filter": filter_, "screen_door": screen_door, "mlab": mlab,
           "bucket_peeling": bucket_peeling, "stochastic": stochastic, "mboit": mboit, "auto": auto}
 # The list versions run the same update in the same (submission) order.
 MODELS.update({"adaptive_lists": adaptive, "mlab_lists": mlab})
+MODELS["wavelet"] = wavelet  # its own module: python/oit/models_wavelet.py

@@ -40,6 +40,7 @@ registry! {
     mlab: [INFO],
     mlab_lists: [INFO],
     mboit: [INFO],
+    wavelet: [INFO],
     bucket_peeling: [INFO],
     auto: [INFO],
 }

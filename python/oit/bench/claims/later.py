@@ -19,13 +19,14 @@ def _thinned(name: str, size: int = 64) -> scene_lib.BuiltScene:
 
 
 def moments_time() -> tuple[str, str]:
-    built = scene_lib.hair()
+    # Hair thinned to 1,500 strands at 256² (up to ~60 layers): depth peeling needs a pass a layer.
+    built = replace(scene_lib.hair(strands=1500), size=(256, 256))
     r = Renderer(*built.size)
     t = {what: median_ms(r, built, m, **p) for what, m, p in (
         ("mboit 6 power moments", "mboit", {"moments": 6}), ("mlab 4 layers", "mlab", {"layers": 4}),
         ("depth peeling", "depth_peeling", {}))}
     a, b, c = t.values()
-    text = ("hair at its size, GPU median of 3: " + ", ".join(f"{k} {v:.0f} ms" for k, v in t.items())
+    text = ("hair (1,500 strands, 256²), GPU median of 3: " + ", ".join(f"{k} {v:.0f} ms" for k, v in t.items())
             + f" (mboit {a / b:.2f}× MLAB's time, {c / a:.1f}× faster than peeling); rule: no slower than MLAB 4 and faster "
             "than depth peeling by more than lavapipe's noise")
     return text, HOLDS if a <= b and c > TIE * a else FAILS
@@ -91,4 +92,5 @@ CLAIMS: list[Claim] = [
     Claim("MB-trig", "Münstermann et al. 2018, Sec. 3.6", "trigonometric moments handle many layers better than power moments",
           True, trigonometric_depth),
     Claim("MB-16", "Münstermann et al. 2018, storage", "16 bits a moment at quality close to 32", True, sixteen_bits),
+    Claim("WT-smoke", "Aizenshtein et al. 2022", "wavelets A-buffer-like on smoke at moment-like cost", False, wavelets_on_smoke),
 ]
