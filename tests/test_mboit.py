@@ -129,3 +129,18 @@ def test_bad_parameters_say_what_to_use(renderer, params, message):
     scene = full_screen_layers([(0.5, (1.0, 0.0, 0.0, 0.5))])
     with pytest.raises(ValueError, match=message):
         renderer(2, 2).render(scene, IDENTITY, "mboit", **params)
+
+
+@pytest.mark.parametrize("precision", ["32", "16"])
+def test_a_budget_tiles_mboit_and_the_image_stays_bit_for_bit(precision):
+    # Tiles keep each pixel's fragments in submission order, into its blends or its critical
+    # sections alike: the same bits, and everything the frame allocates within the budget.
+    s = stacks(32, 24, 12, seed=5)
+    untiled = oit.Renderer(32, 24).render(s.scene, IDENTITY, "mboit", background=tuple(BG), precision=precision)
+    budget = untiled.stats["peak_memory_bytes"] // 3
+    tiled = oit.Renderer(32, 24, memory_budget=budget).render(s.scene, IDENTITY, "mboit", background=tuple(BG),
+                                                              precision=precision)
+    assert tiled.stats["tiles"] > 1 and tiled.stats["peak_memory_bytes"] <= budget
+    assert np.array_equal(tiled.image, untiled.image)
+    if precision == "32":
+        assert np.array_equal(tiled.error_bound, untiled.error_bound)
