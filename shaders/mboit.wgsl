@@ -27,6 +27,8 @@
 
 // Half the moment count: the Hankel matrix is (N + 1) x (N + 1), the kernel polynomial of degree N.
 const N: u32 = MOMENTS / 2u;
+// 1/3 as a product (a division by 3.0 stays a division: its reciprocal is not exact).
+const THIRD: f32 = 0.333333333;
 
 //!include common/absorbance.wgsl
 
@@ -115,6 +117,8 @@ fn bias_hi() -> vec4<f32> {
 // software rasterizer (it made this pass 25 times the cost of the moments pass).
 struct Hankel {
     m: vec4<f32>,
+    // 1 / d: the solves multiply by it (a division costs several multiplications).
+    inv_d: vec4<f32>,
     l1: vec4<f32>,
     l2: vec3<f32>,
     l3: vec2<f32>,
@@ -127,15 +131,20 @@ fn hankel(lo: vec4<f32>, hi: vec4<f32>) -> Hankel {
     h.d = vec4<f32>(1.0);
     // L[i][j] = (m[i + j] - sum over k < j of L[i][k] L[j][k] d[k]) / d[j].
     h.d.x = lo.y - lo.x * lo.x;
-    h.l1 = (vec4<f32>(lo.yzw, hi.x) - lo * lo.x) / h.d.x;
+    h.inv_d = vec4<f32>(1.0);
+    h.inv_d.x = 1.0 / h.d.x;
+    h.l1 = (vec4<f32>(lo.yzw, hi.x) - lo * lo.x) * h.inv_d.x;
     h.d.y = lo.w - lo.y * lo.y - h.l1.y * h.l1.y * h.d.x;
-    h.l2 = (vec3<f32>(lo.w, hi.xy) - lo.yzw * lo.y - h.l1.yzw * h.l1.y * h.d.x) / h.d.y;
+    h.inv_d.y = 1.0 / h.d.y;
+    h.l2 = (vec3<f32>(lo.w, hi.xy) - lo.yzw * lo.y - h.l1.yzw * h.l1.y * h.d.x) * h.inv_d.y;
     if N >= 3u {
         h.d.z = hi.y - lo.z * lo.z - h.l1.z * h.l1.z * h.d.x - h.l2.y * h.l2.y * h.d.y;
-        h.l3 = (hi.yz - lo.zw * lo.z - h.l1.zw * h.l1.z * h.d.x - h.l2.yz * h.l2.y * h.d.y) / h.d.z;
+        h.inv_d.z = 1.0 / h.d.z;
+        h.l3 = (hi.yz - lo.zw * lo.z - h.l1.zw * h.l1.z * h.d.x - h.l2.yz * h.l2.y * h.d.y) * h.inv_d.z;
     }
     if N >= 4u {
         h.d.w = hi.w - lo.w * lo.w - dot(vec3<f32>(h.l1.w, h.l2.z, h.l3.y) * vec3<f32>(h.l1.w, h.l2.z, h.l3.y), h.d.xyz);
+        h.inv_d.w = 1.0 / h.d.w;
     }
     return h;
 }
@@ -165,12 +174,12 @@ fn forward(h: Hankel, x: vec4<f32>) -> Forward {
 // The Christoffel function 1 / (v(x)^T H^-1 v(x)) = 1 / (1 + sum of y_k^2 / d_k) at four
 // points: the weight of a node of a representation of the moments there.
 fn christoffel(h: Hankel, f: Forward) -> vec4<f32> {
-    var s = 1.0 + f.y1 * f.y1 / h.d.x + f.y2 * f.y2 / h.d.y;
+    var s = 1.0 + f.y1 * f.y1 * h.inv_d.x + f.y2 * f.y2 * h.inv_d.y;
     if N >= 3u {
-        s += f.y3 * f.y3 / h.d.z;
+        s += f.y3 * f.y3 * h.inv_d.z;
     }
     if N >= 4u {
-        s += f.y4 * f.y4 / h.d.w;
+        s += f.y4 * f.y4 * h.inv_d.w;
     }
     return 1.0 / s;
 }
@@ -225,14 +234,14 @@ fn kernel_roots(kc: array<vec4<f32>, 2>) -> vec4<f32> {
     }
     if N == 3u {
         // x^3 + a.z x^2 + a.y x + a.x; x = t - s gives t^3 + p t + q.
-        let a = c.xyz / c.w;
-        let s = a.z / 3.0;
+        let a = c.xyz * (1.0 / c.w);
+        let s = a.z * THIRD;
         let p = a.y - 3.0 * s * s;
         let q = (2.0 * s * s - a.y) * s + a.x;
-        let rho = sqrt(max(-p / 3.0, 0.0));
+        let rho = sqrt(max(-p * THIRD, 0.0));
         let cos3 = clamp(-q / max(2.0 * rho * rho * rho, 1e-30), -1.0, 1.0);
         // cos(theta - 2 pi k / 3) from cos and sin of theta = acos(cos3) / 3 in [0, pi / 3].
-        let c0 = cos(acos(cos3) / 3.0);
+        let c0 = cos(acos(cos3) * THIRD);
         let s0 = sqrt(max(1.0 - c0 * c0, 0.0)) * 0.866025404;
         var x = 2.0 * rho * vec3<f32>(c0, -0.5 * c0 - s0, -0.5 * c0 + s0) - s;
         let v = ((x + a.z) * x + a.y) * x + a.x;
@@ -244,17 +253,17 @@ fn kernel_roots(kc: array<vec4<f32>, 2>) -> vec4<f32> {
     // (y^2 + p / 2 + m)^2 - 2 m (y - q / (4 m))^2 at the largest root m of Ferrari's resolvent
     // m^3 + p m^2 + (p^2 / 4 - r) m - q^2 / 8 (the cubic's trigonometric formula): two
     // quadratics. Where q is 0 (m = 0) the quartic is a quadratic in y^2.
-    let a = c / kc[1].x;
+    let a = c * (1.0 / kc[1].x);
     let s = a.w / 4.0;
     let p = a.z - 6.0 * s * s;
     let q = a.y - 2.0 * a.z * s + 8.0 * s * s * s;
     let r = a.x - a.y * s + a.z * s * s - 3.0 * s * s * s * s;
-    let e2 = p / 3.0;
+    let e2 = p * THIRD;
     let e1 = 0.25 * p * p - r;
     let pp = e1 - 3.0 * e2 * e2;
     let qq = (2.0 * e2 * e2 - e1) * e2 - 0.125 * q * q;
-    let rho = sqrt(max(-pp / 3.0, 0.0));
-    let m = max(2.0 * rho * cos(acos(clamp(-qq / max(2.0 * rho * rho * rho, 1e-30), -1.0, 1.0)) / 3.0) - e2, 0.0);
+    let rho = sqrt(max(-pp * THIRD, 0.0));
+    let m = max(2.0 * rho * cos(acos(clamp(-qq / max(2.0 * rho * rho * rho, 1e-30), -1.0, 1.0)) * THIRD) - e2, 0.0);
     var y: vec4<f32>;
     if m > 1e-12 {
         let w = sqrt(2.0 * m);
@@ -286,10 +295,11 @@ fn kernel_roots(kc: array<vec4<f32>, 2>) -> vec4<f32> {
 // polynomial's roots; integrating the polynomial interpolating the overestimation at z, 1 at the
 // roots in front and 0 behind is summing the nodes' Christoffel weights with those factors.
 fn transmittance(b0: f32, lo: vec4<f32>, hi: vec4<f32>, z: f32) -> vec3<f32> {
-    let h = hankel(mix(lo / b0, bias_lo(), MBOIT_BIAS), mix(hi / b0, bias_hi(), MBOIT_BIAS));
+    let inv_b0 = 1.0 / b0;
+    let h = hankel(mix(lo * inv_b0, bias_lo(), MBOIT_BIAS), mix(hi * inv_b0, bias_hi(), MBOIT_BIAS));
     // Components past N are 0 in y and 1 in d.
     let y = forward_at(h, z);
-    let g = y / h.d;
+    let g = y * h.inv_d;
     let own = 1.0 / (1.0 + dot(g, y));
     let roots = kernel_roots(kernel(h, g));
     // Summed lane by lane up to N, so that the compiler drops the unused lanes' work.
