@@ -6,6 +6,8 @@ docs/results.md, "Gaussian splats")."""
 
 from __future__ import annotations
 
+import csv
+
 import numpy as np
 import pytest
 
@@ -54,3 +56,47 @@ def test_every_bounded_method_renders_splats_within_a_budget_as_without_one(spla
         assert framed.stats["tiles"] > 1 or name == "sorted"
     # The same fragments, drawn in the same order within each pixel: bit for bit.
     assert np.array_equal(framed.image, whole.image)
+
+
+def test_a_rebuilt_splat_scene_keeps_its_depth_choice(renderer):
+    # Through MeshArrays (oit.scenes, scene rebuilds such as unlit): "ray" stays "ray".
+    from oit._meshes import unlit
+
+    built = {d: oit.scenes.splats(400, "cloud", splat_depth=d) for d in ("center", "ray")}
+    assert built["ray"].meta["splat_depth"] == "ray"
+    m = built["ray"].meshes[0]
+    direct = oit.Scene()
+    direct.add_gaussians(m.positions, m.primitive["scales"], m.primitive["rotations"], m.colors[:, 3], m.colors[:, :3],
+                         splat_depth="ray")
+    image = {d: renderer(32, 32).render(b.scene, b.camera, "abuffer").image for d, b in built.items()}
+    cam = built["ray"].camera
+    assert np.array_equal(image["ray"], renderer(32, 32).render(direct, cam, "abuffer").image)
+    assert np.array_equal(image["ray"], renderer(32, 32).render(unlit(built["ray"]).scene, cam, "abuffer").image)
+    assert not np.array_equal(image["ray"], image["center"])
+    with pytest.raises(ValueError, match="splat_depth must be 'center' or 'ray'"):
+        oit.scenes.splats(10, splat_depth="peak")
+
+
+def test_the_splat_bench_writes_the_trade_and_the_scale(tmp_path):
+    from oit import cli
+
+    out = tmp_path / "bench"
+    code = cli.main(["bench", "--splats", "--splat-scale", "--quick", "--methods", "sorted", "abuffer", "wboit",
+                     "--frames", "2", "--out", str(out), "--no-plots"])
+    assert code == 0
+    with open(out / "splats.csv") as f:
+        rows = list(csv.DictReader(f))
+    # sorted's order is the means' whatever the depth choice: one row; the others both.
+    assert [(r["method"], r["splat_depth"]) for r in rows[:5]] == [
+        ("sorted", "center"), ("abuffer", "center"), ("abuffer", "ray"), ("wboit", "center"), ("wboit", "ray")]
+    by = {(r["scene"], r["method"], r["splat_depth"]): r for r in rows}
+    for kind in ("surface", "cloud"):
+        # The exact frame is abuffer with "ray": no error and no flicker against itself.
+        exact = by[(f"splats-{kind}", "abuffer", "ray")]
+        assert float(exact["mean_err"]) == 0.0 and float(exact["flicker"]) == 0.0
+        assert float(by[(f"splats-{kind}", "sorted", "center")]["mean_err"]) > 0.0
+    with open(out / "splat-scale.csv") as f:
+        scale = list(csv.DictReader(f))
+    # Bounded methods only (abuffer is not), each within the budget.
+    assert [r["method"] for r in scale] == ["sorted", "wboit"]
+    assert all(r["status"] == "ok" and float(r["peak_mib"]) <= float(r["budget_mib"]) for r in scale)
