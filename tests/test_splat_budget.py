@@ -90,11 +90,11 @@ def test_the_splat_bench_writes_the_trade_and_the_scale(tmp_path):
     assert [(r["method"], r["splat_depth"]) for r in rows[:5]] == [
         ("sorted", "center"), ("abuffer", "center"), ("abuffer", "ray"), ("wboit", "center"), ("wboit", "ray")]
     by = {(r["scene"], r["method"], r["splat_depth"]): r for r in rows}
-    for kind in ("surface", "cloud"):
+    for scene in ("splats", "splat_cloud"):
         # The exact frame is abuffer with "ray": no error and no flicker against itself.
-        exact = by[(f"splats-{kind}", "abuffer", "ray")]
+        exact = by[(scene, "abuffer", "ray")]
         assert float(exact["mean_err"]) == 0.0 and float(exact["flicker"]) == 0.0
-        assert float(by[(f"splats-{kind}", "sorted", "center")]["mean_err"]) > 0.0
+        assert float(by[(scene, "sorted", "center")]["mean_err"]) > 0.0
     with open(out / "splat-scale.csv") as f:
         scale = list(csv.DictReader(f))
     # Bounded methods only (abuffer is not), each within the budget.

@@ -28,7 +28,7 @@ from ._meshes import (
 
 __all__ = ["BuiltScene", "MeshArrays", "from_meshes", "is_lit", "unlit", "hair", "smoke", "foliage",
            "dragons", "glass", "stacks", "splats", "ALPHA_KINDS", "DRAGON_ALPHAS", "DRAGON_FILE", "shared_data_dir",
-           "default_dragon_path", "SCENES", "SHOWCASE", "PEER_FAN_SEGMENTS"]
+           "default_dragon_path", "splat_cloud", "SCENES", "SHOWCASE", "PEER_FAN_SEGMENTS"]
 
 
 ALPHA_KINDS = ("random", "increasing", "worst", "constant")
@@ -375,7 +375,14 @@ def dragons(path: str | os.PathLike | None = "default", max_triangles: int = 800
                        lights=[((-0.4, -0.8, -0.45), (1.0, 1.0, 1.0), 0.65)], ambient=(0.35, 0.35, 0.35))
 
 
+def splat_cloud(count: int = 20000, seed: int = 0, splat_depth: str = "center") -> BuiltScene:
+    """`splats(count, kind="cloud")`: faint anisotropic Gaussians filling an ellipsoid."""
+    return splats(count, "cloud", seed, splat_depth)
+
+
 # Every builder by name; SHOWCASE is what the benchmark runs by default (stacks is the Figure 7
-# experiment's synthetic input, sized to the frame).
-SCENES = {"hair": hair, "smoke": smoke, "foliage": foliage, "dragons": dragons, "glass": glass, "stacks": stacks}
+# experiment's synthetic input, sized to the frame; the splat scenes are chosen by name, and
+# `python -m oit bench --splats` measures them).
+SCENES = {"hair": hair, "smoke": smoke, "foliage": foliage, "dragons": dragons, "glass": glass, "stacks": stacks,
+          "splats": splats, "splat_cloud": splat_cloud}
 SHOWCASE = ("hair", "smoke", "foliage", "dragons", "glass")
