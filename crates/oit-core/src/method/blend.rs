@@ -122,7 +122,7 @@ impl Method for Blend {
 
 /// One draw of a sorted frame: a placement's triangles, or `count` sorted splats of chunk
 /// `chunk` whose draw arguments are at `at` in the batch.
-enum Draw {
+enum SortedDraw {
     Placement(usize),
     Splats { chunk: usize, at: u32, count: u32 },
 }
@@ -173,10 +173,10 @@ fn sorted(cx: &mut FrameCtx<'_>, pipeline: &wgpu::RenderPipeline) -> Result<u64>
     });
     let span = cx.timer.span("blend");
     let mut args: Vec<[u32; 4]> = Vec::with_capacity(batch);
-    let mut draws: Vec<Draw> = Vec::new();
+    let mut draws: Vec<SortedDraw> = Vec::new();
     let mut first = true;
     // Records and submits the draws gathered so far, their arguments written first.
-    let mut flush = |args: &mut Vec<[u32; 4]>, draws: &mut Vec<Draw>, last: bool| {
+    let mut flush = |args: &mut Vec<[u32; 4]>, draws: &mut Vec<SortedDraw>, last: bool| {
         if let Some(b) = &buffer {
             cx.gpu.queue.write_buffer(b, 0, bytemuck::cast_slice(args));
         }
@@ -192,8 +192,8 @@ fn sorted(cx: &mut FrameCtx<'_>, pipeline: &wgpu::RenderPipeline) -> Result<u64>
             pass.set_pipeline(pipeline);
             for d in draws.iter() {
                 match *d {
-                    Draw::Placement(i) => geo.draw_placement(&mut pass, &geo.placements[i]),
-                    Draw::Splats { chunk, at, count } => {
+                    SortedDraw::Placement(i) => geo.draw_placement(&mut pass, &geo.placements[i]),
+                    SortedDraw::Splats { chunk, at, count } => {
                         geo.bind_chunk(&mut pass, chunk);
                         let run = &args[at as usize..(at + count) as usize];
                         match &buffer {
@@ -212,7 +212,7 @@ fn sorted(cx: &mut FrameCtx<'_>, pipeline: &wgpu::RenderPipeline) -> Result<u64>
     for &i in &order {
         let means = &geo.splat_means[i];
         if means.is_empty() {
-            draws.push(Draw::Placement(i));
+            draws.push(SortedDraw::Placement(i));
             continue;
         }
         let keys: Vec<f32> = means.iter().map(|&m| key(m)).collect();
@@ -230,8 +230,8 @@ fn sorted(cx: &mut FrameCtx<'_>, pipeline: &wgpu::RenderPipeline) -> Result<u64>
             let at = args.len() as u32;
             args.push(a);
             match draws.last_mut() {
-                Some(Draw::Splats { chunk: c, count, .. }) if *c == chunk && !fresh => *count += 1,
-                _ => draws.push(Draw::Splats { chunk, at, count: 1 }),
+                Some(SortedDraw::Splats { chunk: c, count, .. }) if *c == chunk && !fresh => *count += 1,
+                _ => draws.push(SortedDraw::Splats { chunk, at, count: 1 }),
             }
             fresh = false;
         }
