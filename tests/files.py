@@ -229,3 +229,20 @@ def ply_face_colors(path: Path, binary: bool = False) -> Path:
         rows += "".join(f"3 {' '.join(map(str, idx))} {' '.join(map(str, rgba))}\n" for idx, rgba in faces)
         path.write_text(head.format("ascii") + rows)
     return path
+
+
+def ply_gaussians(path: Path, count: int = 1500) -> Path:
+    """A 3DGS PLY (binary little endian) of oit.scenes.splats(count): f_dc the color's degree-0
+    harmonic, the opacity as a logit, the scales as logs, the wxyz quaternion."""
+    import oit
+
+    m = oit.scenes.splats(count).meshes[0]
+    rgb, alpha = m.colors[:, :3].astype(np.float64), m.colors[:, 3].astype(np.float64)
+    columns = [m.positions, (rgb - 0.5) / 0.28209479177387814, np.log(alpha / (1 - alpha))[:, None],
+               np.log(m.primitive["scales"]), m.primitive["rotations"]]
+    names = ["x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
+             "rot_0", "rot_1", "rot_2", "rot_3"]
+    header = f"ply\nformat binary_little_endian 1.0\nelement vertex {count}\n"
+    header += "".join(f"property float {n}\n" for n in names) + "end_header\n"
+    path.write_bytes(header.encode() + np.concatenate(columns, 1).astype("<f4").tobytes())
+    return path

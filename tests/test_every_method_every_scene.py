@@ -17,6 +17,8 @@ SMALL = {
     "glass": dict(detail=12),
     "dragons": dict(max_triangles=1500),
     "stacks": dict(layers=12, size=(8, 8)),
+    "splats": dict(count=600),
+    "splat_cloud": dict(count=600),
 }
 
 

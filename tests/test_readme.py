@@ -125,6 +125,7 @@ def test_the_readme_names_the_commands_this_test_runs():
 def test_a_readme_command_runs(line, tmp_path):
     files.box_and_panel_glb(tmp_path / "scene.glb")
     files.obj_with_dissolve(tmp_path / "mesh.obj")
+    files.ply_gaussians(tmp_path / "splats.ply")
     done = subprocess.run([sys.executable, "-m", "oit", *shrink_command(line)], cwd=tmp_path, capture_output=True,
                           text=True, timeout=300)
     assert done.returncode == 0, f"{line}\n{done.stdout}\n{done.stderr}"

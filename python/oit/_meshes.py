@@ -53,7 +53,8 @@ class MeshArrays:
     # "radii": (n,), "falloff": "hard" | "linear" | "gaussian"}; `surface` then holds
     # add_strands' shading, specular, shininess and opacity, or add_particles' opacity. Or a
     # splat set: {"kind": "gaussians", "scales": (n, 3), "rotations": (n, 4), "sh": (n, k, 3)
-    # or None, "degree": int}, the opacities the colors' alpha (add_gaussians).
+    # or None, "degree": int, "splat_depth": "center" (when absent) or "ray"}, the opacities the
+    # colors' alpha (add_gaussians).
     primitive: dict[str, Any] | None = None
 
     def add_to(self, scene: Scene) -> int:
@@ -70,7 +71,8 @@ class MeshArrays:
             if sh is not None:
                 sh = np.asarray(sh, np.float32).reshape(len(self.positions), -1, 3)
             return scene.add_gaussians(self.positions, p["scales"], p["rotations"], col[:, 3],
-                                       None if sh is not None else col[:, :3], sh=sh)
+                                       None if sh is not None else col[:, :3], sh=sh,
+                                       splat_depth=p.get("splat_depth", "center"))
         return scene.add_particles(self.positions, p["radii"], self.colors, self.opaque, falloff=p["falloff"], **self.surface)
 
     def triangles(self, camera: Camera) -> MeshArrays:

@@ -323,3 +323,40 @@ def shading_cost(rows: list[dict], path: str) -> None:
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def splat_trade(rows: list[dict], path: str) -> None:
+    """The splat trade of oit.bench.splats.splat_trade: one panel per scene, each method a point
+    at its mean error against the exact frame (x) and its flicker over abuffer-with-ray's
+    change between frames (y), a circle with splat_depth="center", a triangle with "ray", the
+    area growing with its time. Both logarithmic; the exact answer sits at the lower left."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    scenes = list(dict.fromkeys(r["scene"] for r in ok))
+    fig, axes = plt.subplots(1, len(scenes), figsize=(5.4 * len(scenes), 4.4), squeeze=False)
+    methods = list(dict.fromkeys(r["method"] for r in ok))
+    colors = {m: plt.get_cmap("tab10")(i % 10) for i, m in enumerate(methods)}
+    fastest = min(r["ms"] for r in ok)
+    for ax, scene in zip(axes[0], scenes):
+        for r in (r for r in ok if r["scene"] == scene):
+            # Zero error or flicker (the exact frame itself) drawn at the axis' floor.
+            x, y = max(r["mean_err"], 1e-6), max(r["flicker_ratio"], 1e-4)
+            marker = "o" if r["splat_depth"] == "center" else "^"
+            ax.scatter(x, y, s=30 * math.sqrt(r["ms"] / fastest), marker=marker, color=colors[r["method"]], alpha=0.8)
+            ax.annotate(f"{r['method']} {r['splat_depth'][0]}", (x, y), fontsize=6, xytext=(3, 2), textcoords="offset points")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(scene, fontsize=9)
+        ax.set_xlabel("mean error against abuffer (ray)", fontsize=8)
+        ax.set_ylabel("flicker / exact change between frames", fontsize=8)
+        ax.grid(True, alpha=0.3, which="both")
+    first = ok[0] if ok else {"splats": 0, "size": "", "adapter": ""}
+    fig.suptitle(f"Gaussian splats: error and flicker ({first['splats']} splats, {first['size']}; o center, ^ ray; "
+                 f"area ~ time; {first['adapter']})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

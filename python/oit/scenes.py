@@ -28,7 +28,7 @@ from ._meshes import (
 
 __all__ = ["BuiltScene", "MeshArrays", "from_meshes", "is_lit", "unlit", "hair", "smoke", "foliage",
            "dragons", "glass", "stacks", "splats", "ALPHA_KINDS", "DRAGON_ALPHAS", "DRAGON_FILE", "shared_data_dir",
-           "default_dragon_path", "SCENES", "SHOWCASE", "PEER_FAN_SEGMENTS"]
+           "default_dragon_path", "splat_cloud", "SCENES", "SHOWCASE", "PEER_FAN_SEGMENTS"]
 
 
 ALPHA_KINDS = ("random", "increasing", "worst", "constant")
@@ -248,7 +248,7 @@ def _quaternions_to(normals: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 
 
-def splats(count: int = 20000, kind: str = "surface", seed: int = 0) -> BuiltScene:
+def splats(count: int = 20000, kind: str = "surface", seed: int = 0, splat_depth: str = "center") -> BuiltScene:
     """Gaussian splats (`Scene.add_gaussians`), as 3D Gaussian splatting fits them, in one set.
 
     `kind="surface"`: flat Gaussians fitted to a bumpy blob's surface, each lying in the tangent
@@ -256,9 +256,12 @@ def splats(count: int = 20000, kind: str = "surface", seed: int = 0) -> BuiltSce
     that across), colored by their normal, mostly opaque (0.6-0.95): overlapping discs, a few
     deep where the surface folds or turns edge-on. `kind="cloud"`: anisotropic Gaussians in random orientations
     filling an ellipsoid, faint (0.03-0.25) and deep, as a volume of smoke is fitted. Any count
-    from thousands to millions."""
+    from thousands to millions. `splat_depth`: the set's fragment depth, "center" or "ray"
+    (`Scene.add_gaussians`)."""
     if kind not in ("surface", "cloud"):
         raise ValueError(f"kind must be 'surface' or 'cloud', got {kind!r}")
+    if splat_depth not in ("center", "ray"):
+        raise ValueError(f"splat_depth must be 'center' or 'ray', got {splat_depth!r}")
     if count < 1:
         raise ValueError(f"count must be at least 1, got {count}")
     rng = np.random.default_rng(seed)
@@ -293,10 +296,10 @@ def splats(count: int = 20000, kind: str = "surface", seed: int = 0) -> BuiltSce
         opacity = rng.uniform(0.03, 0.25, count)
     colors = np.concatenate([rgb, opacity[:, None]], 1).astype(np.float32)
     primitive = {"kind": "gaussians", "scales": scales.astype(np.float32), "rotations": rotations.astype(np.float32),
-                 "sh": None, "degree": 0}
+                 "sh": None, "degree": 0, "splat_depth": splat_depth}
     set_ = MeshArrays(means.astype(np.float32), np.zeros((0, 3), np.uint32), colors, primitive=primitive)
     camera = Camera.look_at(eye=(0.6, 0.5, 2.8), target=(0.0, 0.0, 0.0), fov_y=45.0, near=1.0, far=5.0)
-    return from_meshes([set_], camera, (512, 512), {"splats": count, "kind": kind})
+    return from_meshes([set_], camera, (512, 512), {"splats": count, "kind": kind, "splat_depth": splat_depth})
 
 
 # The opacities of the hybrid paper's 22 dragons (Maule et al. 2013), front to back.
@@ -372,7 +375,14 @@ def dragons(path: str | os.PathLike | None = "default", max_triangles: int = 800
                        lights=[((-0.4, -0.8, -0.45), (1.0, 1.0, 1.0), 0.65)], ambient=(0.35, 0.35, 0.35))
 
 
+def splat_cloud(count: int = 20000, seed: int = 0, splat_depth: str = "center") -> BuiltScene:
+    """`splats(count, kind="cloud")`: faint anisotropic Gaussians filling an ellipsoid."""
+    return splats(count, "cloud", seed, splat_depth)
+
+
 # Every builder by name; SHOWCASE is what the benchmark runs by default (stacks is the Figure 7
-# experiment's synthetic input, sized to the frame).
-SCENES = {"hair": hair, "smoke": smoke, "foliage": foliage, "dragons": dragons, "glass": glass, "stacks": stacks}
+# experiment's synthetic input, sized to the frame; the splat scenes are chosen by name, and
+# `python -m oit bench --splats` measures them).
+SCENES = {"hair": hair, "smoke": smoke, "foliage": foliage, "dragons": dragons, "glass": glass, "stacks": stacks,
+          "splats": splats, "splat_cloud": splat_cloud}
 SHOWCASE = ("hair", "smoke", "foliage", "dragons", "glass")

@@ -43,6 +43,20 @@ pub fn over_base_pass<'e>(
 ) -> wgpu::RenderPass<'e> {
     let out = &targets.out_texture;
     enc.copy_texture_to_texture(targets.base_texture.as_image_copy(), out.as_image_copy(), out.size());
+    over_pass(enc, label, targets, depth, depth_ops, tile, timestamps)
+}
+
+/// `over_base_pass` without the copy: the pass blends into the output as an earlier pass left
+/// it (a frame drawn in several passes).
+pub fn over_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    targets: &'e crate::targets::Targets,
+    depth: &'e wgpu::TextureView,
+    depth_ops: Option<wgpu::Operations<f32>>,
+    tile: crate::tiles::Tile,
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'e>>,
+) -> wgpu::RenderPass<'e> {
     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {

@@ -82,6 +82,17 @@ impl PassTimer {
         })
     }
 
+    /// `span_compute` for render passes.
+    pub fn span_render(&self, slot: Option<u32>, begin: bool, end: bool) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        let (set, _, _) = self.queries.as_ref()?;
+        let i = slot?;
+        (begin || end).then_some(wgpu::RenderPassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: begin.then_some(2 * i),
+            end_of_pass_write_index: end.then_some(2 * i + 1),
+        })
+    }
+
     fn slot(&mut self, label: &'static str) -> Option<u32> {
         self.queries.as_ref()?;
         let i = self.labels.len() as u32;

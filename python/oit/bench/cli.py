@@ -23,6 +23,8 @@ from .load import LOAD_COLUMNS, LOAD_TRIANGLES, TARGET_TRIANGLES_PER_S, fuzz_loa
 from .results import COLUMNS, run
 from .scale import SCALE_METHODS, SWEEPS, parse_size, scale, write_scale
 from .shading import SHADING_COLUMNS, SHADING_COSTS, SHADING_METHODS, shading_cost
+from .splats import SCALE_COLUMNS as SPLAT_SCALE_COLUMNS
+from .splats import SPLAT_COUNT, TRADE_COLUMNS, TRADE_METHODS, splat_scale, splat_trade
 from .strands import STRAND_COLUMNS, STRAND_COUNTS, strands_vs_ribbons
 from .strands import STRAND_METHODS as STRAND_METHODS_DEFAULT
 from .temporal import TEMPORAL_COLUMNS, TEMPORAL_FRAMES, TEMPORAL_STEP_DEG, temporal
@@ -98,6 +100,14 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--strand-counts", type=int, nargs="+", default=list(STRAND_COUNTS), help=argparse.SUPPRESS)
     ap.add_argument("--scale-layers", type=int, nargs="+", default=None,
                     help="--scale: layers of the depth sweep's stacks (default: 4 40 400 4000)")
+    ap.add_argument("--splats", action="store_true",
+                    help="instead of the method sweep: on Gaussian splats (oit.scenes.splats, surface and cloud), each "
+                         "method's time, memory, error and flicker over an orbit against abuffer with splat_depth='ray', "
+                         "with both depth choices (splats.csv, splats.md, splats.png)")
+    ap.add_argument("--splat-count", type=int, default=SPLAT_COUNT, help="--splats: splats a scene (default: %(default)s)")
+    ap.add_argument("--splat-scale", action="store_true",
+                    help="instead of the method sweep: a million splats rendered by every bounded method at 512² and "
+                         "1920x1080 under a 256 MiB memory_budget (splat-scale.csv, splat-scale.md)")
     ap.add_argument("--load", action="store_true",
                     help=f"instead of the method sweep: a {LOAD_TRIANGLES / 1e6:.1f} M-triangle mesh as OBJ, GLB, binary PLY "
                          "and binary STL, each loaded by Scene.from_file in a fresh interpreter: triangles a second "
@@ -186,6 +196,22 @@ def run_cli(a: argparse.Namespace) -> int:
         return 0
     if a.claims:
         write_tables(a.out, "claims", run_claims(full=a.full, only=a.only), CLAIM_COLUMNS)
+        return 0
+    if a.splats or a.splat_scale:
+        methods = tuple(a.methods) if a.methods else None
+        if a.splats:
+            size = a.sizes[0] if a.sizes else 256
+            result = splat_trade(methods=methods or TRADE_METHODS, count=a.splat_count, size=size,
+                                 frames=a.frames, step_deg=a.step, quick=a.quick)
+            write_tables(a.out, "splats", result, TRADE_COLUMNS)
+            if not _plots_missing(a):
+                from .. import plots
+
+                path = os.path.join(a.out, "splats.png")
+                plots.splat_trade(result.rows, path)
+                print(f"wrote {path}")
+        if a.splat_scale:
+            write_tables(a.out, "splat-scale", splat_scale(methods=methods, quick=a.quick), SPLAT_SCALE_COLUMNS)
         return 0
     if a.temporal or a.auto or a.antialias or a.scale or a.shading_cost:
         if a.shading_cost:

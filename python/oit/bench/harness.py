@@ -31,6 +31,7 @@ QUICK_SIZE = 64  # --quick caps frames at this size: a smoke test of the bench, 
 # (192,000 triangles, 340 layers) takes 25 s even at 64 x 64 on lavapipe.
 QUICK_SCENE_ARGS: dict[str, dict[str, Any]] = {
     "hair": {"strands": 600}, "smoke": {"particles": 150}, "foliage": {"leaves": 1500}, "dragons": {"max_triangles": 800},
+    "splats": {"count": 2000}, "splat_cloud": {"count": 2000},
 }
 # Parameters that choose a random stream rather than a point on the speed-accuracy trade.
 HELD_AT_DEFAULT = ("seed",)

@@ -46,6 +46,10 @@ pub(crate) struct FrameCtx<'a> {
     pub frame_uniform: &'a wgpu::Buffer,
     /// Limits to size buffers by (the adapter's, or lower ones the caller asked for).
     pub limits: Limits,
+    /// What the memory budget leaves beside the frame's targets (None without a budget): a
+    /// buffer that grows with the scene rather than the tile (`sorted`'s splat draws) is
+    /// sized within it.
+    pub memory_left: Option<u64>,
     /// A coverage-mask frame's per-sample targets (only methods that take coverage masks
     /// see one).
     pub coverage: Option<&'a SampleTargets>,
@@ -345,6 +349,7 @@ impl FrameCtx<'_> {
             fragments: self.fragments,
             frame_uniform: self.frame_uniform,
             limits: self.limits,
+            memory_left: self.memory_left,
             coverage: self.coverage,
             variant: self.variant,
         }

@@ -282,6 +282,7 @@ impl Renderer {
         let (_, gpu_scene) = self.scene.as_ref().expect("uploaded by the caller");
         self.set_uniform(job.camera, gpu_scene, job.background, tile);
         let variant = self.variant(gpu_scene);
+        let memory_left = self.memory_budget.map(|b| b.saturating_sub(self.held_target_bytes()));
         loop {
             self.timer.reset();
             let mut cx = FrameCtx {
@@ -298,6 +299,7 @@ impl Renderer {
                 depth_complexity: tile_counts,
                 frame_uniform: &self.shared.uniform,
                 limits: self.limits,
+                memory_left,
                 coverage: self.coverage.as_ref().filter(|_| job.coverage).map(|c| &c.targets),
                 variant,
             };

@@ -47,7 +47,7 @@ pub struct Geometry {
     pub triangles: u32,
     pub placements: Vec<Placement>,
     /// A splat set's placement: its Gaussians' means in world space (its instance applied),
-    /// what `sorted` orders them by (`splat_draws`); empty for every other placement.
+    /// what `sorted` orders them by (`splat_slots`); empty for every other placement.
     pub splat_means: Vec<Vec<Vec3>>,
     /// Per mesh of this geometry: its segments, its first instance and its instance count.
     segments: Vec<Vec<Segment>>,
@@ -110,28 +110,24 @@ impl Geometry {
         }
     }
 
-    /// The draws of splat set placement `p` with its splats in `order` (indices into the set):
-    /// runs of consecutive splats in one chunk, each its chunk and the indirect draw arguments
-    /// of its splats (six vertices, one instance each: vertex count, instance count, first
-    /// vertex, first instance), for `multi_draw_indirect`; the instance is 0 where the passes
-    /// read no instance table.
-    pub fn splat_draws(&self, p: &Placement, order: &[u32]) -> Vec<(usize, Vec<[u32; 4]>)> {
-        // Each splat's chunk and first vertex, in the set's order (two triangles a splat).
-        let slots: Vec<(usize, u32)> =
-            self.segments[p.mesh].iter().flat_map(|s| (s.lo..s.hi).step_by(2).map(move |t| (s.chunk, 3 * t))).collect();
+    /// Where splat set placement `p` draws its splats: for splat `k` of the set, its chunk and
+    /// the indirect draw arguments of its quad (six vertices, one instance: vertex count,
+    /// instance count, first vertex, first instance), for `multi_draw_indirect`; the instance
+    /// is 0 where the passes read no instance table. Nothing is held a splat: a set's
+    /// segments are few, and `k` finds its own by a binary search of their starts.
+    pub fn splat_slots(&self, p: &Placement) -> impl Fn(u32) -> (usize, [u32; 4]) + '_ {
+        let segments = &self.segments[p.mesh];
+        // The set's first splat in each segment (two triangles a splat).
+        let starts: Vec<u32> = segments.iter().scan(0, |n, s| Some(std::mem::replace(n, *n + (s.hi - s.lo) / 2))).collect();
         let instance = if self.instanced { p.instance } else { 0 };
-        let mut runs: Vec<(usize, Vec<[u32; 4]>)> = Vec::new();
-        for &k in order {
-            let (chunk, first) = slots[k as usize];
-            match runs.last_mut() {
-                Some((c, args)) if *c == chunk => args.push([6, 1, first, instance]),
-                _ => runs.push((chunk, vec![[6, 1, first, instance]])),
-            }
+        move |k| {
+            let i = starts.partition_point(|&s| s <= k) - 1;
+            let s = segments[i];
+            (s.chunk, [6, 1, 3 * (s.lo + 2 * (k - starts[i])), instance])
         }
-        runs
     }
 
-    /// Binds chunk `chunk`'s group 0 (for draws of `splat_draws`).
+    /// Binds chunk `chunk`'s group 0 (for draws of `splat_slots`).
     pub fn bind_chunk(&self, pass: &mut wgpu::RenderPass<'_>, chunk: usize) {
         pass.set_bind_group(0, &self.chunks[chunk].group, &[]);
     }
