@@ -139,6 +139,17 @@ def _size(text: str) -> tuple[int, int]:
         raise argparse.ArgumentTypeError(str(e)) from None
 
 
+def _plot(a: argparse.Namespace, name: str, draw: str, rows: list) -> None:
+    """Draws `rows` with `plots.<draw>` into `<out>/<name>.png`, unless the plots are skipped."""
+    if _plots_missing(a):
+        return
+    from .. import plots
+
+    path = os.path.join(a.out, f"{name}.png")
+    getattr(plots, draw)(rows, path)
+    print(f"wrote {path}")
+
+
 def _plots_missing(a: argparse.Namespace) -> bool:
     """True (and says why) when the plots are to be skipped."""
     if a.no_plots:
@@ -204,12 +215,7 @@ def run_cli(a: argparse.Namespace) -> int:
             result = splat_trade(methods=methods or TRADE_METHODS, count=a.splat_count, size=size,
                                  frames=a.frames, step_deg=a.step, quick=a.quick)
             write_tables(a.out, "splats", result, TRADE_COLUMNS)
-            if not _plots_missing(a):
-                from .. import plots
-
-                path = os.path.join(a.out, "splats.png")
-                plots.splat_trade(result.rows, path)
-                print(f"wrote {path}")
+            _plot(a, "splats", "splat_trade", result.rows)
         if a.splat_scale:
             write_tables(a.out, "splat-scale", splat_scale(methods=methods, quick=a.quick), SPLAT_SCALE_COLUMNS)
         return 0
@@ -219,12 +225,7 @@ def run_cli(a: argparse.Namespace) -> int:
                 raise ValueError(f"--costs must be >= 0, got {a.costs}")
             result = shading_cost(a.scenes, a.methods, a.sizes, tuple(a.costs), repeat, a.quick)
             write_tables(a.out, "shading", result, SHADING_COLUMNS)
-            if not _plots_missing(a):
-                from .. import plots
-
-                path = os.path.join(a.out, "shading.png")
-                plots.shading_cost(result.rows, path)
-                print(f"wrote {path}")
+            _plot(a, "shading", "shading_cost", result.rows)
         if a.scale:
             result = scale(a.scale_sweeps, a.methods, a.scale_sizes, a.scale_strands, a.scale_layers, repeat, a.quick)
             fits = write_scale(a.out, result)
@@ -239,12 +240,7 @@ def run_cli(a: argparse.Namespace) -> int:
         if a.temporal:
             result = temporal(a.scenes, a.methods, a.sizes, a.frames, a.step, a.quick)
             write_tables(a.out, "temporal", result, TEMPORAL_COLUMNS)
-            if not _plots_missing(a):
-                from .. import plots
-
-                path = os.path.join(a.out, "temporal.png")
-                plots.temporal(result.rows, path)
-                print(f"wrote {path}")
+            _plot(a, "temporal", "temporal", result.rows)
         if a.auto:
             if a.methods is not None:
                 print("note: --auto compares auto with hybrid; --methods is ignored")
