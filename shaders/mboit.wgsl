@@ -184,19 +184,6 @@ fn christoffel(h: Hankel, f: Forward) -> vec4<f32> {
     return 1.0 / s;
 }
 
-// L^-1 (1, z, .., z^N) at one point: (y1 .. y4).
-fn forward_at(h: Hankel, z: f32) -> vec4<f32> {
-    var y = vec4<f32>(z - h.m.x, 0.0, 0.0, 0.0);
-    y.y = z * z - h.m.y - h.l1.y * y.x;
-    if N >= 3u {
-        y.z = z * z * z - h.m.z - h.l1.z * y.x - h.l2.y * y.y;
-    }
-    if N >= 4u {
-        y.w = z * z * z * z - h.m.w - dot(vec3<f32>(h.l1.w, h.l2.z, h.l3.y), y.xyz);
-    }
-    return y;
-}
-
 // H^-1 v(z) from g = D^-1 L^-1 v(z): the kernel polynomial's coefficients (c0 .. c3) and c4,
 // by the back substitution c_i = g_i - sum over k > i of L[k][i] c_k.
 fn kernel(h: Hankel, g: vec4<f32>) -> array<vec4<f32>, 2> {
@@ -297,10 +284,10 @@ fn kernel_roots(kc: array<vec4<f32>, 2>) -> vec4<f32> {
 fn transmittance(b0: f32, lo: vec4<f32>, hi: vec4<f32>, z: f32) -> vec3<f32> {
     let inv_b0 = 1.0 / b0;
     let h = hankel(mix(lo * inv_b0, bias_lo(), MBOIT_BIAS), mix(hi * inv_b0, bias_hi(), MBOIT_BIAS));
-    // Components past N are 0 in y and 1 in d.
-    let y = forward_at(h, z);
-    let g = y * h.inv_d;
-    let own = 1.0 / (1.0 + dot(g, y));
+    // In one lane: the other lanes' work is dropped (components past N are 0 in y, 1 in 1 / d).
+    let at_z = forward(h, vec4<f32>(z));
+    let own = christoffel(h, at_z).x;
+    let g = vec4<f32>(at_z.y1.x, at_z.y2.x, at_z.y3.x, at_z.y4.x) * h.inv_d;
     let roots = kernel_roots(kernel(h, g));
     // Summed lane by lane up to N, so that the compiler drops the unused lanes' work.
     let w = christoffel(h, forward(h, roots)) * select(vec4<f32>(0.0), vec4<f32>(1.0), roots < vec4<f32>(z));

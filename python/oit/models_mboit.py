@@ -10,13 +10,12 @@ import numpy as np
 from numpy.polynomial import chebyshev
 
 from ._api import constants
-from ._stack import out, visible
+from ._stack import optical_depth, out, visible
 
 _SHARED = constants()  # the core's numbers (crates/oit-core/src/consts.rs), not copies
 
 # mboit's shared numbers (crates/oit-core/src/consts.rs): the smallest 1 - alpha, the bias
 # vectors' even moments and the default biases for 4, 6 and 8 power moments.
-MBOIT_MIN_TRANSMITTANCE = float(np.float32(_SHARED["MBOIT_MIN_TRANSMITTANCE"]))
 MBOIT_MIN_WEIGHT = float(np.float32(_SHARED["MBOIT_MIN_WEIGHT"]))
 MBOIT_STAR = {m: [float(np.float32(_SHARED[f"MBOIT_STAR{m}_{k}"])) for k in range(2, m + 1, 2)] for m in (4, 6, 8)}
 MBOIT_BIAS = {m: float(np.float32(_SHARED[f"MBOIT_BIAS_{m}"])) for m in (4, 6, 8)}
@@ -34,7 +33,7 @@ def mboit_angle(z) -> np.ndarray:
 def mboit_trig_moments(z, alpha, moments=3) -> np.ndarray:
     """(b0, b1, .., b_moments) complex (`moments` complex ones: twice as many reals): the
     optical depths' sum and their sums times exp(i j angle(z))."""
-    od = -np.log(np.maximum(1.0 - np.asarray(alpha, np.float64), MBOIT_MIN_TRANSMITTANCE))
+    od = optical_depth(alpha)
     phi = mboit_angle(z)
     return np.array([np.sum(od * np.exp(1j * j * phi)) for j in range(moments + 1)])
 
@@ -69,7 +68,7 @@ def mboit_moments(z, alpha, moments=6) -> np.ndarray:
     """(b0, b1, .., b_moments): the sums of the optical depths -ln(1 - alpha) (1 - alpha at least
     MBOIT_MIN_TRANSMITTANCE) and of the optical depths times the warped depth 2 z - 1 to the k
     (the shader's warp under an orthographic camera, the identity included)."""
-    od = -np.log(np.maximum(1.0 - np.asarray(alpha, np.float64), MBOIT_MIN_TRANSMITTANCE))
+    od = optical_depth(alpha)
     w = 2.0 * np.asarray(z, np.float64) - 1.0
     return np.array([np.sum(od * w ** k) for k in range(moments + 1)])
 
@@ -145,7 +144,7 @@ def stored16(z, alpha, moments: int, basis: str) -> tuple[float, np.ndarray]:
     T_k(2z - 1) for the power basis, cos and sin of j times the angle for the trigonometric."""
     b0, t = 0.0, np.zeros(moments)
     for zi, ai in zip(z, alpha):
-        od = -np.log(max(1.0 - float(ai), MBOIT_MIN_TRANSMITTANCE))
+        od = float(optical_depth(ai))
         if basis == "power":
             p = np.array([chebyshev.chebval(2.0 * zi - 1.0, np.eye(moments + 1)[k]) for k in range(1, moments + 1)])
         else:

@@ -7,11 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 from ._api import constants
-from ._stack import out, visible
+from ._stack import optical_depth, out, visible
 
 _SHARED = constants()
-# mboit's floors, shared: the smallest 1 - alpha and the smallest weight.
-MIN_TRANSMITTANCE = float(np.float32(_SHARED["MBOIT_MIN_TRANSMITTANCE"]))
+# mboit's floor, shared: the smallest weight.
 MIN_WEIGHT = float(np.float32(_SHARED["MBOIT_MIN_WEIGHT"]))
 
 
@@ -27,7 +26,7 @@ def wavelet_coefficients(z, alpha, rank=16) -> np.ndarray:
     """d_i = sum of tau h_i(z) over the fragments: tau = -ln(1 - alpha) (1 - alpha at least
     MBOIT_MIN_TRANSMITTANCE), h_0 = 1, h_i = +1 on the near half of wavelet i's support and -1
     on its far half (unnormalized: the orthonormal psi_i is 2^(j/2) h_i)."""
-    tau = -np.log(np.maximum(1.0 - np.asarray(alpha, np.float64), MIN_TRANSMITTANCE))
+    tau = optical_depth(alpha)
     scale, shift = wavelet_levels(rank)
     x = np.minimum(np.asarray(z, np.float64), WAVELET_BELOW_ONE)[:, None] * scale - shift
     h = np.where((x >= 0) & (x < 1), np.where(x < 0.5, 1.0, -1.0), 0.0)
@@ -63,7 +62,7 @@ def wavelet_transmittance(d, z, alpha) -> float:
     over its cell up to z."""
     u = min(float(z), WAVELET_BELOW_ONE)
     near, far = wavelet_cell(len(d), u)
-    own = (u - near) / (far - near) * -np.log(max(1.0 - float(alpha), MIN_TRANSMITTANCE))
+    own = (u - near) / (far - near) * float(optical_depth(alpha))
     return float(np.clip(np.exp(own - wavelet_absorbance(d, u)), MIN_WEIGHT, 1.0))
 
 

@@ -252,17 +252,15 @@ impl Method for Auto {
         let pixels = cx.pixels();
         let counts = cx.depth_complexity;
         let sums = self.measure(cx)?;
-        // mboit's targets when it was tried and missed (they count in the frame's memory).
-        let mut moments_bytes = None;
-        if weighted_average_bound(counts, &sums) <= tolerance {
+        // What became of mboit, and its targets' bytes where it was tried and missed (they count
+        // in the frame's memory).
+        let (moments, tried) = if weighted_average_bound(counts, &sums) <= tolerance {
             match self.try_moments(cx, tolerance)? {
                 Ok(done) => return Ok(done),
-                Err(bytes) => moments_bytes = Some(bytes),
+                Err(bytes) => (MOMENTS_MISSED, bytes),
             }
-        }
-        let (moments, tried) = match moments_bytes {
-            Some(bytes) => (MOMENTS_MISSED, bytes),
-            None => (0.0, 0),
+        } else {
+            (0.0, 0)
         };
         let predicted = choose_slots(counts, &sums, tolerance);
         let predicted_k = predicted.as_ref().map_or(0, |s| s.iter().copied().max().unwrap_or(0));

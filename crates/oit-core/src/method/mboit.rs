@@ -135,15 +135,10 @@ impl Method for Mboit {
         };
         let targets: Vec<_> = formats.iter().map(|&f| blended(f, ADD)).collect();
         let gather = cx.draw_pipeline(spec(PIPELINES, moments_fs), &consts, targets, pipeline::depth_test_only());
-        let shade_targets = SHADE_FORMATS.iter().map(|&f| blended(f, ADD)).collect();
-        let shade = cx.draw_pipeline(spec(PIPELINES, shade_fs), &consts, shade_targets, pipeline::depth_test_only());
-        let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), &consts, true);
         let moments = FloatTargets::ensure(&mut self.moments, cx, &formats, bindings);
-        let accum = FloatTargets::ensure(&mut self.accum, cx, &SHADE_FORMATS, TEXTURES);
         let mut enc = cx.encoder();
         moments.blend("moments", cx, &mut enc, &vec![wgpu::Color::TRANSPARENT; formats.len()], &gather, &[]);
-        accum.blend("shade", cx, &mut enc, &[wgpu::Color::TRANSPARENT; 2], &shade, &[cx.targets_group(), &moments.group]);
-        cx.resolve(&mut enc, "resolve", &resolve, &accum.group, true);
+        shade_and_resolve(cx, &mut enc, &mut self.accum, &consts, shade_fs, &moments.group);
         cx.submit(enc);
         Ok(Outcome::Done(MethodReport { memory_bytes: bytes(cx.pixels(), cx.params), error_bound: true, ..Default::default() }))
     }
@@ -155,16 +150,29 @@ impl Mboit {
     /// a priori (docs/methods.md, "mboit").
     fn render16(&mut self, cx: &mut FrameCtx<'_>, consts: &[Const], m: u32) -> Result<Outcome> {
         let what = format!("mboit with moments = {m} at 16 bits");
-        let shade_targets = SHADE_FORMATS.iter().map(|&f| blended(f, ADD)).collect();
-        let shade = cx.draw_pipeline(spec(PIPELINES, "fs_shade16"), consts, shade_targets, pipeline::depth_test_only());
-        let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), consts, true);
         let gather = cx.capture_pipeline(spec(PIPELINES, "fs_moments16"), consts);
-        let accum = FloatTargets::ensure(&mut self.accum, cx, &SHADE_FORMATS, TEXTURES);
         let (group, mut enc) = self.locks.begin(cx, OWN16, &what, (4 * (1 + m as u64 / 2), 1))?;
         cx.capture(&mut enc, "moments", &gather, group);
-        accum.blend("shade", cx, &mut enc, &[wgpu::Color::TRANSPARENT; 2], &shade, &[cx.targets_group(), group]);
-        cx.resolve(&mut enc, "resolve", &resolve, &accum.group, true);
+        shade_and_resolve(cx, &mut enc, &mut self.accum, consts, "fs_shade16", group);
         let report = self.locks.finish(cx, enc, bytes(cx.pixels(), cx.params))?;
         Ok(Outcome::Done(report))
     }
+}
+
+/// Records the shade pass (entry `shade_fs`, reading the moments bound as `moments`) into the
+/// accumulation targets `accum` keeps, and the resolve: what both precisions share.
+fn shade_and_resolve(
+    cx: &mut FrameCtx<'_>,
+    enc: &mut wgpu::CommandEncoder,
+    accum: &mut Option<FloatTargets>,
+    consts: &[Const],
+    shade_fs: &str,
+    moments: &wgpu::BindGroup,
+) {
+    let shade_targets = SHADE_FORMATS.iter().map(|&f| blended(f, ADD)).collect();
+    let shade = cx.draw_pipeline(spec(PIPELINES, shade_fs), consts, shade_targets, pipeline::depth_test_only());
+    let resolve = cx.resolve_pipeline(spec(PIPELINES, "fs_resolve"), consts, true);
+    let accum = FloatTargets::ensure(accum, cx, &SHADE_FORMATS, TEXTURES);
+    accum.blend("shade", cx, enc, &[wgpu::Color::TRANSPARENT; 2], &shade, &[cx.targets_group(), moments]);
+    cx.resolve(enc, "resolve", &resolve, &accum.group, true);
 }

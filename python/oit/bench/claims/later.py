@@ -6,12 +6,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import numpy as np
-
 from ... import Renderer, memory_bytes
 from ... import scenes as scene_lib
 from ..harness import QUICK_SCENE_ARGS
-from .common import FAILS, HOLDS, TIE, TOL, Claim, full_screen_layers, mean_err, median_ms
+from .common import FAILS, HOLDS, TIE, TOL, Claim, error_against, full_screen_layers, mean_err, median_ms, timed_ms
 
 
 def _thinned(name: str, size: int = 64) -> scene_lib.BuiltScene:
@@ -74,9 +72,8 @@ def wavelets_on_smoke() -> tuple[str, str]:
     exact = r.render(built.scene, built.camera, "abuffer")
     rows = {}
     for label, m, p in (("wavelet", "wavelet", {}), ("mboit 6", "mboit", {"moments": 6}), ("mlab 4", "mlab", {"layers": 4})):
-        frame = r.render(built.scene, built.camera, m, **p)
-        err = float(np.abs(frame.image[..., :3] - exact.image[..., :3]).max(-1)[exact.depth_complexity > 0].mean())
-        rows[label] = (err, median_ms(r, built, m, **p), frame.stats["memory_bytes"] / 2 ** 20)
+        frame, ms = timed_ms(r, built, m, **p)
+        rows[label] = (error_against(frame.image, exact), ms, frame.stats["memory_bytes"] / 2 ** 20)
     w, mb = rows["wavelet"], rows["mboit 6"]
     text = ("smoke at its size, mean error against the A-buffer, GPU median of 3, memory: " + ", ".join(
         f"{k} {e:.4f}, {t:.0f} ms, {mib:.1f} MiB" for k, (e, t, mib) in rows.items())
